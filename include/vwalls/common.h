@@ -1,0 +1,59 @@
+/* vwalls/common.h - status codes, export macro and the axis-aligned box.
+ *
+ * Every call that can fail returns a vw_status; results come back through
+ * out-pointers. Names and messages come from one X-macro so they cannot drift apart.
+ */
+#ifndef VWALLS_COMMON_H
+#define VWALLS_COMMON_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#if defined(VW_BUILDING_LIBRARY) && defined(__GNUC__)
+#define VW_API __attribute__((visibility("default")))
+#else
+#define VW_API
+#endif
+
+#define VW_VERSION_MAJOR 0
+#define VW_VERSION_MINOR 1
+#define VW_VERSION_PATCH 0
+#define VW_VERSION_STRING "0.1.0"
+
+/* X(name, message) */
+#define VW_STATUS_MAP(X)                                              \
+    X(OK, "success")                                                  \
+    X(E_INVAL, "invalid argument")                                    \
+    X(E_INPUT, "bad input")                                           \
+    X(E_NOMEM, "out of memory")                                       \
+    X(E_IO, "input/output error")                                     \
+    X(E_STATE, "call not valid in the current state")                 \
+    X(E_LIMIT, "limit exceeded")                                      \
+    X(E_MPI, "MPI failure")                                           \
+    X(E_PEER, "another process failed")                               \
+    X(E_UNSUPPORTED, "not supported by this build")
+
+typedef enum vw_status {
+#define VW__STATUS_ENUM(name, msg) VW_##name,
+    VW_STATUS_MAP(VW__STATUS_ENUM)
+#undef VW__STATUS_ENUM
+    VW_STATUS_COUNT
+} vw_status;
+
+VW_API const char *vw_status_name(vw_status s);
+VW_API const char *vw_status_message(vw_status s);
+VW_API const char *vw_version(void);
+
+/* A closed axis-aligned box [lo, hi]. */
+typedef struct vw_box {
+    double lo[3], hi[3];
+} vw_box;
+
+#ifdef __cplusplus
+}
+#endif
+#endif

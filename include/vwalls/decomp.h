@@ -1,0 +1,118 @@
+/* vwalls/decomp.h - decompositions of the world box into cells by virtual walls.
+ *
+ * Every decomposition is a kd-tree of axis-aligned splits ("walls") over the world box,
+ * expressed in a decomposition frame: frame coordinates are p' = F p for an orthonormal
+ * 3x3 matrix F (identity unless the balancer rotated the frame). Points, rays and object
+ * bounds are given in world coordinates; cell boxes are in frame coordinates.
+ *
+ * Invariants: the leaves ("cells") tile the world box with no gap or overlap; a point on
+ * a wall belongs to the cell on the side its direction points to (+ side when the
+ * direction is zero along that axis); the segments of a ray walk are contiguous: the
+ * exit parameter of one cell is, as the same double, the entry parameter of the next,
+ * so a ray's t-interval is split the same way wherever the walk is restarted.
+ */
+#ifndef VWALLS_DECOMP_H
+#define VWALLS_DECOMP_H
+
+#include "vwalls/common.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define VW_MAX_CELLS 32768
+
+typedef struct vw_decomp vw_decomp;
+
+typedef enum vw_decomp_kind {
+    VW_DECOMP_GRID = 0,      /* global walls per axis: one neighbour per face */
+    VW_DECOMP_STAGGERED = 1, /* x slabs, y cuts per slab, z cuts per column */
+    VW_DECOMP_DIVIDED = 2    /* any kd-tree, e.g. a grid with divided cells */
+} vw_decomp_kind;
+
+VW_API const char *vw_decomp_kind_name(vw_decomp_kind k);
+
+/* One node of a kd-tree description. axis < 0 marks a leaf holding cell `cell`;
+   otherwise points with p[axis] < split go to `left`, the others to `right`.
+   Node 0 is the root. Cell ids must be exactly 0..ncells-1, each once. */
+typedef struct vw_kd_node {
+    int axis;
+    double split;
+    int left, right;
+    int cell;
+} vw_kd_node;
+
+/* "4", "2x4", "2x2x2" -> dims (missing dimensions are 1). err gets a one-line message. */
+VW_API vw_status vw_layout_parse(const char *s, int dims[3], char *err, size_t errlen);
+
+/* A grid with uniform walls. Cell id of grid index (i,j,k) is i + nx*(j + ny*k). */
+VW_API vw_status vw_decomp_create_grid(const vw_box *world, const int dims[3], vw_decomp **out);
+/* A grid with given walls: walls[a] holds dims[a]-1 increasing interior positions (frame
+   coordinates); frame is a row-major 3x3 orthonormal matrix or NULL for identity, and
+   world is then the box in frame coordinates. */
+VW_API vw_status vw_decomp_create_grid_walls(const vw_box *world, const int dims[3],
+                                             const double *const walls[3], const double *frame,
+                                             vw_decomp **out);
+/* Any kd-tree. world is in frame coordinates; frame may be NULL (identity). */
+VW_API vw_status vw_decomp_create_kd(const vw_box *world, const vw_kd_node *nodes, int nnodes,
+                                     const double *frame, vw_decomp_kind kind, vw_decomp **out);
+VW_API vw_status vw_decomp_clone(const vw_decomp *d, vw_decomp **out);
+VW_API void vw_decomp_free(vw_decomp *d);
+
+VW_API vw_decomp_kind vw_decomp_get_kind(const vw_decomp *d);
+VW_API int vw_decomp_cell_count(const vw_decomp *d);
+/* Grid dims; for other kinds {cells, 1, 1}. */
+VW_API void vw_decomp_dims(const vw_decomp *d, int dims[3]);
+/* "2x2x2" for grids, else the cell count; into buf. */
+VW_API void vw_decomp_layout_string(const vw_decomp *d, char *buf, size_t len);
+/* Interior wall positions of a grid along axis (dims[axis]-1 values); NULL otherwise. */
+VW_API const double *vw_decomp_grid_walls(const vw_decomp *d, int axis);
+VW_API vw_box vw_decomp_world(const vw_decomp *d);
+VW_API vw_box vw_decomp_cell_box(const vw_decomp *d, int cell);
+/* The kd-tree nodes (for balancers that edit a decomposition). */
+VW_API const vw_kd_node *vw_decomp_nodes(const vw_decomp *d, int *nnodes);
+/* Row-major world->frame rotation; NULL when the frame is the identity. */
+VW_API const double *vw_decomp_frame(const vw_decomp *d);
+VW_API void vw_decomp_to_frame(const vw_decomp *d, const double p[3], double out[3]);
+/* Bounds in frame coordinates of a world-coordinate box (conservative under rotation). */
+VW_API void vw_decomp_box_to_frame(const vw_decomp *d, const vw_box *b, vw_box *out);
+
+/* The cell holding world point p; dir decides points on walls (may be NULL).
+   -1 when p lies outside the world box. */
+VW_API int vw_decomp_locate(const vw_decomp *d, const double p[3], const double dir[3]);
+
+typedef struct vw_segment {
+    int cell;
+    double t0, t1;   /* the ray is inside cell for t in [t0, t1] */
+} vw_segment;
+/* Return 0 from the visitor to stop the walk. */
+typedef int (*vw_segment_fn)(const vw_segment *seg, void *user);
+/* Visits, in order of increasing t, every cell that the ray o + t d (world coordinates)
+   crosses for t in [t0, t1] (t1 may be INFINITY), with non-empty parameter intervals.
+   Returns the number of segments visited. */
+VW_API int vw_decomp_walk(const vw_decomp *d, const double o[3], const double dir[3],
+                          double t0, double t1, vw_segment_fn fn, void *user);
+/* The first segment of that walk; returns 0 when the ray misses the world. */
+VW_API int vw_decomp_first_segment(const vw_decomp *d, const double o[3], const double dir[3],
+                                   double t0, double t1, vw_segment *out);
+
+/* Faces: 0 -x, 1 +x, 2 -y, 3 +y, 4 -z, 5 +z (in frame coordinates). */
+#define VW_FACE_AXIS(f) ((f) >> 1)
+#define VW_FACE_SIGN(f) (((f) & 1) ? 1 : -1)
+/* The cells sharing a piece of face `face` of `cell` (positive area). Writes at most max
+   ids; returns the total number (a face may have several neighbours, or none). */
+VW_API int vw_decomp_neighbours(const vw_decomp *d, int cell, int face, int *out, int max);
+/* The largest number of neighbours any cell has over all faces. */
+VW_API int vw_decomp_max_neighbours(const vw_decomp *d);
+/* All cells in front-to-back order as seen from world point p (near side of every
+   split first). order must hold vw_decomp_cell_count() ids. */
+VW_API void vw_decomp_front_to_back(const vw_decomp *d, const double p[3], int *order);
+/* The cells whose box overlaps world box b (after transforming it to the frame), each
+   box widened by pad. Writes at most max ids, returns the total number. */
+VW_API int vw_decomp_cells_overlapping(const vw_decomp *d, const vw_box *b, double pad,
+                                       int *out, int max);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,96 @@
+/* vwalls/module.h - the generic module: how a user plugs a geometric problem into vwalls.
+ *
+ * A module is a table of callbacks. The runtime never knows what a ray or a patch is:
+ * it places objects into cells by their bounds, builds each cell's local state, and
+ * delivers fixed-size messages to handlers. A cell is only ever touched by the one
+ * worker thread that hosts it, so a cell's state needs no locking. Output handlers run
+ * on the output process (rank 0), one call at a time.
+ */
+#ifndef VWALLS_MODULE_H
+#define VWALLS_MODULE_H
+
+#include "vwalls/common.h"
+#include "vwalls/decomp.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define VW_MODULE_ABI 1
+#define VW_MAX_MSG_BYTES 4096
+#define VW_MAX_KINDS 64
+#define VW_MAX_COUNTERS 32
+
+/* Handed to every callback that runs for a cell: who am I, and how to send. */
+typedef struct vw_ctx vw_ctx;
+
+typedef struct vw_msg_kind {
+    const char *name;
+    size_t size;    /* bytes of one message record, at most VW_MAX_MSG_BYTES */
+    /* Runs on the worker hosting the destination cell. May send messages. */
+    void (*handle)(vw_ctx *ctx, void *cell_state, const void *msg);
+    /* For kinds sent with vw_send_output: runs on the output process. */
+    void (*output)(void *user, const void *msg);
+} vw_msg_kind;
+
+typedef struct vw_module {
+    unsigned abi;            /* VW_MODULE_ABI */
+    const char *name;
+
+    /* Objects are plain records of object_size bytes, copied into every cell their
+       bounds overlap (so they must not hold pointers that differ between processes). */
+    size_t object_size;
+    void (*object_bounds)(const void *object, vw_box *out, void *user);
+
+    const vw_msg_kind *kinds;
+    int nkinds;
+
+    /* Named per-cell counters the module adds to with vw_count(); summed over cells
+       (and processes) into the stats. */
+    const char *const *counters;
+    int ncounters;
+
+    /* Build the local state of a cell from its objects (in the order they were added).
+       Runs once per cell at commit, on the worker that hosts the cell. */
+    vw_status (*cell_build)(vw_ctx *ctx, const void *objects, size_t nobjects, void **state);
+    void (*cell_free)(void *state, void *user);
+    /* Optional: local work that needs no message (generate primary rays, shoot a patch).
+       Return nonzero when it did some work; it is called again until it returns 0, and
+       again after the cell receives messages. */
+    int (*step)(vw_ctx *ctx, void *state);
+    /* Optional load estimate of a cell; otherwise measured busy time is used. */
+    double (*load)(vw_ctx *ctx, void *state);
+    /* Optional local convergence test (used by the application's outer loop). */
+    int (*done)(vw_ctx *ctx, void *state);
+} vw_module;
+
+/* Who am I. */
+VW_API int vw_ctx_cell(const vw_ctx *ctx);
+VW_API int vw_ctx_worker(const vw_ctx *ctx);
+VW_API int vw_ctx_process(const vw_ctx *ctx);
+VW_API const vw_decomp *vw_ctx_decomp(const vw_ctx *ctx);
+VW_API vw_box vw_ctx_cell_box(const vw_ctx *ctx);
+VW_API void *vw_ctx_user(const vw_ctx *ctx);
+
+/* Sending. A message is copied when sent; the caller keeps its buffer.
+   Messages are batched per destination into packets, flushed when full or when the
+   worker has nothing else to do. */
+VW_API void vw_send_cell(vw_ctx *ctx, int cell, int kind, const void *msg);
+/* To the cell owning world point p (dir decides points on walls). Returns the cell, or
+   -1 (message dropped) when p lies outside the world. */
+VW_API int vw_send_point(vw_ctx *ctx, const double p[3], const double dir[3], int kind,
+                         const void *msg);
+/* To every neighbour across one face (0..5, see decomp.h). Returns how many. */
+VW_API int vw_send_face(vw_ctx *ctx, int face, int kind, const void *msg);
+/* To every face neighbour. Returns how many. */
+VW_API int vw_send_neighbours(vw_ctx *ctx, int kind, const void *msg);
+/* To the output process, where the kind's output handler receives it. */
+VW_API void vw_send_output(vw_ctx *ctx, int kind, const void *msg);
+
+/* Add n to the module's counter idx for this cell. */
+VW_API void vw_count(vw_ctx *ctx, int idx, int64_t n);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,102 @@
+/* vwalls/scene.h - the in-memory scene that the readers fill and the applications use.
+ *
+ * A scene is plain data: a camera, lights, materials and primitives (spheres, cones,
+ * polygons over a shared vertex array). Every primitive carries a stable global id in
+ * file order; ids are dense, 0..vw_scene_count_objects()-1, across all kinds, so that
+ * an edit script or a stats line can name an object unambiguously.
+ */
+#ifndef VWALLS_SCENE_H
+#define VWALLS_SCENE_H
+
+#include <stddef.h>
+#include <stdio.h>
+#include "vwalls/common.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct vw_material {
+    float diffuse[3];   /* NFF: colour*Kd; MTL: Kd */
+    float specular[3];  /* NFF: Ks,Ks,Ks; MTL: Ks. Weights highlights and mirror rays. */
+    float shine;        /* Phong exponent (NFF Shine, MTL Ns) */
+    float transmit;     /* NFF T; MTL 1-d or Tr */
+    float ior;          /* index of refraction (NFF ior, MTL Ni); 1 when absent */
+    float emission[3];  /* MTL Ke; zero for NFF */
+} vw_material;
+
+typedef struct vw_light {
+    double pos[3];
+    float color[3];     /* 1/sqrt(nlights) each where the file gave none */
+} vw_light;
+
+typedef struct vw_camera {
+    double from[3], at[3], up[3];
+    double angle;       /* full vertical field of view in degrees (NFF: angle) */
+    double hither;      /* near distance */
+    int width, height;  /* resolution */
+    int valid;          /* 1 when the scene file gave a camera */
+} vw_camera;
+
+typedef enum vw_prim_kind {
+    VW_PRIM_SPHERE = 0,
+    VW_PRIM_CONE = 1,       /* cone or cylinder, no caps (NFF c) */
+    VW_PRIM_POLYGON = 2     /* planar polygon, >= 3 vertices (NFF p/pp, OBJ f) */
+} vw_prim_kind;
+
+typedef struct vw_sphere {
+    int id, material;
+    double center[3], radius;
+} vw_sphere;
+
+typedef struct vw_cone {
+    int id, material;
+    double base[3], base_radius;   /* a negative radius means "inside visible" (NFF) */
+    double apex[3], apex_radius;
+} vw_cone;
+
+typedef struct vw_polygon {
+    int id, material;
+    int first;        /* index into vw_scene.indices of the first vertex index */
+    int count;        /* number of vertices, >= 3 */
+    int has_normals;  /* 1 for NFF pp / OBJ with vn: normals[first..first+count) valid */
+} vw_polygon;
+
+typedef struct vw_scene {
+    vw_camera camera;
+    float background[3];
+    vw_light *lights;       size_t nlights;
+    vw_material *materials; size_t nmaterials;
+    vw_sphere *spheres;     size_t nspheres;
+    vw_cone *cones;         size_t ncones;
+    vw_polygon *polygons;   size_t npolygons;
+    double (*vertices)[3];  size_t nvertices;
+    /* indices[k] is a vertex index; normals[k] (if present) the vertex normal for the
+       same corner. Both have nindices entries; normals may be NULL when no polygon has
+       normals. */
+    int *indices;           size_t nindices;
+    double (*normals)[3];
+} vw_scene;
+
+/* Parsers. On failure they return VW_E_INPUT and write "file:line: message" into
+   err (size errlen); *out is left NULL. The file name is used only for messages. */
+VW_API vw_status vw_scene_read_file(const char *path, vw_scene **out, char *err, size_t errlen);
+VW_API vw_status vw_scene_read_nff(const char *name, const char *text, size_t len,
+                                   vw_scene **out, char *err, size_t errlen);
+/* OBJ text; mtllib files are resolved relative to dir (may be NULL: none loaded). */
+VW_API vw_status vw_scene_read_obj(const char *name, const char *text, size_t len,
+                                   const char *dir, vw_scene **out, char *err, size_t errlen);
+VW_API void vw_scene_free(vw_scene *s);
+
+/* Writers */
+VW_API vw_status vw_scene_write_nff(const vw_scene *s, FILE *f);
+
+/* Queries */
+VW_API size_t vw_scene_count_objects(const vw_scene *s);
+/* Axis-aligned bounds of every primitive together (lights excluded). */
+VW_API void vw_scene_bounds(const vw_scene *s, double lo[3], double hi[3]);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

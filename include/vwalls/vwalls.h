@@ -1,0 +1,16 @@
+/* vwalls/vwalls.h - the umbrella header of the vwalls library.
+ *
+ * What is not declared in these headers is not the API. The topic headers:
+ * common.h (status, boxes), decomp.h (cells and walls), module.h (writing a module),
+ * world.h (the runtime), scene.h and image.h (reading scenes, writing images).
+ */
+#ifndef VWALLS_VWALLS_H
+#define VWALLS_VWALLS_H
+
+#include "vwalls/common.h"
+#include "vwalls/decomp.h"
+#include "vwalls/module.h"
+#include "vwalls/world.h"
+#include "vwalls/scene.h"
+
+#endif

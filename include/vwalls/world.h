@@ -1,0 +1,110 @@
+/* vwalls/world.h - the runtime: a world of cells hosted by workers, run to quiescence.
+ *
+ * Life cycle (Embree's commit step): create, add objects, commit (cells are built),
+ * post initial messages and/or let step() callbacks create work, run. run() returns at
+ * global quiescence: every worker idle and every message sent has been handled.
+ * A world may be run again (next frame, next radiosity round); it may be given a new
+ * decomposition between runs (objects migrate to their new cells, cells are rebuilt).
+ *
+ * Engines: worker threads in one process (always), and MPI between processes when the
+ * library was built with MPI and the world is created inside an MPI job.
+ */
+#ifndef VWALLS_WORLD_H
+#define VWALLS_WORLD_H
+
+#include <stdio.h>
+#include "vwalls/common.h"
+#include "vwalls/decomp.h"
+#include "vwalls/module.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct vw_world vw_world;
+
+typedef struct vw_config {
+    int workers;             /* worker threads per process; 0 = number of cores */
+    size_t packet_bytes;     /* flush a packet when it holds this much (default 32 KiB) */
+    size_t cap_bytes;        /* a worker whose unconsumed sent bytes exceed this drains its
+                                inbox before step() creates new work (default 64 MiB) */
+    /* Stress switches (also from the environment: VW_STRESS=seed, VW_STRESS_SPLIT=1). */
+    uint64_t stress_seed;    /* nonzero: delay and reorder deliveries at random */
+    int stress_split;        /* one message per packet */
+    /* Mapping: cell -> global worker id (process * workers + local worker), ncells
+       entries; NULL = contiguous blocks of cells per worker. Copied at create. */
+    const int *cell_worker;
+    /* MPI: pointer to an MPI_Comm to run on (the library then never calls MPI_Init or
+       MPI_Finalize); NULL = MPI_COMM_WORLD if MPI is initialised or the process was
+       started by a launcher, else the threads engine alone. */
+    const void *mpi_comm;
+    /* Per-worker slow-down factor for emulating unequal machines (NULL = none). */
+    const double *worker_slowdown;
+} vw_config;
+
+/* Defaults, then the environment's stress switches. */
+VW_API void vw_config_init(vw_config *c);
+
+VW_API vw_status vw_world_create(const vw_module *m, void *user, const vw_decomp *d,
+                                 const vw_config *c, vw_world **out);
+VW_API void vw_world_free(vw_world *w);
+/* The first error's message, with detail (sqlite3_errmsg style). */
+VW_API const char *vw_world_errmsg(const vw_world *w);
+
+/* Objects get global ids in the order added (0, 1, ...). */
+VW_API vw_status vw_world_add_objects(vw_world *w, const void *objects, size_t n);
+/* Build every cell (cell_build on the hosting worker). */
+VW_API vw_status vw_world_commit(vw_world *w);
+/* A message delivered to `cell` at the start of the next run. */
+VW_API vw_status vw_world_post(vw_world *w, int cell, int kind, const void *msg);
+VW_API vw_status vw_world_run(vw_world *w);
+
+/* Replace the decomposition (and optionally the mapping) between runs: objects are
+   re-placed, moved between workers/processes, and the cells rebuilt. */
+VW_API vw_status vw_world_redecompose(vw_world *w, const vw_decomp *d, const int *cell_worker);
+/* Replace object `id` (dynamic scenes): it leaves cells it no longer overlaps, joins
+   the new ones; only the touched cells are rebuilt at the next commit/run. */
+VW_API vw_status vw_world_update_object(vw_world *w, size_t id, const void *object);
+
+/* Engine facts. */
+VW_API int vw_world_process(const vw_world *w);       /* this process's rank */
+VW_API int vw_world_processes(const vw_world *w);
+VW_API int vw_world_workers(const vw_world *w);       /* per process */
+VW_API int vw_world_is_output(const vw_world *w);     /* rank 0 */
+VW_API const vw_decomp *vw_world_decomp(const vw_world *w);
+VW_API int vw_world_cell_worker(const vw_world *w, int cell);
+
+/* Measurements of the last run(s), valid on every process after run(). */
+typedef struct vw_cell_stats {
+    int worker;
+    size_t objects;
+    uint64_t messages_in;
+    double busy_s;      /* measured time in handlers and step() (all runs) */
+    double load;        /* module's load() if given, else busy_s */
+} vw_cell_stats;
+VW_API vw_status vw_world_cell_stats(const vw_world *w, int cell, vw_cell_stats *out);
+VW_API double vw_world_worker_busy(const vw_world *w, int global_worker);
+/* Sum over all cells and processes of module counter idx. */
+VW_API int64_t vw_world_counter(const vw_world *w, int idx);
+VW_API int64_t vw_world_cell_counter(const vw_world *w, int cell, int idx);
+/* Imbalance lambda = max / mean of worker busy times. */
+VW_API double vw_world_imbalance(const vw_world *w);
+VW_API void vw_world_reset_stats(vw_world *w);
+
+/* Times of phases the application measured itself, for the stats JSON
+   ("load", "build", "compute", "balance", ...). Accumulates. */
+VW_API void vw_world_add_time(vw_world *w, const char *phase, double seconds);
+
+/* What the balancer did, for the stats JSON "balance" member. */
+VW_API void vw_world_set_balance_info(vw_world *w, const char *strategy, double imbalance_before,
+                                      double imbalance_after, uint64_t migrated_objects);
+
+/* Stats JSON of DESIGN.md section 9, written atomically by the output process only.
+   extra_json: more top-level members ("\"rays\": {...}") or NULL. */
+VW_API vw_status vw_world_write_stats(vw_world *w, const char *path, const char *command,
+                                      const char *extra_json);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

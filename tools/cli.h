@@ -1,0 +1,51 @@
+/* tools/cli.h - what every vwalls subcommand shares: option values, engine set-up,
+ * messages, the progress bar and atomic output files.
+ */
+#ifndef VW_TOOLS_CLI_H
+#define VW_TOOLS_CLI_H
+
+#include <stddef.h>
+#include <stdint.h>
+#include "vwalls/vwalls.h"
+
+/* Exit statuses of every subcommand. */
+enum { VW_EXIT_OK = 0, VW_EXIT_FAIL = 1, VW_EXIT_USAGE = 2 };
+
+/* Print "vwalls CMD: message" on stderr (only on the output process under MPI). */
+void vw_cli_error(const char *cmd, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+
+/* Option values: each returns 0 and stores the value, or prints
+   "vwalls CMD: --opt: bad value 'x' (expected ...)" and returns -1. */
+int vw_cli_int(const char *cmd, const char *opt, const char *s, long lo, long hi, long *out);
+int vw_cli_double(const char *cmd, const char *opt, const char *s, double lo, double hi,
+                  double *out);
+int vw_cli_size(const char *cmd, const char *opt, const char *s, int *w, int *h);  /* WxH */
+int vw_cli_layout(const char *cmd, const char *opt, const char *s, int dims[3]);
+
+/* The value after option argv[*i] (advancing *i), or an error and NULL. */
+const char *vw_cli_value(const char *cmd, int argc, char **argv, int *i);
+
+/* Is this process the one that prints (rank 0, or no MPI)? Valid after vw_cli_engine_init. */
+int vw_cli_is_output(void);
+
+/* MPI set-up for the command line: initialises MPI when the process was started by a
+   launcher (and the build has MPI), so the same binary runs with and without mpirun.
+   vw_cli_engine_finish finalises what init started. Both are safe to call without MPI. */
+void vw_cli_engine_init(int *argc, char ***argv);
+void vw_cli_engine_finish(void);
+
+/* A progress bar on stderr when it is a terminal and not quiet: a fraction in [0,1] and
+   a short note (e.g. "2.1 Mrays/s"); redrawn at most ten times a second. Safe to call
+   from one thread at a time. */
+typedef struct vw_progress {
+    const char *label;
+    int enabled;
+    double start, last;
+} vw_progress;
+void vw_progress_begin(vw_progress *p, const char *label, int quiet);
+void vw_progress_update(vw_progress *p, double fraction, const char *note);
+void vw_progress_end(vw_progress *p);
+
+double vw_cli_now(void);
+
+#endif

@@ -1,0 +1,10 @@
+/* tools/commands.h - the subcommands of the vwalls command, one file each (cmd_*.c).
+ * Each takes the arguments after the subcommand name (argv[0] is the subcommand) and
+ * returns the exit status: 0 success, 2 bad input or usage, 1 any other failure.
+ */
+#ifndef VW_TOOLS_COMMANDS_H
+#define VW_TOOLS_COMMANDS_H
+
+int vw_cmd_example_pairs(int argc, char **argv);
+
+#endif

@@ -1,0 +1,459 @@
+/* runtime.c - the worker loop: take the inbox, run module handlers and steps on the
+ * worker's cells, route what they send; and termination by counting.
+ *
+ * Termination (threads engine): w->active counts busy workers plus packets in flight.
+ * A packet is counted before it is queued and uncounted after it has been handled, by
+ * a worker that is itself counted as busy while it handles it; a worker uncounts itself
+ * only with an empty inbox, no open packets and no step work. So active == 0 means no
+ * worker can ever receive anything again: global quiescence, under any interleaving
+ * or delay. Whoever brings it to zero wakes everybody.
+ */
+#include "core/world_internal.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+struct vw_ctx {
+    vw_world *w;
+    vw__worker *wk;
+    int cell;
+};
+
+double vw__now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static uint64_t rng_next(uint64_t *s)
+{
+    uint64_t z = (*s += 0x9e3779b97f4a7c15ull);
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+    return z ^ (z >> 31);
+}
+
+static size_t msg_stride(size_t size) { return sizeof(vw__msg_header) + ((size + 7) & ~(size_t)7); }
+
+vw__packet *vw__packet_new(int dest, int src, size_t cap)
+{
+    vw__packet *p = malloc(sizeof *p + cap);
+    if (!p) {
+        fprintf(stderr, "vwalls: out of memory allocating a %zu-byte packet\n", cap);
+        abort();
+    }
+    p->next = NULL;
+    p->dest = dest;
+    p->src = src;
+    p->nmsgs = 0;
+    p->used = 0;
+    p->cap = cap;
+    return p;
+}
+
+/* ---- delivery ---------------------------------------------------------------------- */
+
+static void finish_run(vw_world *w)
+{
+    atomic_store(&w->finished, 1);
+    for (int i = 0; i < w->nworkers; i++) {
+        pthread_mutex_lock(&w->workers[i].mu);
+        pthread_cond_broadcast(&w->workers[i].cv);
+        pthread_mutex_unlock(&w->workers[i].mu);
+    }
+}
+
+static void uncount(vw_world *w)
+{
+    if (atomic_fetch_sub(&w->active, 1) == 1) finish_run(w);
+}
+
+static void run_output(vw_world *w, vw__packet *p)
+{
+    pthread_mutex_lock(&w->output_mu);
+    size_t off = 0;
+    for (uint32_t i = 0; i < p->nmsgs; i++) {
+        const vw__msg_header *h = (const vw__msg_header *)(p->data + off);
+        const vw_msg_kind *k = &w->m->kinds[h->kind];
+        if (k->output) k->output(w->user, p->data + off + sizeof *h);
+        off += msg_stride(h->size);
+    }
+    pthread_mutex_unlock(&w->output_mu);
+}
+
+/* Hands a full or flushed packet to its destination. The packet is counted in
+   w->active first, so quiescence cannot be declared while it is on its way. */
+void vw__deliver(vw_world *w, vw__worker *from, vw__packet *p)
+{
+    if (from) {
+        from->packets_sent++;
+        from->msgs_sent += p->nmsgs;
+        from->bytes_sent += p->used;
+    }
+    if (w->transport && (p->dest == VW__OUTPUT ? w->rank != 0
+                                               : vw__worker_process(w, p->dest) != w->rank)) {
+        w->transport->send(w, from, p);
+        return;
+    }
+    if (p->dest == VW__OUTPUT) {
+        /* Output packets are handled at once by the output process's lock: they create
+           no work, so they need no counting. */
+        run_output(w, p);
+        free(p);
+        return;
+    }
+    vw__worker *to = &w->workers[p->dest - w->rank * w->nworkers];
+    if (from) atomic_fetch_add(&from->outstanding, p->used);
+    atomic_fetch_add(&w->active, 1);
+    pthread_mutex_lock(&to->mu);
+    if (w->cfg.stress_seed && from && to->head && (rng_next(&from->rng) & 1)) {
+        /* Stress: insert at a random place, so packets overtake each other. */
+        uint64_t n = rng_next(&from->rng) % 8;
+        vw__packet **at = &to->head;
+        while (*at && n--) at = &(*at)->next;
+        p->next = *at;
+        *at = p;
+        if (!p->next) to->tail = p;
+    } else {
+        p->next = NULL;
+        if (to->tail)
+            to->tail->next = p;
+        else
+            to->head = p;
+        to->tail = p;
+    }
+    pthread_cond_signal(&to->cv);
+    pthread_mutex_unlock(&to->mu);
+}
+
+static int flush_all(vw__worker *wk)
+{
+    vw_world *w = wk->w;
+    int any = 0;
+    for (int d = 0; d <= w->gworkers; d++) {
+        vw__packet *p = wk->out[d];
+        if (p && p->nmsgs) {
+            wk->out[d] = NULL;
+            vw__deliver(w, wk, p);
+            any = 1;
+        }
+    }
+    return any;
+}
+
+static void enqueue(vw_ctx *ctx, int slot, int dest, int cell, int kind, const void *msg)
+{
+    vw_world *w = ctx->w;
+    vw__worker *wk = ctx->wk;
+    if (kind < 0 || kind >= w->m->nkinds) {
+        fprintf(stderr, "vwalls: module '%s' sent unknown message kind %d\n", w->m->name, kind);
+        abort();
+    }
+    size_t size = w->m->kinds[kind].size;
+    size_t stride = msg_stride(size);
+    vw__packet *p = wk->out[slot];
+    if (p && p->used + stride > p->cap) {
+        wk->out[slot] = NULL;
+        vw__deliver(w, wk, p);
+        p = NULL;
+    }
+    if (!p) {
+        size_t cap = w->cfg.stress_split ? stride
+                                         : (w->cfg.packet_bytes > stride ? w->cfg.packet_bytes : stride);
+        p = wk->out[slot] = vw__packet_new(dest, wk->global, cap);
+    }
+    vw__msg_header *h = (vw__msg_header *)(p->data + p->used);
+    h->cell = cell;
+    h->kind = (uint16_t)kind;
+    h->size = (uint16_t)size;
+    memcpy(p->data + p->used + sizeof *h, msg, size);
+    p->used += stride;
+    p->nmsgs++;
+    if (w->cfg.stress_split) {
+        wk->out[slot] = NULL;
+        vw__deliver(w, wk, p);
+    }
+}
+
+/* ---- the module's side: vw_ctx ------------------------------------------------------ */
+
+int vw_ctx_cell(const vw_ctx *ctx) { return ctx->cell; }
+int vw_ctx_worker(const vw_ctx *ctx) { return ctx->wk->global; }
+int vw_ctx_process(const vw_ctx *ctx) { return ctx->w->rank; }
+const vw_decomp *vw_ctx_decomp(const vw_ctx *ctx) { return ctx->w->decomp; }
+vw_box vw_ctx_cell_box(const vw_ctx *ctx) { return vw_decomp_cell_box(ctx->w->decomp, ctx->cell); }
+void *vw_ctx_user(const vw_ctx *ctx) { return ctx->w->user; }
+
+void vw_send_cell(vw_ctx *ctx, int cell, int kind, const void *msg)
+{
+    vw_world *w = ctx->w;
+    if (cell < 0 || cell >= w->ncells) {
+        fprintf(stderr, "vwalls: module '%s' sent to cell %d of %d\n", w->m->name, cell, w->ncells);
+        abort();
+    }
+    int dest = w->cell_worker[cell];
+    enqueue(ctx, dest, dest, cell, kind, msg);
+}
+
+int vw_send_point(vw_ctx *ctx, const double p[3], const double dir[3], int kind, const void *msg)
+{
+    int cell = vw_decomp_locate(ctx->w->decomp, p, dir);
+    if (cell >= 0) vw_send_cell(ctx, cell, kind, msg);
+    return cell;
+}
+
+int vw_send_face(vw_ctx *ctx, int face, int kind, const void *msg)
+{
+    int nb[64];
+    int n = vw_decomp_neighbours(ctx->w->decomp, ctx->cell, face, nb, 64);
+    if (n > 64) {
+        int *all = malloc(sizeof(int) * (size_t)n);
+        if (!all) abort();
+        vw_decomp_neighbours(ctx->w->decomp, ctx->cell, face, all, n);
+        for (int i = 0; i < n; i++) vw_send_cell(ctx, all[i], kind, msg);
+        free(all);
+        return n;
+    }
+    for (int i = 0; i < n; i++) vw_send_cell(ctx, nb[i], kind, msg);
+    return n;
+}
+
+int vw_send_neighbours(vw_ctx *ctx, int kind, const void *msg)
+{
+    int n = 0;
+    for (int f = 0; f < 6; f++) n += vw_send_face(ctx, f, kind, msg);
+    return n;
+}
+
+void vw_send_output(vw_ctx *ctx, int kind, const void *msg)
+{
+    enqueue(ctx, ctx->w->gworkers, VW__OUTPUT, -1, kind, msg);
+}
+
+void vw_count(vw_ctx *ctx, int idx, int64_t n)
+{
+    if (idx >= 0 && idx < ctx->w->m->ncounters && ctx->cell >= 0)
+        ctx->w->cells[ctx->cell].counters[idx] += n;
+}
+
+/* ---- the worker loop ---------------------------------------------------------------- */
+
+/* Emulates a slower machine: spin for (k-1) times the time just spent. */
+static void slow_down(vw__worker *wk, double spent)
+{
+    const double *s = wk->w->cfg.worker_slowdown;
+    if (!s || s[wk->global] <= 1.0) return;
+    double until = vw__now() + spent * (s[wk->global] - 1.0);
+    while (vw__now() < until) {
+    }
+}
+
+static void account(vw__worker *wk, int cell, double t0, double t1)
+{
+    double spent = t1 - t0;
+    slow_down(wk, spent);
+    double t2 = vw__now();
+    spent = t2 - t0;
+    wk->busy_s += spent;
+    if (cell >= 0) wk->w->cells[cell].busy_s += spent;
+}
+
+static void handle_packet(vw__worker *wk, vw_ctx *ctx, vw__packet *p)
+{
+    vw_world *w = wk->w;
+    size_t off = 0;
+    int cur = -1;
+    double t0 = vw__now();
+    for (uint32_t i = 0; i < p->nmsgs; i++) {
+        const vw__msg_header *h = (const vw__msg_header *)(p->data + off);
+        if (h->cell != cur) {
+            double t1 = vw__now();
+            account(wk, cur, t0, t1);
+            t0 = vw__now();
+            cur = h->cell;
+        }
+        vw__cell *c = &w->cells[h->cell];
+        c->messages_in++;
+        ctx->cell = h->cell;
+        const vw_msg_kind *k = &w->m->kinds[h->kind];
+        if (k->handle) k->handle(ctx, c->state, p->data + off + sizeof *h);
+        off += msg_stride(h->size);
+    }
+    account(wk, cur, t0, vw__now());
+    if (p->src >= 0 && vw__worker_process(w, p->src) == w->rank)
+        atomic_fetch_sub(&w->workers[p->src - w->rank * w->nworkers].outstanding, p->used);
+}
+
+/* Calls step() on the worker's cells round-robin; returns 1 if one of them worked. */
+static int run_step(vw__worker *wk, vw_ctx *ctx)
+{
+    vw_world *w = wk->w;
+    if (!w->m->step || wk->ncells == 0) return 0;
+    if (atomic_load(&wk->outstanding) > w->cfg.cap_bytes) return 0;
+    for (int tries = 0; tries < wk->ncells; tries++) {
+        int cell = wk->cells[wk->step_cursor];
+        wk->step_cursor = (wk->step_cursor + 1) % wk->ncells;
+        ctx->cell = cell;
+        double t0 = vw__now();
+        int did = w->m->step(ctx, w->cells[cell].state);
+        account(wk, cell, t0, vw__now());
+        if (did) return 1;
+    }
+    return 0;
+}
+
+static vw__packet *take(vw__worker *wk)
+{
+    vw__packet *p = wk->head;
+    if (p) {
+        wk->head = p->next;
+        if (!wk->head) wk->tail = NULL;
+        p->next = NULL;
+    }
+    return p;
+}
+
+static void stress_pause(vw__worker *wk)
+{
+    if (!wk->w->cfg.stress_seed) return;
+    uint64_t r = rng_next(&wk->rng);
+    if ((r & 7) == 0) {
+        struct timespec ts = {0, (long)(r >> 40) % 200000};
+        nanosleep(&ts, NULL);
+    }
+}
+
+static void *worker_main(void *arg)
+{
+    vw__worker *wk = arg;
+    vw_world *w = wk->w;
+    vw_ctx ctx = {w, wk, -1};
+    for (;;) {
+        pthread_mutex_lock(&wk->mu);
+        vw__packet *p = take(wk);
+        pthread_mutex_unlock(&wk->mu);
+        if (p) {
+            stress_pause(wk);
+            handle_packet(wk, &ctx, p);
+            free(p);
+            uncount(w);
+            continue;
+        }
+        if (flush_all(wk)) continue;
+        if (run_step(wk, &ctx)) continue;
+        /* Nothing to do: go idle until a packet arrives or the run ends. */
+        pthread_mutex_lock(&wk->mu);
+        if (wk->head) {
+            pthread_mutex_unlock(&wk->mu);
+            continue;
+        }
+        wk->busy = 0;
+        pthread_mutex_unlock(&wk->mu);
+        uncount(w);
+        pthread_mutex_lock(&wk->mu);
+        while (!wk->head && !atomic_load(&w->finished)) pthread_cond_wait(&wk->cv, &wk->mu);
+        if (!wk->head) {
+            pthread_mutex_unlock(&wk->mu);
+            break;
+        }
+        /* A counted packet is in the inbox, so active > 0 while we count ourselves. */
+        wk->busy = 1;
+        atomic_fetch_add(&w->active, 1);
+        pthread_mutex_unlock(&wk->mu);
+    }
+    return NULL;
+}
+
+vw_status vw__runtime_run(vw_world *w)
+{
+    atomic_store(&w->finished, 0);
+    atomic_store(&w->active, w->nworkers);
+    for (int i = 0; i < w->nworkers; i++) w->workers[i].busy = 1;
+    /* Posted messages: counted like any packet. */
+    while (w->posted) {
+        vw__packet *p = w->posted;
+        w->posted = p->next;
+        vw__deliver(w, NULL, p);
+    }
+    int started = 0;
+    vw_status st = VW_OK;
+    for (int i = 0; i < w->nworkers; i++) {
+        if (pthread_create(&w->workers[i].thread, NULL, worker_main, &w->workers[i]) != 0) {
+            st = vw__world_error(w, VW_E_LIMIT, "cannot start worker thread %d", i);
+            break;
+        }
+        started++;
+    }
+    if (st != VW_OK) {
+        /* The threads that did start cannot end without the others: count the missing
+           ones out so quiescence is still reached. */
+        for (int i = started; i < w->nworkers; i++) uncount(w);
+    }
+    for (int i = 0; i < started; i++) pthread_join(w->workers[i].thread, NULL);
+    w->runs++;
+    return st;
+}
+
+/* ---- building cells in parallel ----------------------------------------------------- */
+
+static void *build_main(void *arg)
+{
+    vw__worker *wk = arg;
+    wk->build_status = VW_OK;
+    for (int i = 0; i < wk->ncells && wk->build_status == VW_OK; i++) {
+        vw__cell *c = &wk->w->cells[wk->cells[i]];
+        if (c->built && !c->dirty) continue;
+        wk->build_status = vw__world_build_cell(wk->w, wk->cells[i], wk);
+    }
+    return NULL;
+}
+
+vw_status vw__runtime_build(vw_world *w)
+{
+    int started = 0;
+    for (int i = 0; i < w->nworkers; i++) {
+        if (pthread_create(&w->workers[i].thread, NULL, build_main, &w->workers[i]) != 0) break;
+        started++;
+    }
+    for (int i = started; i < w->nworkers; i++) build_main(&w->workers[i]);
+    for (int i = 0; i < started; i++) pthread_join(w->workers[i].thread, NULL);
+    for (int i = 0; i < w->nworkers; i++)
+        if (w->workers[i].build_status != VW_OK) return w->workers[i].build_status;
+    return VW_OK;
+}
+
+/* The context handed to cell_build. */
+vw_status vw__world_build_cell(vw_world *w, int cell, vw__worker *wk)
+{
+    vw__cell *c = &w->cells[cell];
+    vw_ctx ctx = {w, wk, cell};
+    size_t osz = w->m->object_size;
+    unsigned char *objs = NULL;
+    if (c->nobjs) {
+        objs = malloc(osz * c->nobjs);
+        if (!objs) return VW_E_NOMEM;
+        for (size_t i = 0; i < c->nobjs; i++)
+            memcpy(objs + i * osz, w->objects + c->objs[i] * osz, osz);
+    }
+    if (c->built && w->m->cell_free) w->m->cell_free(c->state, w->user);
+    c->state = NULL;
+    c->built = 0;
+    vw_status st = VW_OK;
+    if (w->m->cell_build) st = w->m->cell_build(&ctx, objs, c->nobjs, &c->state);
+    free(objs);
+    if (st != VW_OK) return st;
+    c->built = 1;
+    c->dirty = 0;
+    return VW_OK;
+}
+
+/* The module's load estimate of a cell, called between runs. */
+double vw__cell_load(vw_world *w, int cell)
+{
+    vw__cell *c = &w->cells[cell];
+    vw_ctx ctx = {w, &w->workers[c->worker - w->rank * w->nworkers], cell};
+    return w->m->load(&ctx, c->state);
+}

@@ -1,0 +1,142 @@
+/* stats.c - the stats JSON of DESIGN.md section 9 (a contract: tests, benchmarks and
+ * pictures read it). Written by the output process to a temporary name and renamed,
+ * so a reader never sees half a file.
+ */
+#include "core/world_internal.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/resource.h>
+#include <unistd.h>
+
+static double num(double x) { return isfinite(x) ? x : 0.0; }
+
+static void json_string(FILE *f, const char *s)
+{
+    fputc('"', f);
+    for (; *s; s++) {
+        unsigned char ch = (unsigned char)*s;
+        if (ch == '"' || ch == '\\')
+            fprintf(f, "\\%c", ch);
+        else if (ch < 0x20)
+            fprintf(f, "\\u%04x", ch);
+        else
+            fputc(ch, f);
+    }
+    fputc('"', f);
+}
+
+static long peak_rss_bytes(void)
+{
+    struct rusage ru;
+    if (getrusage(RUSAGE_SELF, &ru) != 0) return 0;
+    return ru.ru_maxrss * 1024L;
+}
+
+static void write_body(vw_world *w, FILE *f, const char *command, const char *extra)
+{
+    char layout[64];
+    vw_decomp_layout_string(w->decomp, layout, sizeof layout);
+    fprintf(f, "{\n  \"command\": ");
+    json_string(f, command ? command : "");
+    fprintf(f, ",\n  \"version\": \"%s\",\n", VW_VERSION_STRING);
+    fprintf(f, "  \"engine\": {\"kind\": \"%s\", \"processes\": %d, \"workers\": %d, \"workers_per_process\": %d},\n",
+            w->nprocs > 1 ? "mpi" : "threads", w->nprocs, w->gworkers, w->nworkers);
+    fprintf(f, "  \"decomposition\": {\"kind\": \"%s\", \"layout\": \"%s\", \"cells\": %d, \"max_neighbours\": %d, \"rotated\": %s},\n",
+            vw_decomp_kind_name(vw_decomp_get_kind(w->decomp)), layout, w->ncells,
+            vw_decomp_max_neighbours(w->decomp), vw_decomp_frame(w->decomp) ? "true" : "false");
+    double lambda = vw_world_imbalance(w);
+    fprintf(f, "  \"balance\": {\"strategy\": \"%s\", \"imbalance_before\": %.6g, \"imbalance_after\": %.6g, \"migrated_objects\": %llu, \"imbalance\": %.6g, \"efficiency\": %.6g},\n",
+            w->balance_strategy[0] ? w->balance_strategy : "none",
+            num(w->balance_strategy[0] ? w->imbalance_before : lambda),
+            num(w->balance_strategy[0] ? w->imbalance_after : lambda),
+            (unsigned long long)w->migrated, num(lambda), num(lambda > 0 ? 1.0 / lambda : 0));
+    fprintf(f, "  \"time_s\": {");
+    double total = 0;
+    for (int i = 0; i < w->nphases; i++) {
+        fprintf(f, "\"%s\": %.6f, ", w->phase_name[i], w->time_phase[i]);
+        if (strcmp(w->phase_name[i], "total") != 0) total += w->time_phase[i];
+    }
+    int has_total = 0;
+    for (int i = 0; i < w->nphases; i++) has_total |= strcmp(w->phase_name[i], "total") == 0;
+    if (!has_total)
+        fprintf(f, "\"total\": %.6f", total);
+    else
+        fprintf(f, "\"phases\": %d", w->nphases);
+    fprintf(f, "},\n");
+    uint64_t msgs = 0, bytes = 0, packets = 0, mr = 0, br = 0;
+    for (int i = 0; i < w->nworkers; i++) {
+        msgs += w->workers[i].msgs_sent;
+        bytes += w->workers[i].bytes_sent;
+        packets += w->workers[i].packets_sent;
+        mr += w->workers[i].msgs_remote;
+        br += w->workers[i].bytes_remote;
+    }
+    fprintf(f, "  \"messages\": {\"count\": %llu, \"bytes\": %llu, \"packets\": %llu, \"remote_count\": %llu, \"remote_bytes\": %llu},\n",
+            (unsigned long long)msgs, (unsigned long long)bytes, (unsigned long long)packets,
+            (unsigned long long)mr, (unsigned long long)br);
+    if (w->m->ncounters > 0) {
+        fprintf(f, "  \"counters\": {");
+        for (int k = 0; k < w->m->ncounters; k++) {
+            fprintf(f, "%s", k ? ", " : "");
+            json_string(f, w->m->counters[k]);
+            fprintf(f, ": %lld", (long long)vw_world_counter(w, k));
+        }
+        fprintf(f, "},\n");
+    }
+    if (extra && *extra) fprintf(f, "  %s,\n", extra);
+    fprintf(f, "  \"cells\": [\n");
+    for (int c = 0; c < w->ncells; c++) {
+        vw_box b = vw_decomp_cell_box(w->decomp, c);
+        vw_cell_stats cs;
+        vw_world_cell_stats(w, c, &cs);
+        fprintf(f, "    {\"id\": %d, \"box\": [[%.9g,%.9g,%.9g],[%.9g,%.9g,%.9g]], \"worker\": %d, \"objects\": %zu, \"messages_in\": %llu, \"busy_s\": %.6f, \"load\": %.6g",
+                c, b.lo[0], b.lo[1], b.lo[2], b.hi[0], b.hi[1], b.hi[2], cs.worker, cs.objects,
+                (unsigned long long)cs.messages_in, cs.busy_s, num(cs.load));
+        for (int k = 0; k < w->m->ncounters; k++) {
+            fprintf(f, ", ");
+            json_string(f, w->m->counters[k]);
+            fprintf(f, ": %lld", (long long)vw_world_cell_counter(w, c, k));
+        }
+        fprintf(f, "}%s\n", c + 1 < w->ncells ? "," : "");
+    }
+    fprintf(f, "  ],\n  \"workers\": [\n");
+    long rss = peak_rss_bytes();
+    for (int g = 0; g < w->gworkers; g++) {
+        fprintf(f, "    {\"id\": %d, \"process\": %d, \"busy_s\": %.6f, \"peak_rss_bytes\": %ld}%s\n", g,
+                vw__worker_process(w, g), vw_world_worker_busy(w, g), rss,
+                g + 1 < w->gworkers ? "," : "");
+    }
+    fprintf(f, "  ]\n}\n");
+}
+
+vw_status vw_world_write_stats(vw_world *w, const char *path, const char *command,
+                               const char *extra_json)
+{
+    if (!w || !path) return VW_E_INVAL;
+    if (w->rank != 0) return VW_OK;
+    size_t n = strlen(path) + 32;
+    char *tmp = malloc(n);
+    if (!tmp) return VW_E_NOMEM;
+    snprintf(tmp, n, "%s.tmp.%ld", path, (long)getpid());
+    FILE *f = fopen(tmp, "w");
+    if (!f) {
+        vw__world_error(w, VW_E_IO, "%s: cannot write: %s", path, strerror(errno));
+        free(tmp);
+        return VW_E_IO;
+    }
+    write_body(w, f, command, extra_json);
+    int bad = ferror(f);
+    bad |= fclose(f) != 0;
+    if (bad || rename(tmp, path) != 0) {
+        vw__world_error(w, VW_E_IO, "%s: cannot write: %s", path, strerror(errno));
+        remove(tmp);
+        free(tmp);
+        return VW_E_IO;
+    }
+    free(tmp);
+    return VW_OK;
+}

@@ -1,0 +1,468 @@
+/* world.c - the world: cells, their objects and their workers; creation, placement of
+ * objects into cells, commit, run, and re-decomposition between runs.
+ *
+ * Placement rule: an object belongs to every cell its bounds overlap, each cell box
+ * widened by a tiny pad, so a ray hitting an object near a wall finds it in whichever
+ * cell owns that stretch of the ray.
+ */
+#include "core/world_internal.h"
+
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+vw_status vw__world_error(vw_world *w, vw_status st, const char *fmt, ...)
+{
+    if (w->err == VW_OK) {
+        va_list ap;
+        va_start(ap, fmt);
+        vsnprintf(w->errmsg, sizeof w->errmsg, fmt, ap);
+        va_end(ap);
+        w->err = st;
+    }
+    return st;
+}
+
+const char *vw_world_errmsg(const vw_world *w)
+{
+    if (!w) return "no world";
+    return w->err == VW_OK ? "no error" : w->errmsg;
+}
+
+static uint64_t env_u64(const char *name)
+{
+    const char *s = getenv(name);
+    if (!s || !*s) return 0;
+    return strtoull(s, NULL, 0);
+}
+
+void vw_config_init(vw_config *c)
+{
+    memset(c, 0, sizeof *c);
+    c->workers = 0;
+    c->packet_bytes = 32 * 1024;
+    c->cap_bytes = 64u * 1024 * 1024;
+    c->stress_seed = env_u64("VW_STRESS");
+    c->stress_split = env_u64("VW_STRESS_SPLIT") != 0;
+}
+
+int vw__worker_process(const vw_world *w, int global_worker) { return global_worker / w->nworkers; }
+
+static int default_workers(void)
+{
+    long n = sysconf(_SC_NPROCESSORS_ONLN);
+    return n < 1 ? 1 : (int)n;
+}
+
+/* Sets up cells -> workers and the per-worker cell lists for the current mapping. */
+static vw_status map_cells(vw_world *w, const int *cell_worker)
+{
+    for (int c = 0; c < w->ncells; c++) {
+        int g = cell_worker ? cell_worker[c] : (int)((long)c * w->gworkers / w->ncells);
+        if (g < 0 || g >= w->gworkers)
+            return vw__world_error(w, VW_E_INVAL, "mapping sends cell %d to worker %d of %d", c, g,
+                                   w->gworkers);
+        w->cell_worker[c] = g;
+        w->cells[c].worker = g;
+    }
+    for (int i = 0; i < w->nworkers; i++) {
+        vw__worker *wk = &w->workers[i];
+        wk->ncells = 0;
+        free(wk->cells);
+        wk->cells = malloc(sizeof(int) * (size_t)(w->ncells ? w->ncells : 1));
+        if (!wk->cells) return VW_E_NOMEM;
+        wk->step_cursor = 0;
+    }
+    for (int c = 0; c < w->ncells; c++) {
+        int g = w->cell_worker[c];
+        if (vw__worker_process(w, g) != w->rank) continue;
+        vw__worker *wk = &w->workers[g - w->rank * w->nworkers];
+        wk->cells[wk->ncells++] = c;
+    }
+    return VW_OK;
+}
+
+static vw_status alloc_cells(vw_world *w)
+{
+    w->ncells = vw_decomp_cell_count(w->decomp);
+    w->cells = calloc((size_t)w->ncells, sizeof *w->cells);
+    w->cell_worker = calloc((size_t)w->ncells, sizeof(int));
+    if (!w->cells || !w->cell_worker) return VW_E_NOMEM;
+    int nc = w->m->ncounters > 0 ? w->m->ncounters : 1;
+    for (int c = 0; c < w->ncells; c++) {
+        w->cells[c].counters = calloc((size_t)nc, sizeof(int64_t));
+        if (!w->cells[c].counters) return VW_E_NOMEM;
+    }
+    vw_box wb = vw_decomp_world(w->decomp);
+    double ext = 0;
+    for (int a = 0; a < 3; a++)
+        if (wb.hi[a] - wb.lo[a] > ext) ext = wb.hi[a] - wb.lo[a];
+    w->pad = ext * 1e-9;
+    return VW_OK;
+}
+
+static void free_cells(vw_world *w)
+{
+    if (!w->cells) return;
+    for (int c = 0; c < w->ncells; c++) {
+        vw__cell *cl = &w->cells[c];
+        if (cl->built && w->m->cell_free) w->m->cell_free(cl->state, w->user);
+        free(cl->objs);
+        free(cl->counters);
+    }
+    free(w->cells);
+    free(w->cell_worker);
+    w->cells = NULL;
+    w->cell_worker = NULL;
+}
+
+vw_status vw_world_create(const vw_module *m, void *user, const vw_decomp *d, const vw_config *c,
+                          vw_world **out)
+{
+    if (!out) return VW_E_INVAL;
+    *out = NULL;
+    if (!m || !d || m->abi != VW_MODULE_ABI || m->nkinds < 0 || m->nkinds > VW_MAX_KINDS ||
+        m->ncounters < 0 || m->ncounters > VW_MAX_COUNTERS || (m->object_size && !m->object_bounds))
+        return VW_E_INVAL;
+    for (int k = 0; k < m->nkinds; k++)
+        if (m->kinds[k].size > VW_MAX_MSG_BYTES) return VW_E_INVAL;
+    vw_world *w = calloc(1, sizeof *w);
+    if (!w) return VW_E_NOMEM;
+    w->m = m;
+    w->user = user;
+    if (c)
+        w->cfg = *c;
+    else
+        vw_config_init(&w->cfg);
+    if (w->cfg.packet_bytes < 64) w->cfg.packet_bytes = 64;
+    w->rank = 0;
+    w->nprocs = 1;
+    w->nworkers = w->cfg.workers > 0 ? w->cfg.workers : default_workers();
+    if (w->nworkers > 1024) {
+        free(w);
+        return VW_E_LIMIT;
+    }
+    w->gworkers = w->nworkers * w->nprocs;
+    w->cfg.cell_worker = NULL; /* copied into w->cell_worker below */
+    pthread_mutex_init(&w->output_mu, NULL);
+    vw_status st = vw_decomp_clone(d, &w->decomp);
+    if (st == VW_OK) st = alloc_cells(w);
+    if (st == VW_OK) {
+        w->workers = calloc((size_t)w->nworkers, sizeof *w->workers);
+        if (!w->workers) st = VW_E_NOMEM;
+    }
+    for (int i = 0; st == VW_OK && i < w->nworkers; i++) {
+        vw__worker *wk = &w->workers[i];
+        wk->w = w;
+        wk->local = i;
+        wk->global = w->rank * w->nworkers + i;
+        pthread_mutex_init(&wk->mu, NULL);
+        pthread_cond_init(&wk->cv, NULL);
+        atomic_init(&wk->outstanding, 0);
+        wk->rng = w->cfg.stress_seed * 0x2545f4914f6cdd1dull + (uint64_t)wk->global + 1;
+        wk->out = calloc((size_t)w->gworkers + 1, sizeof *wk->out);
+        if (!wk->out) st = VW_E_NOMEM;
+    }
+    if (st == VW_OK) st = map_cells(w, c ? c->cell_worker : NULL);
+    if (st != VW_OK) {
+        vw_world_free(w);
+        return st;
+    }
+    *out = w;
+    return VW_OK;
+}
+
+void vw_world_free(vw_world *w)
+{
+    if (!w) return;
+    free_cells(w);
+    if (w->workers) {
+        for (int i = 0; i < w->nworkers; i++) {
+            vw__worker *wk = &w->workers[i];
+            if (wk->out)
+                for (int d = 0; d <= w->gworkers; d++) free(wk->out[d]);
+            free(wk->out);
+            free(wk->cells);
+            while (wk->head) {
+                vw__packet *p = wk->head;
+                wk->head = p->next;
+                free(p);
+            }
+            pthread_mutex_destroy(&wk->mu);
+            pthread_cond_destroy(&wk->cv);
+        }
+        free(w->workers);
+    }
+    while (w->posted) {
+        vw__packet *p = w->posted;
+        w->posted = p->next;
+        free(p);
+    }
+    pthread_mutex_destroy(&w->output_mu);
+    vw_decomp_free(w->decomp);
+    free(w->objects);
+    free(w);
+}
+
+/* ---- objects ------------------------------------------------------------------------ */
+
+static vw_status cell_add_object(vw__cell *c, size_t id)
+{
+    if (c->nobjs == c->capobjs) {
+        size_t cap = c->capobjs ? 2 * c->capobjs : 16;
+        size_t *o = realloc(c->objs, cap * sizeof *o);
+        if (!o) return VW_E_NOMEM;
+        c->objs = o;
+        c->capobjs = cap;
+    }
+    c->objs[c->nobjs++] = id;
+    return VW_OK;
+}
+
+/* The cells object id overlaps; returns the count, list in *out (caller frees). */
+static int object_cells(vw_world *w, size_t id, int **out)
+{
+    vw_box b;
+    w->m->object_bounds(w->objects + id * w->m->object_size, &b, w->user);
+    int n = vw_decomp_cells_overlapping(w->decomp, &b, w->pad, NULL, 0);
+    *out = malloc(sizeof(int) * (size_t)(n ? n : 1));
+    if (!*out) return -1;
+    vw_decomp_cells_overlapping(w->decomp, &b, w->pad, *out, n);
+    return n;
+}
+
+static vw_status place_object(vw_world *w, size_t id)
+{
+    int *cells;
+    int n = object_cells(w, id, &cells);
+    if (n < 0) return VW_E_NOMEM;
+    vw_status st = VW_OK;
+    for (int i = 0; i < n && st == VW_OK; i++) {
+        st = cell_add_object(&w->cells[cells[i]], id);
+        w->cells[cells[i]].dirty = 1;
+    }
+    free(cells);
+    return st;
+}
+
+vw_status vw_world_add_objects(vw_world *w, const void *objects, size_t n)
+{
+    if (!w || (n && !objects)) return VW_E_INVAL;
+    size_t osz = w->m->object_size;
+    if (!osz) return n ? VW_E_INVAL : VW_OK;
+    if (w->nobjects + n > w->capobjects) {
+        size_t cap = w->capobjects ? w->capobjects : 64;
+        while (cap < w->nobjects + n) cap *= 2;
+        unsigned char *o = realloc(w->objects, cap * osz);
+        if (!o) return VW_E_NOMEM;
+        w->objects = o;
+        w->capobjects = cap;
+    }
+    memcpy(w->objects + w->nobjects * osz, objects, n * osz);
+    size_t first = w->nobjects;
+    w->nobjects += n;
+    for (size_t i = first; i < w->nobjects; i++) {
+        vw_status st = place_object(w, i);
+        if (st != VW_OK) return st;
+    }
+    w->committed = 0;
+    return VW_OK;
+}
+
+vw_status vw_world_update_object(vw_world *w, size_t id, const void *object)
+{
+    if (!w || !object || id >= w->nobjects) return VW_E_INVAL;
+    int *cells;
+    int n = object_cells(w, id, &cells);
+    if (n < 0) return VW_E_NOMEM;
+    for (int i = 0; i < n; i++) {
+        vw__cell *c = &w->cells[cells[i]];
+        for (size_t k = 0; k < c->nobjs; k++)
+            if (c->objs[k] == id) {
+                memmove(&c->objs[k], &c->objs[k + 1], (c->nobjs - k - 1) * sizeof *c->objs);
+                c->nobjs--;
+                c->dirty = 1;
+                break;
+            }
+    }
+    free(cells);
+    memcpy(w->objects + id * w->m->object_size, object, w->m->object_size);
+    vw_status st = place_object(w, id);
+    w->committed = 0;
+    return st;
+}
+
+vw_status vw_world_commit(vw_world *w)
+{
+    if (!w) return VW_E_INVAL;
+    vw_status st = vw__runtime_build(w);
+    if (st != VW_OK) return vw__world_error(w, st, "building cells failed: %s", vw_status_message(st));
+    w->committed = 1;
+    return VW_OK;
+}
+
+vw_status vw_world_post(vw_world *w, int cell, int kind, const void *msg)
+{
+    if (!w || !msg || cell < 0 || cell >= w->ncells || kind < 0 || kind >= w->m->nkinds)
+        return VW_E_INVAL;
+    int dest = w->cell_worker[cell];
+    if (vw__worker_process(w, dest) != w->rank) return VW_OK; /* its own process posts it */
+    size_t size = w->m->kinds[kind].size;
+    size_t stride = sizeof(vw__msg_header) + ((size + 7) & ~(size_t)7);
+    vw__packet *p = vw__packet_new(dest, -1, stride);
+    vw__msg_header *h = (vw__msg_header *)p->data;
+    h->cell = cell;
+    h->kind = (uint16_t)kind;
+    h->size = (uint16_t)size;
+    memcpy(p->data + sizeof *h, msg, size);
+    p->used = stride;
+    p->nmsgs = 1;
+    p->next = w->posted;
+    w->posted = p;
+    return VW_OK;
+}
+
+vw_status vw_world_run(vw_world *w)
+{
+    if (!w) return VW_E_INVAL;
+    if (!w->committed) {
+        vw_status st = vw_world_commit(w);
+        if (st != VW_OK) return st;
+    }
+    return vw__runtime_run(w);
+}
+
+/* ---- re-decomposition --------------------------------------------------------------- */
+
+vw_status vw_world_redecompose(vw_world *w, const vw_decomp *d, const int *cell_worker)
+{
+    if (!w || !d) return VW_E_INVAL;
+    /* Which worker held each object before, to count migrations. */
+    size_t n = w->nobjects;
+    unsigned char *held = calloc(n ? n * (size_t)w->gworkers : 1, 1);
+    if (!held) return VW_E_NOMEM;
+    for (int c = 0; c < w->ncells; c++)
+        for (size_t k = 0; k < w->cells[c].nobjs; k++)
+            held[w->cells[c].objs[k] * (size_t)w->gworkers + (size_t)w->cells[c].worker] = 1;
+    vw_decomp *nd;
+    vw_status st = vw_decomp_clone(d, &nd);
+    if (st != VW_OK) {
+        free(held);
+        return st;
+    }
+    free_cells(w);
+    vw_decomp_free(w->decomp);
+    w->decomp = nd;
+    st = alloc_cells(w);
+    if (st == VW_OK) st = map_cells(w, cell_worker);
+    for (size_t i = 0; st == VW_OK && i < n; i++) st = place_object(w, i);
+    uint64_t migrated = 0;
+    for (int c = 0; st == VW_OK && c < w->ncells; c++)
+        for (size_t k = 0; k < w->cells[c].nobjs; k++) {
+            unsigned char *h = &held[w->cells[c].objs[k] * (size_t)w->gworkers + (size_t)w->cells[c].worker];
+            if (!*h) migrated++;
+            *h = 2; /* count each (object, worker) once */
+        }
+    free(held);
+    w->migrated += migrated;
+    w->committed = 0;
+    return st;
+}
+
+/* ---- facts and measurements --------------------------------------------------------- */
+
+int vw_world_process(const vw_world *w) { return w->rank; }
+int vw_world_processes(const vw_world *w) { return w->nprocs; }
+int vw_world_workers(const vw_world *w) { return w->nworkers; }
+int vw_world_is_output(const vw_world *w) { return w->rank == 0; }
+const vw_decomp *vw_world_decomp(const vw_world *w) { return w->decomp; }
+
+int vw_world_cell_worker(const vw_world *w, int cell)
+{
+    return cell >= 0 && cell < w->ncells ? w->cell_worker[cell] : -1;
+}
+
+vw_status vw_world_cell_stats(const vw_world *w, int cell, vw_cell_stats *out)
+{
+    if (!w || !out || cell < 0 || cell >= w->ncells) return VW_E_INVAL;
+    const vw__cell *c = &w->cells[cell];
+    out->worker = c->worker;
+    out->objects = c->nobjs;
+    out->messages_in = c->messages_in;
+    out->busy_s = c->busy_s;
+    out->load = c->busy_s;
+    if (w->m->load && c->built && vw__worker_process(w, c->worker) == w->rank)
+        out->load = vw__cell_load((vw_world *)w, cell);
+    return VW_OK;
+}
+
+double vw_world_worker_busy(const vw_world *w, int g)
+{
+    if (g < 0 || g >= w->gworkers) return 0;
+    double s = 0;
+    for (int c = 0; c < w->ncells; c++)
+        if (w->cells[c].worker == g) s += w->cells[c].busy_s;
+    return s;
+}
+
+int64_t vw_world_cell_counter(const vw_world *w, int cell, int idx)
+{
+    if (cell < 0 || cell >= w->ncells || idx < 0 || idx >= w->m->ncounters) return 0;
+    return w->cells[cell].counters[idx];
+}
+
+int64_t vw_world_counter(const vw_world *w, int idx)
+{
+    int64_t s = 0;
+    for (int c = 0; c < w->ncells; c++) s += vw_world_cell_counter(w, c, idx);
+    return s;
+}
+
+double vw_world_imbalance(const vw_world *w)
+{
+    double max = 0, sum = 0;
+    for (int g = 0; g < w->gworkers; g++) {
+        double b = vw_world_worker_busy(w, g);
+        sum += b;
+        if (b > max) max = b;
+    }
+    return sum > 0 ? max / (sum / w->gworkers) : 1.0;
+}
+
+void vw_world_reset_stats(vw_world *w)
+{
+    for (int c = 0; c < w->ncells; c++) {
+        w->cells[c].busy_s = 0;
+        w->cells[c].messages_in = 0;
+        memset(w->cells[c].counters, 0, sizeof(int64_t) * (size_t)(w->m->ncounters > 0 ? w->m->ncounters : 1));
+    }
+    for (int i = 0; i < w->nworkers; i++) {
+        vw__worker *wk = &w->workers[i];
+        wk->busy_s = 0;
+        wk->msgs_sent = wk->bytes_sent = wk->packets_sent = 0;
+        wk->msgs_remote = wk->bytes_remote = 0;
+    }
+}
+
+void vw_world_add_time(vw_world *w, const char *phase, double seconds)
+{
+    for (int i = 0; i < w->nphases; i++)
+        if (strcmp(w->phase_name[i], phase) == 0) {
+            w->time_phase[i] += seconds;
+            return;
+        }
+    if (w->nphases == 8) return;
+    snprintf(w->phase_name[w->nphases], sizeof w->phase_name[0], "%s", phase);
+    w->time_phase[w->nphases++] = seconds;
+}
+
+void vw_world_set_balance_info(vw_world *w, const char *strategy, double before, double after,
+                               uint64_t migrated)
+{
+    snprintf(w->balance_strategy, sizeof w->balance_strategy, "%s", strategy ? strategy : "none");
+    w->imbalance_before = before;
+    w->imbalance_after = after;
+    w->migrated = migrated;
+}

@@ -1,0 +1,125 @@
+/* world_internal.h - the runtime's representation: world, cells, workers, packets.
+ *
+ * Ownership rules that must stay true:
+ *  - a cell's state is touched only by the worker hosting it (cell->worker);
+ *  - a packet is owned by exactly one party at a time: the sending worker while it is
+ *    open, the destination's inbox, then the worker handling it (which frees it);
+ *  - w->active counts busy workers plus packets sent and not yet handled; it reaches
+ *    zero exactly once per run, at global quiescence, and only then does run() end.
+ */
+#ifndef VW_WORLD_INTERNAL_H
+#define VW_WORLD_INTERNAL_H
+
+#include <pthread.h>
+#include <stdatomic.h>
+#include <stdint.h>
+
+#include "vwalls/world.h"
+
+#define VW__OUTPUT (-1) /* destination "the output process" */
+
+/* One message inside a packet: header then payload, padded to 8 bytes. */
+typedef struct vw__msg_header {
+    int32_t cell;   /* destination cell; unused for output messages */
+    uint16_t kind;
+    uint16_t size;
+} vw__msg_header;
+
+typedef struct vw__packet {
+    struct vw__packet *next;
+    int dest;          /* global worker id, or VW__OUTPUT */
+    int src;           /* global worker that filled it, -1 for posted messages */
+    uint32_t nmsgs;
+    size_t used, cap;  /* bytes of data */
+    unsigned char data[];
+} vw__packet;
+
+typedef struct vw__cell {
+    int worker;              /* global worker id */
+    void *state;             /* the module's cell state */
+    int built, dirty;
+    size_t *objs;            /* ids of the objects overlapping the cell */
+    size_t nobjs, capobjs;
+    uint64_t messages_in;
+    double busy_s;
+    int64_t *counters;       /* module counters, ncounters */
+} vw__cell;
+
+typedef struct vw__worker {
+    struct vw_world *w;
+    int local, global;
+    pthread_t thread;
+    pthread_mutex_t mu;
+    pthread_cond_t cv;
+    vw__packet *head, *tail;   /* the inbox, guarded by mu */
+    int busy;
+    atomic_size_t outstanding; /* bytes this worker sent that are not yet handled */
+    vw__packet **out;          /* open packet per destination: [0..G) workers, [G] output */
+    int *cells, ncells;        /* the cells this worker hosts */
+    int step_cursor;
+    uint64_t rng;              /* stress switch */
+    double busy_s;
+    uint64_t msgs_sent, bytes_sent, packets_sent;
+    uint64_t msgs_remote, bytes_remote; /* to other processes */
+    vw_status build_status;
+} vw__worker;
+
+/* How packets leave this process (the MPI engine); NULL for the threads engine.
+   A table of functions, like SQLite's VFS: one contract, one implementation per engine. */
+typedef struct vw__transport {
+    const char *name;
+    /* Takes ownership of a packet for a worker of another process (or the output
+       process); must keep the termination protocol's counts. */
+    void (*send)(struct vw_world *w, struct vw__worker *from, struct vw__packet *p);
+    void *impl;
+} vw__transport;
+
+struct vw_world {
+    const vw_module *m;
+    void *user;
+    vw_decomp *decomp;
+    vw_config cfg;
+    int rank, nprocs;          /* process rank and count (1 without MPI) */
+    int nworkers;              /* per process */
+    int gworkers;              /* all processes */
+    int ncells;
+    vw__cell *cells;
+    int *cell_worker;          /* cell -> global worker */
+    vw__worker *workers;       /* this process's workers */
+    unsigned char *objects;    /* all object records, object_size each */
+    size_t nobjects, capobjects;
+    double pad;                /* placement padding (world units) */
+    int committed;
+    vw__packet *posted;        /* messages posted before run */
+    atomic_long active;
+    atomic_int finished;
+    pthread_mutex_t output_mu; /* output handlers run one at a time */
+    vw__transport *transport;
+    char errmsg[512];
+    vw_status err;
+    /* stats */
+    double time_phase[8];
+    char phase_name[8][16];
+    int nphases;
+    char balance_strategy[32];
+    double imbalance_before, imbalance_after;
+    uint64_t migrated;
+    uint64_t runs;
+};
+
+/* world.c */
+vw_status vw__world_error(vw_world *w, vw_status st, const char *fmt, ...)
+    __attribute__((format(printf, 3, 4)));
+int vw__worker_process(const vw_world *w, int global_worker);
+vw_status vw__world_build_cell(vw_world *w, int cell, vw__worker *wk);
+
+/* runtime.c */
+vw_status vw__runtime_run(vw_world *w);
+vw_status vw__runtime_build(vw_world *w);
+vw__packet *vw__packet_new(int dest, int src, size_t cap);
+void vw__deliver(vw_world *w, vw__worker *from, vw__packet *p);
+double vw__cell_load(vw_world *w, int cell);
+
+double vw__now(void);
+
+#endif

@@ -1,0 +1,553 @@
+/* kdtree.c - every decomposition is a kd-tree of walls over the world box.
+ *
+ * The tree gives point location, the cells a ray crosses (with their parameter
+ * intervals), face neighbours, front-to-back order and object placement. A ray walk
+ * computes the crossing parameter of a wall as (split - o[a]) / d[a] and nothing else,
+ * so the exit parameter of one cell is bit-for-bit the entry parameter of the next,
+ * and a walk restarted at any exit parameter splits the rest of the ray identically.
+ */
+#include "decomp/decomp_internal.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+const char *vw_decomp_kind_name(vw_decomp_kind k)
+{
+    switch (k) {
+    case VW_DECOMP_GRID: return "grid";
+    case VW_DECOMP_STAGGERED: return "staggered";
+    case VW_DECOMP_DIVIDED: return "divided";
+    }
+    return "unknown";
+}
+
+/* ---- construction -------------------------------------------------------------- */
+
+/* Computes the cell boxes top-down and checks that the tree is a tree: every node
+   reached once, splits strictly inside their node's box, cell ids a permutation. */
+static int kd_check(vw_decomp *d, int node, vw_box box, int depth, unsigned char *seen)
+{
+    if (node < 0 || node >= d->nnodes || seen[node] || depth > 200) return 0;
+    seen[node] = 1;
+    const vw_kd_node *n = &d->nodes[node];
+    if (n->axis < 0) {
+        if (n->cell < 0 || n->cell >= d->ncells || d->cell_leaf[n->cell] >= 0) return 0;
+        d->cell_leaf[n->cell] = node;
+        d->cell_box[n->cell] = box;
+        return 1;
+    }
+    if (n->axis > 2 || !isfinite(n->split)) return 0;
+    if (!(n->split > box.lo[n->axis] && n->split < box.hi[n->axis])) return 0;
+    vw_box l = box, r = box;
+    l.hi[n->axis] = n->split;
+    r.lo[n->axis] = n->split;
+    return kd_check(d, n->left, l, depth + 1, seen) && kd_check(d, n->right, r, depth + 1, seen);
+}
+
+static void build_neighbours(vw_decomp *d);
+
+vw_status vw_decomp_create_kd(const vw_box *world, const vw_kd_node *nodes, int nnodes,
+                              const double *frame, vw_decomp_kind kind, vw_decomp **out)
+{
+    if (!out) return VW_E_INVAL;
+    *out = NULL;
+    if (!world || !nodes || nnodes < 1) return VW_E_INVAL;
+    for (int a = 0; a < 3; a++)
+        if (!(world->lo[a] < world->hi[a]) || !isfinite(world->lo[a]) || !isfinite(world->hi[a]))
+            return VW_E_INVAL;
+    int ncells = 0;
+    for (int i = 0; i < nnodes; i++)
+        if (nodes[i].axis < 0) ncells++;
+    if (ncells < 1 || ncells > VW_MAX_CELLS) return VW_E_LIMIT;
+
+    vw_decomp *d = calloc(1, sizeof *d);
+    if (!d) return VW_E_NOMEM;
+    d->kind = kind;
+    d->world = *world;
+    d->nnodes = nnodes;
+    d->ncells = ncells;
+    d->nodes = malloc(sizeof *d->nodes * (size_t)nnodes);
+    d->cell_box = malloc(sizeof *d->cell_box * (size_t)ncells);
+    d->cell_leaf = malloc(sizeof *d->cell_leaf * (size_t)ncells);
+    unsigned char *seen = calloc((size_t)nnodes, 1);
+    if (!d->nodes || !d->cell_box || !d->cell_leaf || !seen) {
+        free(seen);
+        vw_decomp_free(d);
+        return VW_E_NOMEM;
+    }
+    memcpy(d->nodes, nodes, sizeof *d->nodes * (size_t)nnodes);
+    for (int c = 0; c < ncells; c++) d->cell_leaf[c] = -1;
+    int ok = kd_check(d, 0, d->world, 0, seen);
+    for (int i = 0; ok && i < nnodes; i++) ok = seen[i];
+    free(seen);
+    if (!ok) {
+        vw_decomp_free(d);
+        return VW_E_INVAL;
+    }
+    if (frame) {
+        /* Orthonormal rows, so that t is preserved: |F d| = |d|. */
+        for (int i = 0; i < 3 && ok; i++)
+            for (int j = 0; j < 3; j++) {
+                double dot = 0;
+                for (int k = 0; k < 3; k++) dot += frame[3 * i + k] * frame[3 * j + k];
+                if (fabs(dot - (i == j)) > 1e-9) ok = 0;
+            }
+        if (!ok) {
+            vw_decomp_free(d);
+            return VW_E_INVAL;
+        }
+        int identity = 1;
+        for (int k = 0; k < 9; k++)
+            if (frame[k] != ((k % 4) == 0 ? 1.0 : 0.0)) identity = 0;
+        if (!identity) {
+            d->has_frame = 1;
+            memcpy(d->frame, frame, sizeof d->frame);
+        }
+    }
+    d->dims[0] = ncells;
+    d->dims[1] = d->dims[2] = 1;
+    build_neighbours(d);
+    if (!d->nb_start) {
+        vw_decomp_free(d);
+        return VW_E_NOMEM;
+    }
+    *out = d;
+    return VW_OK;
+}
+
+/* Appends the nodes splitting axis `axis` of grid index range [i0, i1) with boundary
+   positions b; below each slab, recurses into the next axis. Returns the node index. */
+static int grid_build(vw_kd_node *nodes, int *nn, const int dims[3], const double *b[3],
+                      int axis, int i0, int i1, int idx[3])
+{
+    int me = (*nn)++;
+    if (i1 - i0 > 1) {
+        int mid = (i0 + i1) / 2;
+        nodes[me].axis = axis;
+        nodes[me].split = b[axis][mid];
+        nodes[me].cell = -1;
+        int l = grid_build(nodes, nn, dims, b, axis, i0, mid, idx);
+        int r = grid_build(nodes, nn, dims, b, axis, mid, i1, idx);
+        nodes[me].left = l;
+        nodes[me].right = r;
+        return me;
+    }
+    idx[axis] = i0;
+    if (axis == 2) {
+        nodes[me].axis = -1;
+        nodes[me].cell = idx[0] + dims[0] * (idx[1] + dims[1] * idx[2]);
+        nodes[me].left = nodes[me].right = -1;
+        return me;
+    }
+    (*nn)--; /* this slab is not a node of its own: the next axis starts here */
+    return grid_build(nodes, nn, dims, b, axis + 1, 0, dims[axis + 1], idx);
+}
+
+vw_status vw_decomp_create_grid_walls(const vw_box *world, const int dims[3],
+                                      const double *const walls[3], const double *frame,
+                                      vw_decomp **out)
+{
+    if (!out) return VW_E_INVAL;
+    *out = NULL;
+    if (!world || !dims) return VW_E_INVAL;
+    long ncells = 1;
+    for (int a = 0; a < 3; a++) {
+        if (dims[a] < 1) return VW_E_INVAL;
+        ncells *= dims[a];
+        if (ncells > VW_MAX_CELLS) return VW_E_LIMIT;
+    }
+    double *b[3] = {0};
+    vw_status st = VW_OK;
+    for (int a = 0; a < 3 && st == VW_OK; a++) {
+        b[a] = malloc(sizeof(double) * (size_t)(dims[a] + 1));
+        if (!b[a]) {
+            st = VW_E_NOMEM;
+            break;
+        }
+        b[a][0] = world->lo[a];
+        b[a][dims[a]] = world->hi[a];
+        for (int i = 1; i < dims[a]; i++) {
+            double f = (double)i / dims[a];
+            b[a][i] = walls && walls[a] ? walls[a][i - 1]
+                                        : world->lo[a] * (1.0 - f) + world->hi[a] * f;
+        }
+        for (int i = 0; i < dims[a]; i++)
+            if (!(b[a][i] < b[a][i + 1])) st = VW_E_INVAL;
+    }
+    vw_kd_node *nodes = NULL;
+    if (st == VW_OK) {
+        nodes = calloc((size_t)(2 * ncells), sizeof *nodes);
+        if (!nodes) st = VW_E_NOMEM;
+    }
+    if (st == VW_OK) {
+        int nn = 0, idx[3] = {0, 0, 0};
+        const double *cb[3] = {b[0], b[1], b[2]};
+        grid_build(nodes, &nn, dims, cb, 0, 0, dims[0], idx);
+        st = vw_decomp_create_kd(world, nodes, nn, frame, VW_DECOMP_GRID, out);
+    }
+    if (st == VW_OK) {
+        vw_decomp *d = *out;
+        for (int a = 0; a < 3; a++) {
+            d->dims[a] = dims[a];
+            d->walls[a] = malloc(sizeof(double) * (size_t)(dims[a] > 1 ? dims[a] - 1 : 1));
+            if (!d->walls[a]) {
+                vw_decomp_free(d);
+                *out = NULL;
+                st = VW_E_NOMEM;
+                break;
+            }
+            for (int i = 1; i < dims[a]; i++) d->walls[a][i - 1] = b[a][i];
+        }
+    }
+    free(nodes);
+    for (int a = 0; a < 3; a++) free(b[a]);
+    return st;
+}
+
+vw_status vw_decomp_create_grid(const vw_box *world, const int dims[3], vw_decomp **out)
+{
+    return vw_decomp_create_grid_walls(world, dims, NULL, NULL, out);
+}
+
+vw_status vw_decomp_clone(const vw_decomp *d, vw_decomp **out)
+{
+    if (!d || !out) return VW_E_INVAL;
+    vw_status st;
+    if (d->kind == VW_DECOMP_GRID) {
+        const double *w[3] = {d->walls[0], d->walls[1], d->walls[2]};
+        st = vw_decomp_create_grid_walls(&d->world, d->dims, w, d->has_frame ? d->frame : NULL,
+                                         out);
+    } else {
+        st = vw_decomp_create_kd(&d->world, d->nodes, d->nnodes, d->has_frame ? d->frame : NULL,
+                                 d->kind, out);
+    }
+    return st;
+}
+
+void vw_decomp_free(vw_decomp *d)
+{
+    if (!d) return;
+    free(d->nodes);
+    free(d->cell_box);
+    free(d->cell_leaf);
+    free(d->nb_start);
+    free(d->nb);
+    for (int a = 0; a < 3; a++) free(d->walls[a]);
+    free(d);
+}
+
+/* ---- queries -------------------------------------------------------------------- */
+
+vw_decomp_kind vw_decomp_get_kind(const vw_decomp *d) { return d->kind; }
+int vw_decomp_cell_count(const vw_decomp *d) { return d ? d->ncells : 0; }
+void vw_decomp_dims(const vw_decomp *d, int dims[3]) { memcpy(dims, d->dims, sizeof d->dims); }
+vw_box vw_decomp_world(const vw_decomp *d) { return d->world; }
+const double *vw_decomp_frame(const vw_decomp *d) { return d->has_frame ? d->frame : NULL; }
+
+const double *vw_decomp_grid_walls(const vw_decomp *d, int axis)
+{
+    if (!d || d->kind != VW_DECOMP_GRID || axis < 0 || axis > 2 || d->dims[axis] < 2) return NULL;
+    return d->walls[axis];
+}
+
+const vw_kd_node *vw_decomp_nodes(const vw_decomp *d, int *nnodes)
+{
+    if (nnodes) *nnodes = d->nnodes;
+    return d->nodes;
+}
+
+vw_box vw_decomp_cell_box(const vw_decomp *d, int cell)
+{
+    if (cell < 0 || cell >= d->ncells) {
+        vw_box empty = {{0, 0, 0}, {0, 0, 0}};
+        return empty;
+    }
+    return d->cell_box[cell];
+}
+
+void vw_decomp_layout_string(const vw_decomp *d, char *buf, size_t len)
+{
+    if (d->kind == VW_DECOMP_GRID)
+        snprintf(buf, len, "%dx%dx%d", d->dims[0], d->dims[1], d->dims[2]);
+    else
+        snprintf(buf, len, "%d", d->ncells);
+}
+
+void vw_decomp_to_frame(const vw_decomp *d, const double p[3], double out[3])
+{
+    if (!d->has_frame) {
+        out[0] = p[0], out[1] = p[1], out[2] = p[2];
+        return;
+    }
+    const double *F = d->frame;
+    double x = p[0], y = p[1], z = p[2];
+    for (int i = 0; i < 3; i++) out[i] = F[3 * i] * x + F[3 * i + 1] * y + F[3 * i + 2] * z;
+}
+
+void vw_decomp_box_to_frame(const vw_decomp *d, const vw_box *b, vw_box *out)
+{
+    if (!d->has_frame) {
+        *out = *b;
+        return;
+    }
+    vw_box r;
+    for (int a = 0; a < 3; a++) r.lo[a] = INFINITY, r.hi[a] = -INFINITY;
+    for (int c = 0; c < 8; c++) {
+        double p[3] = {(c & 1) ? b->hi[0] : b->lo[0], (c & 2) ? b->hi[1] : b->lo[1],
+                       (c & 4) ? b->hi[2] : b->lo[2]};
+        double q[3];
+        vw_decomp_to_frame(d, p, q);
+        for (int a = 0; a < 3; a++) {
+            if (q[a] < r.lo[a]) r.lo[a] = q[a];
+            if (q[a] > r.hi[a]) r.hi[a] = q[a];
+        }
+    }
+    *out = r;
+}
+
+int vw_decomp_locate(const vw_decomp *d, const double p[3], const double dir[3])
+{
+    double q[3], v[3] = {0, 0, 0};
+    vw_decomp_to_frame(d, p, q);
+    if (dir) vw_decomp_to_frame(d, dir, v);
+    for (int a = 0; a < 3; a++)
+        if (!(q[a] >= d->world.lo[a] && q[a] <= d->world.hi[a])) return -1;
+    int node = 0;
+    while (d->nodes[node].axis >= 0) {
+        const vw_kd_node *n = &d->nodes[node];
+        int a = n->axis;
+        int right = q[a] > n->split || (q[a] == n->split && v[a] >= 0);
+        node = right ? n->right : n->left;
+    }
+    return d->nodes[node].cell;
+}
+
+/* ---- the ray walk ---------------------------------------------------------------- */
+
+typedef struct walk_state {
+    const vw_decomp *d;
+    const double *o, *v;
+    vw_segment_fn fn;
+    void *user;
+    int count, stop;
+} walk_state;
+
+static void walk(walk_state *w, int node, double t0, double t1)
+{
+    const vw_kd_node *n = &w->d->nodes[node];
+    if (n->axis < 0) {
+        if (t0 < t1) {
+            vw_segment s = {n->cell, t0, t1};
+            w->count++;
+            if (!w->fn(&s, w->user)) w->stop = 1;
+        }
+        return;
+    }
+    int a = n->axis;
+    if (w->v[a] == 0) {
+        walk(w, w->o[a] < n->split ? n->left : n->right, t0, t1);
+        return;
+    }
+    double ts = (n->split - w->o[a]) / w->v[a];
+    int near = w->v[a] > 0 ? n->left : n->right;
+    int far = w->v[a] > 0 ? n->right : n->left;
+    if (t0 < ts) walk(w, near, t0, t1 < ts ? t1 : ts);
+    if (!w->stop && ts < t1) walk(w, far, t0 > ts ? t0 : ts, t1);
+}
+
+int vw_decomp_walk(const vw_decomp *d, const double o[3], const double dir[3], double t0,
+                   double t1, vw_segment_fn fn, void *user)
+{
+    double q[3], v[3];
+    vw_decomp_to_frame(d, o, q);
+    vw_decomp_to_frame(d, dir, v);
+    /* Clip to the world box (slab test). */
+    for (int a = 0; a < 3; a++) {
+        if (v[a] == 0) {
+            if (q[a] < d->world.lo[a] || q[a] > d->world.hi[a]) return 0;
+            continue;
+        }
+        double ta = (d->world.lo[a] - q[a]) / v[a], tb = (d->world.hi[a] - q[a]) / v[a];
+        if (ta > tb) {
+            double t = ta;
+            ta = tb;
+            tb = t;
+        }
+        if (ta > t0) t0 = ta;
+        if (tb < t1) t1 = tb;
+    }
+    if (!(t0 < t1)) return 0;
+    walk_state w = {d, q, v, fn, user, 0, 0};
+    walk(&w, 0, t0, t1);
+    return w.count;
+}
+
+static int first_fn(const vw_segment *s, void *user)
+{
+    *(vw_segment *)user = *s;
+    return 0;
+}
+
+int vw_decomp_first_segment(const vw_decomp *d, const double o[3], const double dir[3],
+                            double t0, double t1, vw_segment *out)
+{
+    return vw_decomp_walk(d, o, dir, t0, t1, first_fn, out) > 0;
+}
+
+/* ---- overlap queries, neighbours, front-to-back ------------------------------------ */
+
+static int overlap(const vw_decomp *d, int node, const vw_box *b, double pad, int *out,
+                   int max, int count)
+{
+    const vw_kd_node *n = &d->nodes[node];
+    if (n->axis < 0) {
+        if (count < max) out[count] = n->cell;
+        return count + 1;
+    }
+    if (b->lo[n->axis] - pad <= n->split) count = overlap(d, n->left, b, pad, out, max, count);
+    if (b->hi[n->axis] + pad >= n->split) count = overlap(d, n->right, b, pad, out, max, count);
+    return count;
+}
+
+int vw_decomp_cells_overlapping(const vw_decomp *d, const vw_box *b, double pad, int *out,
+                                int max)
+{
+    vw_box f;
+    vw_decomp_box_to_frame(d, b, &f);
+    for (int a = 0; a < 3; a++)
+        if (f.hi[a] + pad < d->world.lo[a] || f.lo[a] - pad > d->world.hi[a]) return 0;
+    return overlap(d, 0, &f, pad, out, max, 0);
+}
+
+/* Two boxes share a face piece of positive area across axis a at coordinate s. */
+static int shares_face(const vw_box *p, const vw_box *q, int a)
+{
+    for (int k = 0; k < 3; k++) {
+        if (k == a) continue;
+        double lo = p->lo[k] > q->lo[k] ? p->lo[k] : q->lo[k];
+        double hi = p->hi[k] < q->hi[k] ? p->hi[k] : q->hi[k];
+        if (!(hi > lo)) return 0;
+    }
+    return 1;
+}
+
+/* Neighbour lists per (cell, face), found with a flat box on the face plane. */
+static void build_neighbours(vw_decomp *d)
+{
+    int n = d->ncells;
+    int cap = 16 * n + 16, used = 0;
+    int *tmp = malloc(sizeof(int) * (size_t)(n > 64 ? n : 64));
+    d->nb = malloc(sizeof(int) * (size_t)cap);
+    d->nb_start = malloc(sizeof(int) * (size_t)(6 * n + 1));
+    if (!tmp || !d->nb || !d->nb_start) goto fail;
+    d->max_nb = 0;
+    for (int c = 0; c < n; c++) {
+        int total = 0;
+        for (int f = 0; f < 6; f++) {
+            d->nb_start[6 * c + f] = used;
+            int a = VW_FACE_AXIS(f);
+            vw_box flat = d->cell_box[c];
+            double s = VW_FACE_SIGN(f) > 0 ? flat.hi[a] : flat.lo[a];
+            flat.lo[a] = flat.hi[a] = s;
+            int k = overlap(d, 0, &flat, 0, tmp, n, 0);
+            for (int i = 0; i < k && i < n; i++) {
+                const vw_box *q = &d->cell_box[tmp[i]];
+                double qs = VW_FACE_SIGN(f) > 0 ? q->lo[a] : q->hi[a];
+                if (tmp[i] == c || qs != s || !shares_face(&d->cell_box[c], q, a)) continue;
+                if (used == cap) {
+                    cap *= 2;
+                    int *nb = realloc(d->nb, sizeof(int) * (size_t)cap);
+                    if (!nb) goto fail;
+                    d->nb = nb;
+                }
+                d->nb[used++] = tmp[i];
+                total++;
+            }
+        }
+        if (total > d->max_nb) d->max_nb = total;
+    }
+    d->nb_start[6 * n] = used;
+    free(tmp);
+    return;
+fail:
+    free(tmp);
+    free(d->nb_start);
+    d->nb_start = NULL;
+}
+
+int vw_decomp_neighbours(const vw_decomp *d, int cell, int face, int *out, int max)
+{
+    if (cell < 0 || cell >= d->ncells || face < 0 || face > 5) return 0;
+    int s = d->nb_start[6 * cell + face], e = d->nb_start[6 * cell + face + 1];
+    for (int i = s; i < e && i - s < max; i++) out[i - s] = d->nb[i];
+    return e - s;
+}
+
+int vw_decomp_max_neighbours(const vw_decomp *d) { return d->max_nb; }
+
+static void ftb(const vw_decomp *d, int node, const double q[3], int *order, int *k)
+{
+    const vw_kd_node *n = &d->nodes[node];
+    if (n->axis < 0) {
+        order[(*k)++] = n->cell;
+        return;
+    }
+    int near_left = q[n->axis] < n->split;
+    ftb(d, near_left ? n->left : n->right, q, order, k);
+    ftb(d, near_left ? n->right : n->left, q, order, k);
+}
+
+void vw_decomp_front_to_back(const vw_decomp *d, const double p[3], int *order)
+{
+    double q[3];
+    vw_decomp_to_frame(d, p, q);
+    int k = 0;
+    ftb(d, 0, q, order, &k);
+}
+
+/* ---- layout strings --------------------------------------------------------------- */
+
+vw_status vw_layout_parse(const char *s, int dims[3], char *err, size_t errlen)
+{
+    dims[0] = dims[1] = dims[2] = 1;
+    const char *p = s ? s : "";
+    int n = 0;
+    long total = 1;
+    if (!*p) goto bad;
+    while (*p) {
+        if (n == 3) goto bad;
+        if (*p < '0' || *p > '9') goto bad;
+        long v = 0;
+        while (*p >= '0' && *p <= '9') {
+            v = v * 10 + (*p - '0');
+            if (v > VW_MAX_CELLS) break;
+            p++;
+        }
+        if (v < 1) {
+            if (err) snprintf(err, errlen, "layout '%s': every dimension must be at least 1", s);
+            return VW_E_INPUT;
+        }
+        total *= v;
+        if (v > VW_MAX_CELLS || total > VW_MAX_CELLS) {
+            if (err)
+                snprintf(err, errlen, "layout '%s': more than %d cells", s, VW_MAX_CELLS);
+            return VW_E_INPUT;
+        }
+        dims[n++] = (int)v;
+        if (*p == 'x' || *p == 'X') {
+            p++;
+            if (!*p) goto bad;
+        } else if (*p) {
+            goto bad;
+        }
+    }
+    return VW_OK;
+bad:
+    if (err)
+        snprintf(err, errlen, "layout '%s': expected 1 to 3 positive numbers joined by 'x', like 2x2x2",
+                 s ? s : "");
+    dims[0] = dims[1] = dims[2] = 1;
+    return VW_E_INPUT;
+}

@@ -1,0 +1,77 @@
+/* src/io/io_internal.h - helpers shared by the scene readers, writers and generators.
+ *
+ * Not installed. Everything here has a vw__ name and hidden visibility: the scene
+ * builder that every reader and generator fills, error formatting, and the atomic
+ * file writer that keeps failed writes from leaving partial files behind.
+ */
+#ifndef VW_IO_INTERNAL_H
+#define VW_IO_INTERNAL_H
+
+#include <stdarg.h>
+#include <stdio.h>
+#include "vwalls/scene.h"
+
+/* Writes a formatted message into err (NULL or errlen 0: nothing written). The
+   message is truncated, never overflowed. */
+void vw__errf(char *err, size_t errlen, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 3, 4)))
+#endif
+    ;
+
+/* The scene builder owns a scene under construction plus the capacities of its
+   arrays. Invariants: ids are handed out densely in the order primitives are added;
+   when s->normals is non-NULL it has as many entries as s->indices (capacity too),
+   and corners added without a normal hold (0,0,0). */
+typedef struct vw__sb {
+    vw_scene *s;
+    size_t cap_lights, cap_materials, cap_spheres, cap_cones, cap_polygons;
+    size_t cap_vertices, cap_indices;
+    int next_id;
+    size_t poly_first;       /* first index of the polygon being built */
+    int *mat_hash;           /* open addressing over material indices, -1 empty */
+    size_t mat_hash_cap;
+} vw__sb;
+
+vw_status vw__sb_init(vw__sb *b);
+/* Hands the scene over (the builder is empty afterwards). */
+vw_scene *vw__sb_finish(vw__sb *b);
+void vw__sb_abort(vw__sb *b);
+
+void vw__default_material(vw_material *m);
+vw_status vw__sb_add_light(vw__sb *b, const double pos[3], const float color[3]);
+/* Appends a material unconditionally (OBJ: names matter, values may repeat). */
+vw_status vw__sb_add_material(vw__sb *b, const vw_material *m, int *index);
+/* Returns the index of a bit-identical material, adding it if there is none. NFF
+   has no material names, so equal values are the same material; this is also what
+   makes write-then-read reproduce the material table. */
+vw_status vw__sb_intern_material(vw__sb *b, const vw_material *m, int *index);
+vw_status vw__sb_add_sphere(vw__sb *b, int material, const double c[3], double r);
+vw_status vw__sb_add_cone(vw__sb *b, int material, const double base[3], double base_r,
+                          const double apex[3], double apex_r);
+vw_status vw__sb_add_vertex(vw__sb *b, const double v[3], int *index);
+/* A polygon is built as begin, one corner per vertex, end. normal may be NULL. */
+void vw__sb_polygon_begin(vw__sb *b);
+vw_status vw__sb_polygon_corner(vw__sb *b, int vertex, const double *normal);
+vw_status vw__sb_polygon_end(vw__sb *b, int material, int has_normals);
+/* Convenience: a polygon from its own fresh vertices (no normals). */
+vw_status vw__sb_add_polygon(vw__sb *b, int material, int n, const double (*v)[3]);
+
+/* Atomic output: write to "path.tmp.XXXXXX" in the same directory, then rename over
+   path on commit. Abort (or a failed commit) removes the temporary file, so a failed
+   write never leaves a partial file under either name. */
+typedef struct vw__atomic_file {
+    FILE *f;
+    char *path;
+    char *tmp;
+} vw__atomic_file;
+
+vw_status vw__atomic_open(vw__atomic_file *af, const char *path, char *err, size_t errlen);
+vw_status vw__atomic_commit(vw__atomic_file *af, char *err, size_t errlen);
+void vw__atomic_abort(vw__atomic_file *af);
+
+/* Reads a whole file into a NUL-terminated buffer (the NUL is not counted in *len). */
+vw_status vw__read_whole_file(const char *path, char **text, size_t *len, char *err,
+                              size_t errlen);
+
+#endif

@@ -1,0 +1,589 @@
+/* src/io/nff.c - reader for Eric Haines' Neutral File Format (the SPD scenes).
+ *
+ * NFF is read as a stream of whitespace-separated tokens, not lines, so an entity
+ * split across lines parses exactly like one on a single line; the lexer counts
+ * lines only to name them in messages. '#' at the start of a token comments out
+ * the rest of its line. One extension rides in comments: "#vw Ks r g b" and
+ * "#vw Ke r g b" set the specular colour and emission of the current material
+ * (see vw_scene_write_nff), which other NFF readers ignore.
+ */
+#include <float.h>
+#include <limits.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "io/io_internal.h"
+
+typedef struct token {
+    const char *s;
+    size_t n;
+    int line;
+    int ext;    /* a "#vw" comment; s..s+n is the rest of its line */
+} token;
+
+typedef struct lexer {
+    const char *p, *end;
+    int line;
+} lexer;
+
+typedef struct nff {
+    const char *name;
+    lexer lx;
+    char *err;
+    size_t errlen;
+    vw__sb b;
+    /* The current material is interned only when a primitive uses it, so an 'f'
+       that no primitive follows leaves no trace in the material table. */
+    vw_material cur;
+    int cur_index;          /* -1 until interned */
+    int have_f;
+    unsigned char *nocolor; /* per light: 1 when the file gave no colour */
+    size_t nocolor_cap;
+    const char *entity;     /* the entity being read, for messages */
+    int entity_line;
+    int have_v;
+} nff;
+
+static int is_space(char c)
+{
+    return c == ' ' || c == '\t' || c == '\n' || c == '\r' || c == '\v' || c == '\f';
+}
+
+/* Next token, or 0 at the end of the text. Comments are skipped, except that a
+   "#vw" comment is returned as an extension token when want_ext is set (only where
+   an entity may start; elsewhere it is an ordinary comment). */
+static int lex_next(lexer *lx, token *t, int want_ext)
+{
+    for (;;) {
+        while (lx->p < lx->end && is_space(*lx->p)) {
+            if (*lx->p == '\n')
+                lx->line++;
+            lx->p++;
+        }
+        if (lx->p >= lx->end)
+            return 0;
+        if (*lx->p == '#') {
+            const char *q = lx->p;
+            const char *eol = memchr(q, '\n', (size_t)(lx->end - q));
+            if (!eol)
+                eol = lx->end;
+            lx->p = eol;
+            if (want_ext && eol - q >= 4 && memcmp(q, "#vw", 3) == 0 && is_space(q[3])) {
+                t->s = q + 3;
+                t->n = (size_t)(eol - (q + 3));
+                t->line = lx->line;
+                t->ext = 1;
+                return 1;
+            }
+            continue;
+        }
+        const char *start = lx->p;
+        while (lx->p < lx->end && !is_space(*lx->p))
+            lx->p++;
+        t->s = start;
+        t->n = (size_t)(lx->p - start);
+        t->line = lx->line;
+        t->ext = 0;
+        return 1;
+    }
+}
+
+static int tok_is(const token *t, const char *kw)
+{
+    size_t n = strlen(kw);
+    return !t->ext && t->n == n && memcmp(t->s, kw, n) == 0;
+}
+
+static int is_keyword(const token *t)
+{
+    static const char *const kws[] = {"v", "b", "l", "f", "c", "s", "p", "pp",
+                                      "from", "at", "up", "angle", "hither",
+                                      "resolution"};
+    for (size_t i = 0; i < sizeof kws / sizeof kws[0]; i++)
+        if (tok_is(t, kws[i]))
+            return 1;
+    return 0;
+}
+
+/* A printable, bounded copy of a token for messages: files may hold anything. */
+static const char *show(const token *t, char buf[48])
+{
+    size_t n = t->n < 40 ? t->n : 40, i;
+    for (i = 0; i < n; i++) {
+        unsigned char c = (unsigned char)t->s[i];
+        buf[i] = (c >= 0x20 && c < 0x7f && c != '\'') ? (char)c : '?';
+    }
+    if (t->n > n) {
+        memcpy(buf + i, "...", 3);
+        i += 3;
+    }
+    buf[i] = '\0';
+    return buf;
+}
+
+static vw_status fail(nff *P, int line, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 3, 4)))
+#endif
+    ;
+
+static vw_status fail(nff *P, int line, const char *fmt, ...)
+{
+    if (P->err && P->errlen) {
+        int k = snprintf(P->err, P->errlen, "%s:%d: ", P->name, line);
+        if (k >= 0 && (size_t)k < P->errlen) {
+            va_list ap;
+            va_start(ap, fmt);
+            vsnprintf(P->err + k, P->errlen - (size_t)k, fmt, ap);
+            va_end(ap);
+        }
+    }
+    return VW_E_INPUT;
+}
+
+static vw_status fail_status(nff *P, vw_status st)
+{
+    if (st == VW_E_NOMEM) {
+        fail(P, P->entity_line, "out of memory");
+        return VW_E_NOMEM;
+    }
+    fail(P, P->entity_line, "too many objects, vertices or materials");
+    return VW_E_LIMIT;
+}
+
+/* 1: a finite number; 0: not a number; -1: NaN or infinite. */
+static int parse_double(const token *t, double *out)
+{
+    char buf[128];
+    if (t->ext || t->n == 0 || t->n >= sizeof buf)
+        return 0;
+    memcpy(buf, t->s, t->n);
+    buf[t->n] = '\0';
+    if (memchr(buf, '\0', t->n))
+        return 0;
+    char *endp;
+    double v = strtod(buf, &endp);
+    if (endp != buf + t->n)
+        return 0;
+    if (!isfinite(v))
+        return -1;
+    *out = v;
+    return 1;
+}
+
+static vw_status read_num(nff *P, double *out)
+{
+    token t;
+    char sb[48];
+    if (!lex_next(&P->lx, &t, 0))
+        return fail(P, P->entity_line, "file ends in the middle of '%s'", P->entity);
+    int r = parse_double(&t, out);
+    if (r == 1)
+        return VW_OK;
+    if (r < 0)
+        return fail(P, t.line, "NaN or infinite number '%s' in '%s'", show(&t, sb),
+                    P->entity);
+    if (is_keyword(&t))
+        return fail(P, t.line, "wrong number of values for '%s'", P->entity);
+    return fail(P, t.line, "bad number '%s' in '%s'", show(&t, sb), P->entity);
+}
+
+static vw_status read_nums(nff *P, double *out, int n)
+{
+    for (int i = 0; i < n; i++) {
+        vw_status st = read_num(P, &out[i]);
+        if (st != VW_OK)
+            return st;
+    }
+    return VW_OK;
+}
+
+/* Colours and material numbers are stored as float: check they fit. */
+static vw_status to_float(nff *P, double v, float *out)
+{
+    if (fabs(v) > FLT_MAX)
+        return fail(P, P->lx.line, "number %g out of range in '%s'", v, P->entity);
+    *out = (float)v;
+    return VW_OK;
+}
+
+static vw_status read_floats(nff *P, float *out, int n)
+{
+    for (int i = 0; i < n; i++) {
+        double v;
+        vw_status st = read_num(P, &v);
+        if (st == VW_OK)
+            st = to_float(P, v, &out[i]);
+        if (st != VW_OK)
+            return st;
+    }
+    return VW_OK;
+}
+
+static vw_status read_int(nff *P, const char *what, long lo, long hi, int *out)
+{
+    token t;
+    char sb[48];
+    if (!lex_next(&P->lx, &t, 0))
+        return fail(P, P->entity_line, "file ends in the middle of '%s'", P->entity);
+    long v = 0;
+    size_t i = 0;
+    int ok = t.n > 0 && t.n < 12;
+    int neg = 0;
+    if (ok && (t.s[0] == '-' || t.s[0] == '+')) {
+        neg = t.s[0] == '-';
+        i = 1;
+        ok = t.n > 1;
+    }
+    for (; ok && i < t.n; i++) {
+        if (t.s[i] < '0' || t.s[i] > '9')
+            ok = 0;
+        else
+            v = v * 10 + (t.s[i] - '0');
+    }
+    if (!ok) {
+        if (is_keyword(&t))
+            return fail(P, t.line, "wrong number of values for '%s'", P->entity);
+        return fail(P, t.line, "bad %s '%s' in '%s'", what, show(&t, sb), P->entity);
+    }
+    if (neg)
+        v = -v;
+    if (v < lo || v > hi) {
+        if (P->entity[0] == 'p' && v < lo)
+            return fail(P, t.line, "polygon needs at least 3 vertices");
+        return fail(P, t.line, "%s %ld out of range in '%s' (%ld..%ld)", what, v, P->entity,
+                    lo, hi);
+    }
+    *out = (int)v;
+    return VW_OK;
+}
+
+static void begin(nff *P, const char *entity, int line)
+{
+    P->entity = entity;
+    P->entity_line = line;
+}
+
+/* ---- entities ----------------------------------------------------------------- */
+
+static vw_status parse_view(nff *P)
+{
+    vw_camera *cam = &P->b.s->camera;
+    int view_line = P->entity_line;
+    int have_from = 0, have_at = 0, have_up = 0, have_angle = 0, have_res = 0;
+    cam->hither = 1.0;  /* not every NFF writer gives hither */
+    for (;;) {
+        lexer save = P->lx;
+        token t;
+        if (!lex_next(&P->lx, &t, 0))
+            break;
+        vw_status st;
+        if (tok_is(&t, "from")) {
+            begin(P, "from", t.line);
+            st = read_nums(P, cam->from, 3);
+            have_from = 1;
+        } else if (tok_is(&t, "at")) {
+            begin(P, "at", t.line);
+            st = read_nums(P, cam->at, 3);
+            have_at = 1;
+        } else if (tok_is(&t, "up")) {
+            begin(P, "up", t.line);
+            st = read_nums(P, cam->up, 3);
+            have_up = 1;
+        } else if (tok_is(&t, "angle")) {
+            begin(P, "angle", t.line);
+            st = read_num(P, &cam->angle);
+            if (st == VW_OK && !(cam->angle > 0.0 && cam->angle < 180.0))
+                st = fail(P, t.line, "angle must be between 0 and 180 degrees");
+            have_angle = 1;
+        } else if (tok_is(&t, "hither")) {
+            begin(P, "hither", t.line);
+            st = read_num(P, &cam->hither);
+            if (st == VW_OK && cam->hither < 0.0)
+                st = fail(P, t.line, "hither must not be negative");
+        } else if (tok_is(&t, "resolution")) {
+            begin(P, "resolution", t.line);
+            st = read_int(P, "resolution", 0, 1L << 20, &cam->width);
+            if (st == VW_OK)
+                st = read_int(P, "resolution", 0, 1L << 20, &cam->height);
+            if (st == VW_OK && (cam->width == 0 || cam->height == 0))
+                st = fail(P, t.line, "resolution must not be zero");
+            have_res = 1;
+        } else {
+            P->lx = save;   /* the next entity */
+            break;
+        }
+        if (st != VW_OK)
+            return st;
+    }
+    const char *missing = !have_from ? "from" : !have_at ? "at" : !have_up ? "up"
+                        : !have_angle ? "angle" : !have_res ? "resolution" : NULL;
+    if (missing)
+        return fail(P, view_line, "'v' block without '%s'", missing);
+    double d[3], c[3];
+    for (int k = 0; k < 3; k++)
+        d[k] = cam->at[k] - cam->from[k];
+    if (d[0] == 0.0 && d[1] == 0.0 && d[2] == 0.0)
+        return fail(P, view_line, "'from' and 'at' are the same point");
+    c[0] = d[1] * cam->up[2] - d[2] * cam->up[1];
+    c[1] = d[2] * cam->up[0] - d[0] * cam->up[2];
+    c[2] = d[0] * cam->up[1] - d[1] * cam->up[0];
+    if (c[0] == 0.0 && c[1] == 0.0 && c[2] == 0.0)
+        return fail(P, view_line, "'up' is zero or parallel to the view direction");
+    cam->valid = 1;
+    P->have_v = 1;
+    return VW_OK;
+}
+
+static vw_status parse_light(nff *P)
+{
+    double pos[3];
+    float col[3] = {1.0f, 1.0f, 1.0f};
+    vw_status st = read_nums(P, pos, 3);
+    if (st != VW_OK)
+        return st;
+    /* The colour is optional: look at the next token without consuming it. */
+    lexer save = P->lx;
+    token t;
+    double dummy;
+    int has_color = lex_next(&P->lx, &t, 0) && parse_double(&t, &dummy) != 0;
+    P->lx = save;
+    if (has_color && (st = read_floats(P, col, 3)) != VW_OK)
+        return st;
+    size_t i = P->b.s->nlights;
+    if (i + 1 > P->nocolor_cap) {
+        size_t ncap = P->nocolor_cap ? P->nocolor_cap * 2 : 16;
+        unsigned char *q = realloc(P->nocolor, ncap);
+        if (!q)
+            return fail_status(P, VW_E_NOMEM);
+        P->nocolor = q;
+        P->nocolor_cap = ncap;
+    }
+    P->nocolor[i] = !has_color;
+    st = vw__sb_add_light(&P->b, pos, col);
+    return st == VW_OK ? VW_OK : fail_status(P, st);
+}
+
+static vw_status parse_fill(nff *P)
+{
+    double v[8];
+    vw_status st = read_nums(P, v, 8);
+    if (st != VW_OK)
+        return st;
+    vw_material m;
+    vw__default_material(&m);
+    for (int k = 0; k < 3; k++)
+        if ((st = to_float(P, v[k] * v[3], &m.diffuse[k])) != VW_OK)
+            return st;
+    if ((st = to_float(P, v[4], &m.specular[0])) != VW_OK ||
+        (st = to_float(P, v[5], &m.shine)) != VW_OK ||
+        (st = to_float(P, v[6], &m.transmit)) != VW_OK ||
+        (st = to_float(P, v[7], &m.ior)) != VW_OK)
+        return st;
+    m.specular[1] = m.specular[2] = m.specular[0];
+    P->cur = m;
+    P->cur_index = -1;
+    P->have_f = 1;
+    return VW_OK;
+}
+
+static vw_status parse_ext(nff *P, const token *t)
+{
+    /* The extension line is tokenised on its own so it cannot run past its line. */
+    nff sub = *P;
+    sub.lx.p = t->s;
+    sub.lx.end = t->s + t->n;
+    token key;
+    if (!lex_next(&sub.lx, &key, 0))
+        return VW_OK;
+    float *dst = tok_is(&key, "Ks") ? P->cur.specular
+               : tok_is(&key, "Ke") ? P->cur.emission : NULL;
+    if (!dst)
+        return VW_OK;   /* an extension from a later version: a comment to us */
+    if (!P->have_f)
+        return fail(P, t->line, "'#vw %s' before any 'f'", key.s[1] == 's' ? "Ks" : "Ke");
+    begin(&sub, key.s[1] == 's' ? "#vw Ks" : "#vw Ke", t->line);
+    float col[3];
+    vw_status st = read_floats(&sub, col, 3);
+    if (st != VW_OK)
+        return st;
+    token extra;
+    if (lex_next(&sub.lx, &extra, 0))
+        return fail(P, t->line, "wrong number of values for '%s'", sub.entity);
+    memcpy(dst, col, sizeof col);
+    P->cur_index = -1;
+    return VW_OK;
+}
+
+static vw_status use_material(nff *P, int *index)
+{
+    if (P->cur_index < 0) {
+        vw_status st = vw__sb_intern_material(&P->b, &P->cur, &P->cur_index);
+        if (st != VW_OK)
+            return fail_status(P, st);
+    }
+    *index = P->cur_index;
+    return VW_OK;
+}
+
+static vw_status parse_sphere(nff *P)
+{
+    double v[4];
+    int mat;
+    vw_status st = read_nums(P, v, 4);
+    if (st != VW_OK)
+        return st;
+    if (!(v[3] > 0.0))
+        return fail(P, P->entity_line, "sphere radius must be positive (got %g)", v[3]);
+    if ((st = use_material(P, &mat)) != VW_OK)
+        return st;
+    st = vw__sb_add_sphere(&P->b, mat, v, v[3]);
+    return st == VW_OK ? VW_OK : fail_status(P, st);
+}
+
+static vw_status parse_cone(nff *P)
+{
+    double v[8];
+    int mat;
+    vw_status st = read_nums(P, v, 8);
+    if (st != VW_OK)
+        return st;
+    if (v[0] == v[4] && v[1] == v[5] && v[2] == v[6])
+        return fail(P, P->entity_line, "cone base and apex are the same point");
+    if (v[3] == 0.0 && v[7] == 0.0)
+        return fail(P, P->entity_line, "cone has zero radius at both ends");
+    if ((st = use_material(P, &mat)) != VW_OK)
+        return st;
+    st = vw__sb_add_cone(&P->b, mat, v, v[3], v + 4, v[7]);
+    return st == VW_OK ? VW_OK : fail_status(P, st);
+}
+
+static vw_status parse_polygon(nff *P, int with_normals)
+{
+    int n, mat;
+    vw_status st = read_int(P, "vertex count", 3, INT_MAX, &n);
+    if (st != VW_OK)
+        return st;
+    /* Vertices go straight into the scene as they are read: a count that promises
+       more than the file holds fails at the end of the text, never by allocating
+       for the promise. */
+    vw__sb_polygon_begin(&P->b);
+    for (int i = 0; i < n; i++) {
+        double v[6];
+        int vi;
+        if ((st = read_nums(P, v, with_normals ? 6 : 3)) != VW_OK)
+            return st;
+        st = vw__sb_add_vertex(&P->b, v, &vi);
+        if (st == VW_OK)
+            st = vw__sb_polygon_corner(&P->b, vi, with_normals ? v + 3 : NULL);
+        if (st != VW_OK)
+            return fail_status(P, st);
+    }
+    if ((st = use_material(P, &mat)) != VW_OK)
+        return st;
+    st = vw__sb_polygon_end(&P->b, mat, with_normals);
+    return st == VW_OK ? VW_OK : fail_status(P, st);
+}
+
+static vw_status parse_all(nff *P)
+{
+    token t;
+    char sb[48];
+    const char *last = NULL;
+    while (lex_next(&P->lx, &t, 1)) {
+        vw_status st;
+        if (t.ext) {
+            st = parse_ext(P, &t);
+        } else if (tok_is(&t, "v")) {
+            begin(P, "v", t.line);
+            st = parse_view(P);
+        } else if (tok_is(&t, "b")) {
+            begin(P, "b", t.line);
+            st = read_floats(P, P->b.s->background, 3);
+        } else if (tok_is(&t, "l")) {
+            begin(P, "l", t.line);
+            st = parse_light(P);
+        } else if (tok_is(&t, "f")) {
+            begin(P, "f", t.line);
+            st = parse_fill(P);
+        } else if (tok_is(&t, "c")) {
+            begin(P, "c", t.line);
+            st = parse_cone(P);
+        } else if (tok_is(&t, "s")) {
+            begin(P, "s", t.line);
+            st = parse_sphere(P);
+        } else if (tok_is(&t, "p")) {
+            begin(P, "p", t.line);
+            st = parse_polygon(P, 0);
+        } else if (tok_is(&t, "pp")) {
+            begin(P, "pp", t.line);
+            st = parse_polygon(P, 1);
+        } else {
+            double d;
+            int r = parse_double(&t, &d);
+            /* A number where an entity should start: the previous entity had more
+               values than it takes. */
+            if (r != 0 && last)
+                return fail(P, t.line, "wrong number of values for '%s'", last);
+            if (r != 0)
+                return fail(P, t.line, "number '%s' where a keyword was expected",
+                            show(&t, sb));
+            return fail(P, t.line, "unknown keyword '%s'", show(&t, sb));
+        }
+        if (st != VW_OK)
+            return st;
+        if (!t.ext)
+            last = P->entity;
+        /* After a 'v' block the last entity read was its last line, e.g. 'resolution'. */
+    }
+    if (!P->have_v)
+        return fail(P, P->lx.line, "missing 'v' block (NFF needs a camera)");
+    /* The classic SPD convention: lights without a colour share a total intensity,
+       1/sqrt(number of lights) each. It needs the final count, so it is applied
+       after the whole file was read. */
+    vw_scene *s = P->b.s;
+    float dflt = (float)(1.0 / sqrt((double)s->nlights));
+    for (size_t i = 0; i < s->nlights; i++)
+        if (P->nocolor[i])
+            s->lights[i].color[0] = s->lights[i].color[1] = s->lights[i].color[2] = dflt;
+    return VW_OK;
+}
+
+VW_API vw_status vw_scene_read_nff(const char *name, const char *text, size_t len,
+                                   vw_scene **out, char *err, size_t errlen)
+{
+    if (out)
+        *out = NULL;
+    if (!out || (!text && len)) {
+        vw__errf(err, errlen, "vw_scene_read_nff: NULL argument");
+        return VW_E_INVAL;
+    }
+    nff P;
+    memset(&P, 0, sizeof P);
+    P.name = name ? name : "<nff>";
+    /* Offsetting a null pointer, even by zero, is undefined: use an empty text. */
+    P.lx.p = text ? text : "";
+    P.lx.end = P.lx.p + len;
+    P.lx.line = 1;
+    P.err = err;
+    P.errlen = errlen;
+    P.cur_index = -1;
+    P.entity = "";
+    vw__default_material(&P.cur);
+    if (err && errlen)
+        err[0] = '\0';
+    vw_status st = vw__sb_init(&P.b);
+    if (st != VW_OK) {
+        vw__errf(err, errlen, "%s: out of memory", P.name);
+        return st;
+    }
+    st = parse_all(&P);
+    free(P.nocolor);
+    if (st != VW_OK) {
+        vw__sb_abort(&P.b);
+        return st;
+    }
+    *out = vw__sb_finish(&P.b);
+    return VW_OK;
+}

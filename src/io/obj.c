@@ -1,0 +1,516 @@
+/* src/io/obj.c - reader for Wavefront OBJ meshes and their MTL material libraries.
+ *
+ * OBJ is line-oriented. Faces stay polygons (consumers triangulate) over the shared
+ * vertex array; texture coordinates, groups, objects and smoothing are accepted and
+ * ignored. OBJ has no camera and no lights: camera.valid is 0.
+ */
+#include <errno.h>
+#include <float.h>
+#include <limits.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "io/io_internal.h"
+
+/* Materials named in MTL files start as 0.8 grey: white (1.0) would reflect all
+   light, and a radiosity solution over such a scene never converges. The same grey
+   is used for faces before any usemtl. */
+#define OBJ_DEFAULT_REFLECTANCE 0.8f
+
+typedef struct span {
+    const char *s;
+    size_t n;
+} span;
+
+typedef struct obj {
+    const char *name;     /* file name for messages (the OBJ or the current MTL) */
+    int line;
+    char *err;
+    size_t errlen;
+    vw__sb b;
+    size_t nvt, nvn;
+    double (*vn)[3];
+    size_t cap_vn;
+    char **mat_names;     /* mat_names[i] names scene material mat_ids[i] */
+    int *mat_ids;
+    size_t nnames, cap_names;
+    int cur_mat;          /* -1: the default material, created on first use */
+    int default_mat;
+} obj;
+
+static int is_space(char c)
+{
+    return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f';
+}
+
+/* Next whitespace-separated token of a line; a '#' starting a token ends the line. */
+static int next_tok(span *line, span *t)
+{
+    while (line->n && is_space(*line->s)) {
+        line->s++;
+        line->n--;
+    }
+    if (!line->n || *line->s == '#')
+        return 0;
+    t->s = line->s;
+    while (line->n && !is_space(*line->s)) {
+        line->s++;
+        line->n--;
+    }
+    t->n = (size_t)(line->s - t->s);
+    return 1;
+}
+
+/* The rest of the line with surrounding blanks removed (material names, file names). */
+static span rest_of_line(span line)
+{
+    while (line.n && is_space(*line.s)) {
+        line.s++;
+        line.n--;
+    }
+    while (line.n && is_space(line.s[line.n - 1]))
+        line.n--;
+    return line;
+}
+
+static int span_is(span t, const char *kw)
+{
+    size_t n = strlen(kw);
+    return t.n == n && memcmp(t.s, kw, n) == 0;
+}
+
+static const char *show(span t, char buf[48])
+{
+    size_t n = t.n < 40 ? t.n : 40, i;
+    for (i = 0; i < n; i++) {
+        unsigned char c = (unsigned char)t.s[i];
+        buf[i] = (c >= 0x20 && c < 0x7f && c != '\'') ? (char)c : '?';
+    }
+    if (t.n > n) {
+        memcpy(buf + i, "...", 3);
+        i += 3;
+    }
+    buf[i] = '\0';
+    return buf;
+}
+
+static vw_status fail(obj *O, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 2, 3)))
+#endif
+    ;
+
+static vw_status fail(obj *O, const char *fmt, ...)
+{
+    if (O->err && O->errlen) {
+        int k = snprintf(O->err, O->errlen, "%s:%d: ", O->name, O->line);
+        if (k >= 0 && (size_t)k < O->errlen) {
+            va_list ap;
+            va_start(ap, fmt);
+            vsnprintf(O->err + k, O->errlen - (size_t)k, fmt, ap);
+            va_end(ap);
+        }
+    }
+    return VW_E_INPUT;
+}
+
+static vw_status fail_status(obj *O, vw_status st)
+{
+    if (st == VW_E_NOMEM) {
+        fail(O, "out of memory");
+        return VW_E_NOMEM;
+    }
+    fail(O, "too many vertices, faces or materials");
+    return VW_E_LIMIT;
+}
+
+static vw_status parse_double(obj *O, span t, double *out)
+{
+    char buf[128], sb[48];
+    if (t.n == 0 || t.n >= sizeof buf || memchr(t.s, '\0', t.n))
+        return fail(O, "bad number '%s'", show(t, sb));
+    memcpy(buf, t.s, t.n);
+    buf[t.n] = '\0';
+    char *endp;
+    double v = strtod(buf, &endp);
+    if (endp != buf + t.n)
+        return fail(O, "bad number '%s'", show(t, sb));
+    if (!isfinite(v))
+        return fail(O, "NaN or infinite number '%s'", show(t, sb));
+    *out = v;
+    return VW_OK;
+}
+
+/* Reads between min and max numbers from the rest of the line; *n gets the count. */
+static vw_status read_numbers(obj *O, span *line, const char *key, double *out, int min,
+                              int max, int *n)
+{
+    span t;
+    int k = 0;
+    while (k < max && next_tok(line, &t)) {
+        vw_status st = parse_double(O, t, &out[k]);
+        if (st != VW_OK)
+            return st;
+        k++;
+    }
+    if (k < min)
+        return fail(O, "wrong number of values for '%s'", key);
+    if (n)
+        *n = k;
+    return VW_OK;
+}
+
+/* ---- MTL ---------------------------------------------------------------------- */
+
+static vw_status mtl_color(obj *O, span *line, const char *key, float col[3])
+{
+    double v[3];
+    int n;
+    vw_status st = read_numbers(O, line, key, v, 1, 3, &n);
+    if (st != VW_OK)
+        return st;
+    if (n == 2)
+        return fail(O, "wrong number of values for '%s'", key);
+    if (n == 1)
+        v[1] = v[2] = v[0];   /* "Kd r" means grey */
+    for (int k = 0; k < 3; k++) {
+        if (fabs(v[k]) > FLT_MAX)
+            return fail(O, "number out of range in '%s'", key);
+        col[k] = (float)v[k];
+    }
+    return VW_OK;
+}
+
+static vw_status mtl_scalar(obj *O, span *line, const char *key, float *out)
+{
+    double v;
+    vw_status st = read_numbers(O, line, key, &v, 1, 1, NULL);
+    if (st != VW_OK)
+        return st;
+    if (fabs(v) > FLT_MAX)
+        return fail(O, "number out of range in '%s'", key);
+    *out = (float)v;
+    return VW_OK;
+}
+
+static vw_status add_named_material(obj *O, span name)
+{
+    if (O->nnames == O->cap_names) {
+        size_t ncap = O->cap_names ? O->cap_names * 2 : 8;
+        char **q = realloc(O->mat_names, ncap * sizeof *q);
+        if (!q)
+            return fail_status(O, VW_E_NOMEM);
+        O->mat_names = q;
+        int *r = realloc(O->mat_ids, ncap * sizeof *r);
+        if (!r)
+            return fail_status(O, VW_E_NOMEM);
+        O->mat_ids = r;
+        O->cap_names = ncap;
+    }
+    char *copy = malloc(name.n + 1);
+    if (!copy)
+        return fail_status(O, VW_E_NOMEM);
+    memcpy(copy, name.s, name.n);
+    copy[name.n] = '\0';
+    vw_material m;
+    vw__default_material(&m);
+    m.diffuse[0] = m.diffuse[1] = m.diffuse[2] = OBJ_DEFAULT_REFLECTANCE;
+    int id;
+    vw_status st = vw__sb_add_material(&O->b, &m, &id);
+    if (st != VW_OK) {
+        free(copy);
+        return fail_status(O, st);
+    }
+    O->mat_names[O->nnames] = copy;
+    O->mat_ids[O->nnames] = id;
+    O->nnames++;
+    return VW_OK;
+}
+
+static vw_status parse_mtl(obj *O, const char *text, size_t len)
+{
+    const char *p = text, *end = text + len;
+    vw_material *m = NULL;
+    O->line = 0;
+    while (p < end) {
+        const char *eol = memchr(p, '\n', (size_t)(end - p));
+        if (!eol)
+            eol = end;
+        O->line++;
+        span line = {p, (size_t)(eol - p)}, key;
+        p = eol + (eol < end);
+        if (!next_tok(&line, &key))
+            continue;
+        if (span_is(key, "newmtl")) {
+            span name = rest_of_line(line);
+            if (!name.n)
+                return fail(O, "'newmtl' without a name");
+            vw_status st = add_named_material(O, name);
+            if (st != VW_OK)
+                return st;
+            m = &O->b.s->materials[O->b.s->nmaterials - 1];
+            continue;
+        }
+        static const char *const known[] = {"Kd", "Ks", "Ke", "Ns", "d", "Tr", "Ni"};
+        const char *k = NULL;
+        for (size_t i = 0; i < sizeof known / sizeof known[0]; i++)
+            if (span_is(key, known[i]))
+                k = known[i];
+        if (!k)
+            continue;   /* Ka, illum, maps...: not used by vwalls */
+        if (!m)
+            return fail(O, "'%s' before any 'newmtl'", k);
+        vw_status st;
+        float v;
+        if (!strcmp(k, "Kd"))
+            st = mtl_color(O, &line, k, m->diffuse);
+        else if (!strcmp(k, "Ks"))
+            st = mtl_color(O, &line, k, m->specular);
+        else if (!strcmp(k, "Ke"))
+            st = mtl_color(O, &line, k, m->emission);
+        else if (!strcmp(k, "Ns"))
+            st = mtl_scalar(O, &line, k, &m->shine);
+        else if (!strcmp(k, "Ni"))
+            st = mtl_scalar(O, &line, k, &m->ior);
+        else if ((st = mtl_scalar(O, &line, k, &v)) == VW_OK)
+            m->transmit = !strcmp(k, "d") ? 1.0f - v : v;   /* d is opacity */
+        if (st != VW_OK)
+            return st;
+    }
+    return VW_OK;
+}
+
+static vw_status load_mtllib(obj *O, const char *dir, span fname)
+{
+    char sb[48];
+    if (memchr(fname.s, '\0', fname.n))
+        return fail(O, "bad material library name '%s'", show(fname, sb));
+    size_t dn = strlen(dir);
+    char *path = malloc(dn + fname.n + 2);
+    if (!path)
+        return fail_status(O, VW_E_NOMEM);
+    if (fname.n && fname.s[0] == '/') {
+        memcpy(path, fname.s, fname.n);
+        path[fname.n] = '\0';
+    } else {
+        memcpy(path, dir, dn);
+        path[dn] = '/';
+        memcpy(path + dn + 1, fname.s, fname.n);
+        path[dn + 1 + fname.n] = '\0';
+    }
+    char *text;
+    size_t len;
+    char why[256] = "";
+    vw_status st = vw__read_whole_file(path, &text, &len, why, sizeof why);
+    if (st != VW_OK) {
+        fail(O, "material library %s", why);
+        free(path);
+        return st == VW_E_NOMEM ? st : VW_E_INPUT;
+    }
+    const char *obj_name = O->name;
+    int obj_line = O->line;
+    O->name = path;
+    st = parse_mtl(O, text, len);
+    O->name = obj_name;
+    O->line = obj_line;
+    free(text);
+    free(path);
+    return st;
+}
+
+/* ---- OBJ ---------------------------------------------------------------------- */
+
+/* Resolves one OBJ index (1-based, or negative: relative to the end so far). */
+static vw_status resolve(obj *O, span t, const char *what, size_t count, int *out)
+{
+    char sb[48];
+    long long v = 0;
+    size_t i = 0;
+    int neg = 0, ok = t.n > 0 && t.n < 16;
+    if (ok && (t.s[0] == '-' || t.s[0] == '+')) {
+        neg = t.s[0] == '-';
+        i = 1;
+        ok = t.n > 1;
+    }
+    for (; ok && i < t.n; i++) {
+        if (t.s[i] < '0' || t.s[i] > '9')
+            ok = 0;
+        else
+            v = v * 10 + (t.s[i] - '0');
+    }
+    if (!ok)
+        return fail(O, "bad %s index '%s'", what, show(t, sb));
+    if (neg)
+        v = -v;
+    long long at = v > 0 ? v - 1 : (long long)count + v;
+    if (v == 0 || at < 0 || at >= (long long)count)
+        return fail(O, "%s index %lld out of range (%zu %s)", what, v, count,
+                    !strcmp(what, "vertex") ? "vertices"
+                    : !strcmp(what, "normal") ? "normals" : "texture coordinates");
+    *out = (int)at;
+    return VW_OK;
+}
+
+static vw_status parse_face(obj *O, span *line)
+{
+    char sb[48];
+    span t;
+    int n = 0, all_normals = 1;
+    vw__sb_polygon_begin(&O->b);
+    while (next_tok(line, &t)) {
+        /* v, v/vt, v//vn or v/vt/vn */
+        span part[3] = {{t.s, 0}, {NULL, 0}, {NULL, 0}};
+        int np = 1;
+        for (size_t i = 0; i < t.n; i++) {
+            if (t.s[i] == '/') {
+                if (np == 3)
+                    return fail(O, "bad face vertex '%s'", show(t, sb));
+                part[np].s = t.s + i + 1;
+                np++;
+            } else {
+                part[np - 1].n++;
+            }
+        }
+        int vi, ti, ni = -1;
+        vw_status st = resolve(O, part[0], "vertex", O->b.s->nvertices, &vi);
+        if (st != VW_OK)
+            return st;
+        if (np >= 2 && part[1].n && (st = resolve(O, part[1], "texture", O->nvt, &ti)) != VW_OK)
+            return st;
+        if (np == 2 && !part[1].n)
+            return fail(O, "bad face vertex '%s'", show(t, sb));
+        if (np == 3) {
+            if (!part[2].n)
+                return fail(O, "bad face vertex '%s'", show(t, sb));
+            if ((st = resolve(O, part[2], "normal", O->nvn, &ni)) != VW_OK)
+                return st;
+        }
+        if (ni < 0)
+            all_normals = 0;
+        st = vw__sb_polygon_corner(&O->b, vi, ni >= 0 ? O->vn[ni] : NULL);
+        if (st != VW_OK)
+            return fail_status(O, st);
+        n++;
+    }
+    if (n < 3)
+        return fail(O, "face needs at least 3 vertices");
+    int mat = O->cur_mat;
+    if (mat < 0) {
+        if (O->default_mat < 0) {
+            vw_material m;
+            vw__default_material(&m);
+            m.diffuse[0] = m.diffuse[1] = m.diffuse[2] = OBJ_DEFAULT_REFLECTANCE;
+            vw_status st = vw__sb_add_material(&O->b, &m, &O->default_mat);
+            if (st != VW_OK)
+                return fail_status(O, st);
+        }
+        mat = O->default_mat;
+    }
+    vw_status st = vw__sb_polygon_end(&O->b, mat, all_normals);
+    return st == VW_OK ? VW_OK : fail_status(O, st);
+}
+
+static vw_status parse_obj(obj *O, const char *text, size_t len, const char *dir)
+{
+    const char *p = text, *end = text + len;
+    while (p < end) {
+        const char *eol = memchr(p, '\n', (size_t)(end - p));
+        if (!eol)
+            eol = end;
+        O->line++;
+        span line = {p, (size_t)(eol - p)}, key;
+        p = eol + (eol < end);
+        if (!next_tok(&line, &key))
+            continue;
+        vw_status st = VW_OK;
+        double v[3];
+        if (span_is(key, "v")) {
+            int vi;
+            /* x y z, then an optional w or r g b that vwalls does not use */
+            if ((st = read_numbers(O, &line, "v", v, 3, 3, NULL)) != VW_OK)
+                return st;
+            if ((st = vw__sb_add_vertex(&O->b, v, &vi)) != VW_OK)
+                return fail_status(O, st);
+        } else if (span_is(key, "vn")) {
+            if ((st = read_numbers(O, &line, "vn", v, 3, 3, NULL)) != VW_OK)
+                return st;
+            if (O->nvn == O->cap_vn) {
+                size_t ncap = O->cap_vn ? O->cap_vn * 2 : 64;
+                void *q = realloc(O->vn, ncap * sizeof *O->vn);
+                if (!q)
+                    return fail_status(O, VW_E_NOMEM);
+                O->vn = q;
+                O->cap_vn = ncap;
+            }
+            memcpy(O->vn[O->nvn++], v, sizeof v);
+        } else if (span_is(key, "vt")) {
+            if ((st = read_numbers(O, &line, "vt", v, 1, 3, NULL)) != VW_OK)
+                return st;
+            O->nvt++;
+        } else if (span_is(key, "f")) {
+            if ((st = parse_face(O, &line)) != VW_OK)
+                return st;
+        } else if (span_is(key, "usemtl")) {
+            span name = rest_of_line(line);
+            O->cur_mat = -1;
+            /* Unknown names fall back to the default material: exporters write
+               usemtl without shipping the library often enough that refusing the
+               mesh would help nobody. */
+            for (size_t i = O->nnames; i-- > 0;)
+                if (strlen(O->mat_names[i]) == name.n &&
+                    memcmp(O->mat_names[i], name.s, name.n) == 0) {
+                    O->cur_mat = O->mat_ids[i];
+                    break;
+                }
+        } else if (span_is(key, "mtllib")) {
+            span fname;
+            if (!dir)
+                continue;   /* no directory given: libraries are not loaded */
+            while (next_tok(&line, &fname))
+                if ((st = load_mtllib(O, dir, fname)) != VW_OK)
+                    return st;
+        }
+        /* o, g, s, l, p and the free-form geometry keys are ignored. */
+    }
+    return VW_OK;
+}
+
+VW_API vw_status vw_scene_read_obj(const char *name, const char *text, size_t len,
+                                   const char *dir, vw_scene **out, char *err,
+                                   size_t errlen)
+{
+    if (out)
+        *out = NULL;
+    if (!out || (!text && len)) {
+        vw__errf(err, errlen, "vw_scene_read_obj: NULL argument");
+        return VW_E_INVAL;
+    }
+    obj O;
+    memset(&O, 0, sizeof O);
+    O.name = name ? name : "<obj>";
+    O.err = err;
+    O.errlen = errlen;
+    O.cur_mat = -1;
+    O.default_mat = -1;
+    if (err && errlen)
+        err[0] = '\0';
+    vw_status st = vw__sb_init(&O.b);
+    if (st != VW_OK) {
+        vw__errf(err, errlen, "%s: out of memory", O.name);
+        return st;
+    }
+    st = parse_obj(&O, text ? text : "", len, dir);
+    for (size_t i = 0; i < O.nnames; i++)
+        free(O.mat_names[i]);
+    free(O.mat_names);
+    free(O.mat_ids);
+    free(O.vn);
+    if (st != VW_OK) {
+        vw__sb_abort(&O.b);
+        return st;
+    }
+    *out = vw__sb_finish(&O.b);
+    (*out)->camera.valid = 0;
+    return VW_OK;
+}

@@ -1,0 +1,142 @@
+/* cli.c - what every vwalls subcommand shares: option values, messages, engine set-up
+ * and the progress bar.
+ */
+#include "cli.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include <unistd.h>
+
+static int cli_rank = 0;
+
+int vw_cli_is_output(void) { return cli_rank == 0; }
+
+void vw_cli_error(const char *cmd, const char *fmt, ...)
+{
+    if (!vw_cli_is_output()) return;
+    va_list ap;
+    va_start(ap, fmt);
+    fprintf(stderr, "vwalls %s: ", cmd);
+    vfprintf(stderr, fmt, ap);
+    fputc('\n', stderr);
+    va_end(ap);
+}
+
+int vw_cli_int(const char *cmd, const char *opt, const char *s, long lo, long hi, long *out)
+{
+    char *end;
+    errno = 0;
+    long v = strtol(s ? s : "", &end, 10);
+    if (!s || !*s || *end || errno || v < lo || v > hi) {
+        vw_cli_error(cmd, "%s: bad value '%s' (expected a whole number from %ld to %ld)", opt,
+                     s ? s : "", lo, hi);
+        return -1;
+    }
+    *out = v;
+    return 0;
+}
+
+int vw_cli_double(const char *cmd, const char *opt, const char *s, double lo, double hi, double *out)
+{
+    char *end;
+    errno = 0;
+    double v = strtod(s ? s : "", &end);
+    if (!s || !*s || *end || errno || !isfinite(v) || v < lo || v > hi) {
+        vw_cli_error(cmd, "%s: bad value '%s' (expected a number from %g to %g)", opt, s ? s : "",
+                     lo, hi);
+        return -1;
+    }
+    *out = v;
+    return 0;
+}
+
+int vw_cli_size(const char *cmd, const char *opt, const char *s, int *w, int *h)
+{
+    long a, b;
+    char *end;
+    errno = 0;
+    a = strtol(s ? s : "", &end, 10);
+    if (s && *s && (*end == 'x' || *end == 'X') && !errno) {
+        const char *q = end + 1;
+        b = strtol(q, &end, 10);
+        if (*q && !*end && !errno && a >= 1 && b >= 1 && a <= 65536 && b <= 65536 && a * b <= (1L << 28)) {
+            *w = (int)a;
+            *h = (int)b;
+            return 0;
+        }
+    }
+    vw_cli_error(cmd, "%s: bad value '%s' (expected WIDTHxHEIGHT, like 512x512)", opt, s ? s : "");
+    return -1;
+}
+
+int vw_cli_layout(const char *cmd, const char *opt, const char *s, int dims[3])
+{
+    char err[256];
+    if (vw_layout_parse(s, dims, err, sizeof err) != VW_OK) {
+        vw_cli_error(cmd, "%s: %s", opt, err);
+        return -1;
+    }
+    return 0;
+}
+
+const char *vw_cli_value(const char *cmd, int argc, char **argv, int *i)
+{
+    if (*i + 1 >= argc) {
+        vw_cli_error(cmd, "%s needs a value", argv[*i]);
+        return NULL;
+    }
+    return argv[++*i];
+}
+
+double vw_cli_now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+void vw_cli_engine_init(int *argc, char ***argv)
+{
+    (void)argc;
+    (void)argv;
+}
+
+void vw_cli_engine_finish(void) {}
+
+void vw_progress_begin(vw_progress *p, const char *label, int quiet)
+{
+    p->label = label;
+    p->enabled = !quiet && vw_cli_is_output() && isatty(2);
+    p->start = p->last = vw_cli_now();
+}
+
+void vw_progress_update(vw_progress *p, double fraction, const char *note)
+{
+    if (!p->enabled) return;
+    double now = vw_cli_now();
+    if (now - p->last < 0.1 && fraction < 1.0) return;
+    p->last = now;
+    if (fraction < 0) fraction = 0;
+    if (fraction > 1) fraction = 1;
+    int filled = (int)(fraction * 30 + 0.5);
+    char bar[31];
+    for (int i = 0; i < 30; i++) bar[i] = i < filled ? '#' : '.';
+    bar[30] = 0;
+    double el = now - p->start;
+    double eta = fraction > 0.01 ? el * (1 - fraction) / fraction : 0;
+    fprintf(stderr, "\r%s [%s] %5.1f%% %5.1fs eta %4.0fs %s\033[K", p->label, bar, 100 * fraction,
+            el, eta, note ? note : "");
+    fflush(stderr);
+}
+
+void vw_progress_end(vw_progress *p)
+{
+    if (!p->enabled) return;
+    fprintf(stderr, "\r\033[K");
+    fflush(stderr);
+}

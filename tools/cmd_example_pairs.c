@@ -1,0 +1,129 @@
+/* cmd_example_pairs.c - vwalls example-pairs: the example module on random spheres,
+ * printing the distributed count of touching pairs (and, with --check, the O(n^2) one).
+ */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "cli.h"
+#include "commands.h"
+#include "pairs.h"
+
+static const char *const CMD = "example-pairs";
+
+static void help(void)
+{
+    printf("usage: vwalls example-pairs [--spheres N] [--radius R] [--seed S] [--cells LAYOUT]\n"
+           "                            [--workers W] [--stats FILE.json] [--check] [--quiet]\n"
+           "\n"
+           "Counts touching pairs among N random spheres in the unit cube, distributed over\n"
+           "cells: each cell owns the spheres whose centre it holds and sends ghosts of them\n"
+           "to the cells within reach.\n"
+           "  --spheres N    number of spheres (default 10000)\n"
+           "  --radius R     largest radius (default 0.01)\n"
+           "  --seed S       random seed (default 1)\n"
+           "  --cells L      layout of cells, like 4, 2x4, 2x2x2 (default 2x2x2)\n"
+           "  --workers W    worker threads per process (default: number of cores)\n"
+           "  --stats FILE   write the stats JSON\n"
+           "  --check        also count by brute force and fail if the counts differ\n"
+           "  --quiet        print only the count\n");
+}
+
+int vw_cmd_example_pairs(int argc, char **argv)
+{
+    long n = 10000, seed = 1, workers = 0;
+    double rmax = 0.01;
+    int dims[3] = {2, 2, 2}, check = 0, quiet = 0;
+    const char *stats = NULL;
+    for (int i = 1; i < argc; i++) {
+        const char *a = argv[i], *v;
+        if (!strcmp(a, "--help") || !strcmp(a, "-h")) {
+            help();
+            return VW_EXIT_OK;
+        } else if (!strcmp(a, "--check")) {
+            check = 1;
+        } else if (!strcmp(a, "--quiet")) {
+            quiet = 1;
+        } else if (!strcmp(a, "--spheres")) {
+            if (!(v = vw_cli_value(CMD, argc, argv, &i)) || vw_cli_int(CMD, a, v, 0, 100000000, &n))
+                return VW_EXIT_USAGE;
+        } else if (!strcmp(a, "--seed")) {
+            if (!(v = vw_cli_value(CMD, argc, argv, &i)) || vw_cli_int(CMD, a, v, 0, 0x7fffffffL, &seed))
+                return VW_EXIT_USAGE;
+        } else if (!strcmp(a, "--workers")) {
+            if (!(v = vw_cli_value(CMD, argc, argv, &i)) || vw_cli_int(CMD, a, v, 1, 1024, &workers))
+                return VW_EXIT_USAGE;
+        } else if (!strcmp(a, "--radius")) {
+            if (!(v = vw_cli_value(CMD, argc, argv, &i)) || vw_cli_double(CMD, a, v, 1e-9, 1, &rmax))
+                return VW_EXIT_USAGE;
+        } else if (!strcmp(a, "--cells")) {
+            if (!(v = vw_cli_value(CMD, argc, argv, &i)) || vw_cli_layout(CMD, a, v, dims))
+                return VW_EXIT_USAGE;
+        } else if (!strcmp(a, "--stats")) {
+            if (!(stats = vw_cli_value(CMD, argc, argv, &i))) return VW_EXIT_USAGE;
+        } else {
+            vw_cli_error(CMD, "unknown option '%s' (try --help)", a);
+            return VW_EXIT_USAGE;
+        }
+    }
+    ex_sphere *s = malloc(sizeof *s * (size_t)(n ? n : 1));
+    if (!s) {
+        vw_cli_error(CMD, "out of memory for %ld spheres", n);
+        return VW_EXIT_FAIL;
+    }
+    double t0 = vw_cli_now();
+    ex_pairs_generate(s, (size_t)n, rmax, (uint64_t)seed);
+    vw_box unit = {{0, 0, 0}, {1, 1, 1}};
+    vw_decomp *d;
+    vw_status st = vw_decomp_create_grid(&unit, dims, &d);
+    if (st != VW_OK) {
+        vw_cli_error(CMD, "cannot make the decomposition: %s", vw_status_message(st));
+        free(s);
+        return VW_EXIT_FAIL;
+    }
+    vw_config cfg;
+    vw_config_init(&cfg);
+    cfg.workers = (int)workers;
+    int64_t pairs = 0;
+    vw_world *w = NULL;
+    double t1 = vw_cli_now();
+    st = ex_pairs_count(s, (size_t)n, rmax, d, &cfg, &pairs, &w);
+    double t2 = vw_cli_now();
+    int rc = VW_EXIT_OK;
+    if (st != VW_OK) {
+        vw_cli_error(CMD, "run failed: %s", w ? vw_world_errmsg(w) : vw_status_message(st));
+        rc = VW_EXIT_FAIL;
+    }
+    if (rc == VW_EXIT_OK && vw_world_is_output(w)) {
+        vw_world_add_time(w, "load", t1 - t0);
+        vw_world_add_time(w, "compute", t2 - t1);
+        if (quiet) {
+            printf("%lld\n", (long long)pairs);
+        } else {
+            char layout[64];
+            vw_decomp_layout_string(d, layout, sizeof layout);
+            printf("touching pairs: %lld\n", (long long)pairs);
+            printf("spheres %ld, cells %s (%d), workers %d x %d processes\n", n, layout,
+                   vw_decomp_cell_count(d), vw_world_workers(w), vw_world_processes(w));
+            printf("ghosts sent %lld, time %.3f s, imbalance %.3f\n", (long long)vw_world_counter(w, 1),
+                   t2 - t1, vw_world_imbalance(w));
+        }
+        if (stats && vw_world_write_stats(w, stats, CMD, NULL) != VW_OK) {
+            vw_cli_error(CMD, "%s", vw_world_errmsg(w));
+            rc = VW_EXIT_FAIL;
+        }
+        if (check) {
+            int64_t ref = ex_pairs_brute(s, (size_t)n);
+            if (!quiet) printf("brute force: %lld\n", (long long)ref);
+            if (ref != pairs) {
+                vw_cli_error(CMD, "distributed count %lld differs from brute force %lld",
+                             (long long)pairs, (long long)ref);
+                rc = VW_EXIT_FAIL;
+            }
+        }
+    }
+    vw_world_free(w);
+    vw_decomp_free(d);
+    free(s);
+    return rc;
+}

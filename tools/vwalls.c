@@ -1,0 +1,57 @@
+/* vwalls.c - the vwalls command: dispatches to one subcommand per file (cmd_*.c).
+ * The same binary runs alone (threads engine) and under mpirun (MPI engine).
+ */
+#include <stdio.h>
+#include <string.h>
+
+#include "cli.h"
+#include "commands.h"
+
+typedef struct vw_command {
+    const char *name;
+    int (*run)(int argc, char **argv);
+    const char *summary;
+} vw_command;
+
+static const vw_command commands[] = {
+    {"example-pairs", vw_cmd_example_pairs, "count touching sphere pairs (the example module)"},
+};
+
+static void usage(FILE *f)
+{
+    fprintf(f,
+            "usage: vwalls COMMAND [options]   (vwalls COMMAND --help for its options)\n"
+            "\n"
+            "Distributed geometric computation with the Virtual Walls method: space is cut\n"
+            "into cells by axis-aligned walls; cells compute locally and talk to neighbours.\n"
+            "Runs on worker threads; the same command runs under mpirun on several machines.\n"
+            "\ncommands:\n");
+    for (size_t i = 0; i < sizeof commands / sizeof commands[0]; i++)
+        fprintf(f, "  %-14s %s\n", commands[i].name, commands[i].summary);
+    fprintf(f, "\nexit status: 0 success, 2 bad input or usage, 1 any other failure\n");
+}
+
+int main(int argc, char **argv)
+{
+    if (argc < 2) {
+        usage(stderr);
+        return VW_EXIT_USAGE;
+    }
+    if (!strcmp(argv[1], "--help") || !strcmp(argv[1], "-h") || !strcmp(argv[1], "help")) {
+        usage(stdout);
+        return VW_EXIT_OK;
+    }
+    if (!strcmp(argv[1], "--version")) {
+        printf("vwalls %s\n", vw_version());
+        return VW_EXIT_OK;
+    }
+    for (size_t i = 0; i < sizeof commands / sizeof commands[0]; i++)
+        if (!strcmp(argv[1], commands[i].name)) {
+            vw_cli_engine_init(&argc, &argv);
+            int rc = commands[i].run(argc - 1, argv + 1);
+            vw_cli_engine_finish();
+            return rc;
+        }
+    fprintf(stderr, "vwalls: unknown command '%s' (try vwalls --help)\n", argv[1]);
+    return VW_EXIT_USAGE;
+}

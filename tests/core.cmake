@@ -1,0 +1,43 @@
+# core.cmake - tests of the decomposition, the runtime and the example module.
+# Label "threads": tests of the threads engine, also run under ThreadSanitizer by CI.
+
+function(vw_core_test name)
+  add_executable(${name} ${PROJECT_SOURCE_DIR}/tests/core/${name}.c)
+  target_include_directories(${name} PRIVATE ${PROJECT_SOURCE_DIR}/tests)
+  target_link_libraries(${name} PRIVATE vwalls_static m)
+  target_compile_definitions(${name} PRIVATE _GNU_SOURCE)
+endfunction()
+
+vw_core_test(test_decomp)
+add_test(NAME core_decomp COMMAND test_decomp)
+set_tests_properties(core_decomp PROPERTIES LABELS "core")
+
+vw_core_test(test_storm)
+add_test(NAME core_storm COMMAND test_storm 20)
+add_test(NAME core_storm_stress COMMAND test_storm 8 --stress)
+add_test(NAME core_storm_split COMMAND test_storm 4 --stress)
+set_tests_properties(core_storm_split PROPERTIES ENVIRONMENT "VW_STRESS_SPLIT=1")
+set_tests_properties(core_storm core_storm_stress core_storm_split PROPERTIES LABELS "core;threads")
+
+# The example module equals the O(n^2) count for every layout and worker count.
+foreach(layout 1 2x4 2x2x2 4x4x4)
+  foreach(workers 1 2 4)
+    add_test(NAME example_pairs_${layout}_w${workers}
+             COMMAND vwalls_tool example-pairs --spheres 3000 --radius 0.03 --seed 5
+                     --cells ${layout} --workers ${workers} --check --quiet)
+    set_tests_properties(example_pairs_${layout}_w${workers} PROPERTIES LABELS "core;threads")
+  endforeach()
+endforeach()
+add_test(NAME example_pairs_stress
+         COMMAND vwalls_tool example-pairs --spheres 3000 --radius 0.03 --cells 4x4x4 --workers 4 --check)
+set_tests_properties(example_pairs_stress PROPERTIES LABELS "core;threads" ENVIRONMENT "VW_STRESS=99")
+
+# Bad usage: exit status 2 and a one-line message naming what is wrong.
+foreach(bad "--cells;2x" "--cells;0" "--cells;99x99x99" "--workers;0" "--spheres;-3" "--bogus")
+  string(REPLACE ";" "_" tname "${bad}")
+  string(REGEX REPLACE "[^A-Za-z0-9_]" "" tname "${tname}")
+  add_test(NAME cli_bad_${tname} COMMAND vwalls_tool example-pairs ${bad})
+  set_tests_properties(cli_bad_${tname} PROPERTIES LABELS "core" WILL_FAIL TRUE)
+endforeach()
+add_test(NAME cli_unknown_command COMMAND vwalls_tool frobnicate)
+set_tests_properties(cli_unknown_command PROPERTIES LABELS "core" WILL_FAIL TRUE)

@@ -1,0 +1,293 @@
+/* test_decomp.c - the decomposition's invariants, checked against brute force:
+ * cells tile the world, point location, ray walks (order, contiguity, restart),
+ * neighbour symmetry, front-to-back order, object placement, layout strings.
+ */
+#include <string.h>
+
+#include "vw_test.h"
+#include "vwalls/vwalls.h"
+
+static uint64_t rng = 12345;
+static double urand(void)
+{
+    uint64_t z = (rng += 0x9e3779b97f4a7c15ull);
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+    return (double)((z ^ (z >> 31)) >> 11) * 0x1.0p-53;
+}
+
+static int inside(const vw_box *b, const double q[3])
+{
+    for (int a = 0; a < 3; a++)
+        if (q[a] < b->lo[a] || q[a] > b->hi[a]) return 0;
+    return 1;
+}
+
+typedef struct segs {
+    vw_segment s[VW_MAX_CELLS];
+    int n;
+} segs;
+static segs walk_a, walk_b;
+
+static int collect(const vw_segment *s, void *user)
+{
+    segs *w = user;
+    w->s[w->n++] = *s;
+    return 1;
+}
+
+/* Does the ray cross box b (frame coordinates) over an interval of positive length
+   within [t0, t1]? Brute force slab test, with a tolerance that only admits
+   grazing contacts the walk may legitimately skip. */
+static int crosses(const vw_box *b, const double o[3], const double d[3], double t0, double t1,
+                   double *lo, double *hi)
+{
+    for (int a = 0; a < 3; a++) {
+        if (d[a] == 0) {
+            if (o[a] < b->lo[a] || o[a] > b->hi[a]) return 0;
+            continue;
+        }
+        double ta = (b->lo[a] - o[a]) / d[a], tb = (b->hi[a] - o[a]) / d[a];
+        if (ta > tb) {
+            double t = ta;
+            ta = tb;
+            tb = t;
+        }
+        if (ta > t0) t0 = ta;
+        if (tb < t1) t1 = tb;
+    }
+    *lo = t0;
+    *hi = t1;
+    return t1 - t0 > 1e-9;
+}
+
+static void check_decomp(const vw_decomp *d)
+{
+    int n = vw_decomp_cell_count(d);
+    vw_box world = vw_decomp_world(d);
+    double wvol = 1, vol = 0;
+    for (int a = 0; a < 3; a++) wvol *= world.hi[a] - world.lo[a];
+    for (int c = 0; c < n; c++) {
+        vw_box b = vw_decomp_cell_box(d, c);
+        double v = 1;
+        for (int a = 0; a < 3; a++) {
+            CHECK(b.hi[a] > b.lo[a]);
+            v *= b.hi[a] - b.lo[a];
+        }
+        vol += v;
+    }
+    CHECK_NEAR(vol, wvol, 1e-9 * wvol);
+
+    /* Random points: exactly one cell holds each (interior points), and locate finds it. */
+    const double *F = vw_decomp_frame(d);
+    for (int i = 0; i < 2000; i++) {
+        double q[3], p[3];
+        for (int a = 0; a < 3; a++) q[a] = world.lo[a] + urand() * (world.hi[a] - world.lo[a]);
+        /* q is in frame coordinates; p = F^T q in world coordinates */
+        for (int a = 0; a < 3; a++)
+            p[a] = F ? F[a] * q[0] + F[3 + a] * q[1] + F[6 + a] * q[2] : q[a];
+        double qq[3];
+        vw_decomp_to_frame(d, p, qq);
+        int holders = 0, holder = -1;
+        for (int c = 0; c < n; c++) {
+            vw_box b = vw_decomp_cell_box(d, c);
+            if (inside(&b, qq)) holders++, holder = c;
+        }
+        CHECK_EQ_INT(holders, 1);
+        CHECK_EQ_INT(vw_decomp_locate(d, p, NULL), holder);
+    }
+
+    /* Neighbours: symmetric, and touching with positive area. */
+    for (int c = 0; c < n; c++)
+        for (int f = 0; f < 6; f++) {
+            int nb[VW_MAX_CELLS];
+            int k = vw_decomp_neighbours(d, c, f, nb, VW_MAX_CELLS);
+            for (int i = 0; i < k; i++) {
+                int back[VW_MAX_CELLS];
+                int m = vw_decomp_neighbours(d, nb[i], f ^ 1, back, VW_MAX_CELLS);
+                int found = 0;
+                for (int j = 0; j < m; j++) found |= back[j] == c;
+                CHECK(found);
+            }
+        }
+
+    /* Ray walks against brute force, contiguity, restart, front-to-back order. */
+    int *order = malloc(sizeof(int) * (size_t)n), *rank = malloc(sizeof(int) * (size_t)n);
+    for (int i = 0; i < 300; i++) {
+        double o[3], dir[3], qo[3], qd[3];
+        for (int a = 0; a < 3; a++) {
+            double ext = world.hi[a] - world.lo[a];
+            o[a] = world.lo[a] - 0.5 * ext + 2 * ext * urand();
+            dir[a] = urand() - 0.5;
+        }
+        if (i % 7 == 0) dir[i % 3] = 0; /* axis-parallel components */
+        walk_a.n = 0;
+        vw_decomp_walk(d, o, dir, 0, INFINITY, collect, &walk_a);
+        vw_decomp_to_frame(d, o, qo);
+        vw_decomp_to_frame(d, dir, qd);
+        for (int s = 0; s < walk_a.n; s++) {
+            CHECK(walk_a.s[s].t0 < walk_a.s[s].t1);
+            if (s) CHECK(walk_a.s[s].t0 == walk_a.s[s - 1].t1); /* the same double */
+            /* Restarting at an exit gives the rest of the walk, bit for bit. */
+            walk_b.n = 0;
+            vw_decomp_walk(d, o, dir, walk_a.s[s].t0, INFINITY, collect, &walk_b);
+            CHECK_EQ_INT(walk_b.n, walk_a.n - s);
+            for (int k = 0; k < walk_b.n; k++) {
+                CHECK_EQ_INT(walk_b.s[k].cell, walk_a.s[s + k].cell);
+                CHECK(walk_b.s[k].t1 == walk_a.s[s + k].t1);
+            }
+        }
+        /* Every cell the ray really crosses is in the walk, and only those. */
+        for (int c = 0; c < n; c++) {
+            vw_box b = vw_decomp_cell_box(d, c);
+            double lo = 0, hi = 0;
+            int want = crosses(&b, qo, qd, 0, INFINITY, &lo, &hi);
+            int got = 0;
+            for (int s = 0; s < walk_a.n; s++)
+                if (walk_a.s[s].cell == c) {
+                    got = 1;
+                    CHECK_NEAR(walk_a.s[s].t0, lo, 1e-9 * (1 + fabs(lo)));
+                    CHECK_NEAR(walk_a.s[s].t1, hi, 1e-9 * (1 + fabs(hi)));
+                }
+            if (want) CHECK(got);
+        }
+        /* Front-to-back from the origin (when inside): the walk respects that order. */
+        if (vw_decomp_locate(d, o, dir) >= 0) {
+            vw_decomp_front_to_back(d, o, order);
+            for (int k = 0; k < n; k++) rank[order[k]] = k;
+            for (int s = 1; s < walk_a.n; s++)
+                CHECK(rank[walk_a.s[s].cell] > rank[walk_a.s[s - 1].cell]);
+        }
+    }
+    free(order);
+    free(rank);
+
+    /* Placement: a box lands in exactly the cells it overlaps. */
+    for (int i = 0; i < 300; i++) {
+        vw_box b;
+        for (int a = 0; a < 3; a++) {
+            double ext = world.hi[a] - world.lo[a];
+            double c = world.lo[a] + ext * urand(), r = 0.2 * ext * urand();
+            b.lo[a] = c - r;
+            b.hi[a] = c + r;
+        }
+        if (F) continue; /* under rotation the frame box is conservative: skip brute force */
+        int cells[VW_MAX_CELLS];
+        int k = vw_decomp_cells_overlapping(d, &b, 0, cells, VW_MAX_CELLS);
+        int want = 0;
+        for (int c = 0; c < n; c++) {
+            vw_box cb = vw_decomp_cell_box(d, c);
+            int ov = 1;
+            for (int a = 0; a < 3; a++) ov &= b.lo[a] <= cb.hi[a] && b.hi[a] >= cb.lo[a];
+            int got = 0;
+            for (int j = 0; j < k; j++) got |= cells[j] == c;
+            CHECK_EQ_INT(got, ov);
+            want += ov;
+        }
+        CHECK_EQ_INT(k, want);
+    }
+}
+
+/* A staggered kd-tree: 3 x slabs, each cut in y at its own place, each column in z. */
+static vw_decomp *make_staggered(const vw_box *world)
+{
+    vw_kd_node nodes[64];
+    int nn = 0, cell = 0;
+    double xs[2] = {0.3, 0.55};
+    /* root: x < 0.3 | rest; rest: x < 0.55 | x >= 0.55 */
+    int root = nn++, rest = nn++;
+    int slab[3];
+    for (int s = 0; s < 3; s++) {
+        int ysplit = nn++;
+        slab[s] = ysplit;
+        double y = 0.2 + 0.25 * s;
+        nodes[ysplit] = (vw_kd_node){1, y, -1, -1, -1};
+        for (int side = 0; side < 2; side++) {
+            int zs = nn++;
+            nodes[zs] = (vw_kd_node){2, 0.1 + 0.3 * s + 0.2 * side, nn, nn + 1, -1};
+            nodes[nn] = (vw_kd_node){-1, 0, -1, -1, cell++};
+            nodes[nn + 1] = (vw_kd_node){-1, 0, -1, -1, cell++};
+            nn += 2;
+            if (side == 0)
+                nodes[ysplit].left = zs;
+            else
+                nodes[ysplit].right = zs;
+        }
+    }
+    nodes[root] = (vw_kd_node){0, xs[0], slab[0], rest, -1};
+    nodes[rest] = (vw_kd_node){0, xs[1], slab[1], slab[2], -1};
+    vw_decomp *d = NULL;
+    CHECK_EQ_INT(vw_decomp_create_kd(world, nodes, nn, NULL, VW_DECOMP_STAGGERED, &d), VW_OK);
+    return d;
+}
+
+int main(void)
+{
+    vw_box world = {{0, 0, 0}, {1, 1, 1}};
+    const char *layouts[] = {"1", "2", "2x4", "2x2x2", "3x3x3", "4x4x4", "1x1x5", "7x3x2"};
+    for (size_t i = 0; i < sizeof layouts / sizeof layouts[0]; i++) {
+        int dims[3];
+        CHECK_EQ_INT(vw_layout_parse(layouts[i], dims, NULL, 0), VW_OK);
+        vw_decomp *d;
+        CHECK_EQ_INT(vw_decomp_create_grid(&world, dims, &d), VW_OK);
+        CHECK_EQ_INT(vw_decomp_cell_count(d), dims[0] * dims[1] * dims[2]);
+        check_decomp(d);
+        /* Grid invariant: one neighbour per face at most. */
+        for (int c = 0; c < vw_decomp_cell_count(d); c++)
+            for (int f = 0; f < 6; f++) CHECK(vw_decomp_neighbours(d, c, f, NULL, 0) <= 1);
+        vw_decomp_free(d);
+    }
+    /* Uneven walls, and a rotated frame. */
+    {
+        int dims[3] = {3, 2, 2};
+        double wx[2] = {0.1, 0.8}, wy[1] = {0.3}, wz[1] = {0.9};
+        const double *walls[3] = {wx, wy, wz};
+        double c = cos(0.4), s = sin(0.4);
+        double frame[9] = {c, -s, 0, s, c, 0, 0, 0, 1};
+        vw_decomp *d;
+        CHECK_EQ_INT(vw_decomp_create_grid_walls(&world, dims, walls, NULL, &d), VW_OK);
+        check_decomp(d);
+        vw_decomp_free(d);
+        CHECK_EQ_INT(vw_decomp_create_grid_walls(&world, dims, walls, frame, &d), VW_OK);
+        CHECK(vw_decomp_frame(d) != NULL);
+        check_decomp(d);
+        vw_decomp *e;
+        CHECK_EQ_INT(vw_decomp_clone(d, &e), VW_OK);
+        check_decomp(e);
+        vw_decomp_free(e);
+        vw_decomp_free(d);
+        double bad[1] = {1.5};
+        const double *bw[3] = {wx, bad, wz};
+        CHECK_EQ_INT(vw_decomp_create_grid_walls(&world, dims, bw, NULL, &d), VW_E_INVAL);
+    }
+    /* Staggered: several neighbours per face. */
+    {
+        vw_decomp *d = make_staggered(&world);
+        CHECK_EQ_INT(vw_decomp_cell_count(d), 12);
+        CHECK(vw_decomp_max_neighbours(d) > 6);
+        check_decomp(d);
+        vw_decomp_free(d);
+    }
+    /* Malformed trees are refused. */
+    {
+        vw_kd_node cyc[3] = {{0, 0.5, 1, 1, -1}, {-1, 0, -1, -1, 0}, {-1, 0, -1, -1, 1}};
+        vw_decomp *d;
+        CHECK_EQ_INT(vw_decomp_create_kd(&world, cyc, 3, NULL, VW_DECOMP_DIVIDED, &d), VW_E_INVAL);
+        vw_kd_node outside[3] = {{0, 1.5, 1, 2, -1}, {-1, 0, -1, -1, 0}, {-1, 0, -1, -1, 1}};
+        CHECK_EQ_INT(vw_decomp_create_kd(&world, outside, 3, NULL, VW_DECOMP_DIVIDED, &d), VW_E_INVAL);
+    }
+    /* Layout strings. */
+    {
+        int dims[3];
+        char err[128];
+        const char *bad[] = {"", "x", "2x", "x2", "0", "2x0", "-1", "2x2x2x2", "a", "2y3", "99999999",
+                             "100x100x100"};
+        for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+            CHECK_EQ_INT(vw_layout_parse(bad[i], dims, err, sizeof err), VW_E_INPUT);
+            CHECK(strstr(err, "layout") != NULL);
+        }
+        CHECK_EQ_INT(vw_layout_parse("2X3", dims, err, sizeof err), VW_OK);
+        CHECK_EQ_INT(dims[0] * 10 + dims[1] * 100 + dims[2], 2 * 10 + 3 * 100 + 1);
+    }
+    TEST_DONE();
+}

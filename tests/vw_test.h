@@ -1,0 +1,52 @@
+/* vw_test.h - the few assertion macros every test executable uses: on failure they
+ * print the expression, both values, file and line, and exit non-zero (ctest reads
+ * the status).
+ */
+#ifndef VW_TEST_H
+#define VW_TEST_H
+
+#include <inttypes.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+
+static int vw_test_checks;
+
+#define CHECK(cond)                                                                     \
+    do {                                                                                \
+        vw_test_checks++;                                                               \
+        if (!(cond)) {                                                                  \
+            fprintf(stderr, "%s:%d: check failed: %s\n", __FILE__, __LINE__, #cond);     \
+            exit(1);                                                                    \
+        }                                                                               \
+    } while (0)
+
+#define CHECK_EQ_INT(a, b)                                                              \
+    do {                                                                                \
+        vw_test_checks++;                                                               \
+        long long va_ = (long long)(a), vb_ = (long long)(b);                           \
+        if (va_ != vb_) {                                                               \
+            fprintf(stderr, "%s:%d: %s == %s failed: %lld != %lld\n", __FILE__, __LINE__, \
+                    #a, #b, va_, vb_);                                                  \
+            exit(1);                                                                    \
+        }                                                                               \
+    } while (0)
+
+#define CHECK_NEAR(a, b, tol)                                                           \
+    do {                                                                                \
+        vw_test_checks++;                                                               \
+        double va_ = (double)(a), vb_ = (double)(b);                                    \
+        if (!(fabs(va_ - vb_) <= (tol))) {                                              \
+            fprintf(stderr, "%s:%d: |%s - %s| <= %s failed: %.17g vs %.17g\n", __FILE__, \
+                    __LINE__, #a, #b, #tol, va_, vb_);                                  \
+            exit(1);                                                                    \
+        }                                                                               \
+    } while (0)
+
+#define TEST_DONE()                                                                     \
+    do {                                                                                \
+        printf("%d checks passed\n", vw_test_checks);                                   \
+        return 0;                                                                       \
+    } while (0)
+
+#endif

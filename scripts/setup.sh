@@ -1,0 +1,33 @@
+#!/usr/bin/env bash
+# setup.sh - installs the Debian packages vwalls needs, and only those missing.
+# Idempotent: a second run installs nothing and does not touch the network.
+# usage: scripts/setup.sh [build|bench|fuzz|mpich]...   (default: build)
+set -euo pipefail
+
+want=()
+for what in "${@:-build}"; do
+  case "$what" in
+    build) want+=(gcc libc6-dev make cmake pkg-config libembree-dev libpng-dev
+                  libopenmpi-dev openmpi-bin openssh-client iproute2) ;;
+    bench) want+=(povray gnuplot-nox time) ;;
+    fuzz)  want+=(clang libclang-rt-14-dev) ;;
+    mpich) want+=(libmpich-dev mpich) ;;
+    docs)  want+=(doxygen) ;;
+    *) echo "setup.sh: unknown package set '$what' (build, bench, fuzz, mpich, docs)" >&2; exit 2 ;;
+  esac
+done
+
+missing=()
+for p in "${want[@]}"; do
+  if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then
+    missing+=("$p")
+  fi
+done
+[ ${#missing[@]} -eq 0 ] && exit 0
+
+echo "setup: installing ${missing[*]}" >&2
+SUDO=""
+if [ "$(id -u)" != 0 ]; then SUDO="sudo"; fi
+export DEBIAN_FRONTEND=noninteractive
+$SUDO apt-get update -qq
+$SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}" >&2

@@ -1,0 +1,307 @@
+/* geometry.c - a cell's Embree scene over its object records, and the queries the
+ * shading needs: the first hit in a t-interval and "is anything in this interval".
+ * Spheres are Embree points (RTC_GEOMETRY_TYPE_SPHERE_POINT), triangles triangle
+ * geometry, NFF cones user geometry with the exact intersection below.
+ *
+ * Invariant for bit-identical images: the hit found for a ray and an interval depends
+ * only on the ray and the primitives, never on which other primitives share the cell.
+ * Every primitive test is a pure function of (ray, primitive); Embree's interval tests
+ * run in float on (float)tnear and (float)tfar, and since consecutive segments share
+ * their boundary as one double, they share it as one float too, so the intervals of a
+ * ray's segments tile its whole interval in float as well.
+ */
+#include <embree3/rtcore.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include "raytrace/geometry.h"
+
+/* The intersect context carries the ray in double precision to the cone callbacks. */
+typedef struct rt_isect_ctx {
+    struct RTCIntersectContext base; /* first: Embree hands back a pointer to it */
+    const double *org, *dir;
+} rt_isect_ctx;
+
+/* ---- cones -------------------------------------------------------------------------- */
+
+/* The smallest t in [tn, tf] (compared as floats, like Embree's own tests) where the
+   ray meets the cone's side between its end discs; 0 when there is none.
+   The side is |P - (P.w)w|^2 = (r0 + k P.w)^2 for 0 <= P.w <= h, with P = o + t d - base,
+   w the unit axis, h its length and k = (r1 - r0) / h. */
+static int cone_hit(const rt_object *o, const double org[3], const double dir[3], float tn,
+                    float tf, double *tout)
+{
+    double w[3], D[3], h = 0;
+    for (int a = 0; a < 3; a++) {
+        w[a] = o->g.cone.apex[a] - o->g.cone.base[a];
+        D[a] = org[a] - o->g.cone.base[a];
+        h += w[a] * w[a];
+    }
+    h = sqrt(h);
+    if (!(h > 0)) return 0;
+    for (int a = 0; a < 3; a++) w[a] /= h;
+    double r0 = o->g.cone.r0, k = (o->g.cone.r1 - o->g.cone.r0) / h;
+    double dd = dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2];
+    double dw = dir[0] * w[0] + dir[1] * w[1] + dir[2] * w[2];
+    double Dd = D[0] * dir[0] + D[1] * dir[1] + D[2] * dir[2];
+    double Dw = D[0] * w[0] + D[1] * w[1] + D[2] * w[2];
+    double DD = D[0] * D[0] + D[1] * D[1] + D[2] * D[2];
+    double rD = r0 + k * Dw;
+    double A = dd - dw * dw - k * k * dw * dw;
+    double B = 2.0 * (Dd - Dw * dw - rD * k * dw);
+    double C = DD - Dw * Dw - rD * rD;
+    double ts[2];
+    int nt = 0;
+    if (fabs(A) < 1e-12 * dd) {
+        if (B != 0) ts[nt++] = -C / B;
+    } else {
+        double disc = B * B - 4 * A * C;
+        if (disc < 0) return 0;
+        double s = sqrt(disc);
+        /* The numerically stable pair of roots. */
+        double q = B < 0 ? -0.5 * (B - s) : -0.5 * (B + s);
+        double x0 = q / A, x1 = q != 0 ? C / q : x0;
+        ts[nt++] = fmin(x0, x1);
+        ts[nt++] = fmax(x0, x1);
+    }
+    for (int i = 0; i < nt; i++) {
+        double t = ts[i];
+        float tf32 = (float)t;
+        if (!(tf32 >= tn && tf32 <= tf)) continue;
+        double z = Dw + t * dw;
+        /* Only the nappe whose radius is the (non-negative) interpolated radius. */
+        if (z < 0 || z > h || r0 + k * z < 0) continue;
+        *tout = t;
+        return 1;
+    }
+    return 0;
+}
+
+void rt_cone_normal(const rt_object *o, const double p[3], double n[3])
+{
+    double w[3], P[3], h = 0;
+    for (int a = 0; a < 3; a++) {
+        w[a] = o->g.cone.apex[a] - o->g.cone.base[a];
+        P[a] = p[a] - o->g.cone.base[a];
+        h += w[a] * w[a];
+    }
+    h = sqrt(h);
+    for (int a = 0; a < 3; a++) w[a] /= h;
+    double k = (o->g.cone.r1 - o->g.cone.r0) / h;
+    double z = P[0] * w[0] + P[1] * w[1] + P[2] * w[2];
+    double r = o->g.cone.r0 + k * z;
+    /* Gradient of |P - zw|^2 - (r0 + kz)^2, halved. */
+    double l = 0;
+    for (int a = 0; a < 3; a++) {
+        n[a] = P[a] - z * w[a] - k * r * w[a];
+        l += n[a] * n[a];
+    }
+    l = sqrt(l);
+    double s = (o->flags & RT_INSIDE) ? -1.0 : 1.0;
+    for (int a = 0; a < 3; a++) n[a] = l > 0 ? s * n[a] / l : 0;
+}
+
+static void cone_bounds(const struct RTCBoundsFunctionArguments *args)
+{
+    const rt_cell_geo *g = args->geometryUserPtr;
+    const rt_object *o = &g->obj[g->cone_map[args->primID]];
+    vw_box b;
+    rt_object_bounds(o, 0, &b);
+    /* Round outward so the float box contains the double one. */
+    args->bounds_o->lower_x = nextafterf((float)b.lo[0], -INFINITY);
+    args->bounds_o->lower_y = nextafterf((float)b.lo[1], -INFINITY);
+    args->bounds_o->lower_z = nextafterf((float)b.lo[2], -INFINITY);
+    args->bounds_o->upper_x = nextafterf((float)b.hi[0], INFINITY);
+    args->bounds_o->upper_y = nextafterf((float)b.hi[1], INFINITY);
+    args->bounds_o->upper_z = nextafterf((float)b.hi[2], INFINITY);
+}
+
+static void cone_intersect(const struct RTCIntersectFunctionNArguments *args)
+{
+    if (!args->valid[0]) return;
+    const rt_cell_geo *g = args->geometryUserPtr;
+    const rt_isect_ctx *c = (const rt_isect_ctx *)args->context;
+    struct RTCRayHit *rh = (struct RTCRayHit *)args->rayhit; /* N == 1: rtcIntersect1 */
+    double t;
+    if (!cone_hit(&g->obj[g->cone_map[args->primID]], c->org, c->dir, rh->ray.tnear,
+                  rh->ray.tfar, &t))
+        return;
+    rh->ray.tfar = (float)t;
+    rh->hit.u = rh->hit.v = 0;
+    rh->hit.Ng_x = rh->hit.Ng_y = rh->hit.Ng_z = 0;
+    rh->hit.primID = args->primID;
+    rh->hit.geomID = args->geomID;
+    rh->hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+}
+
+static void cone_occluded(const struct RTCOccludedFunctionNArguments *args)
+{
+    if (!args->valid[0]) return;
+    const rt_cell_geo *g = args->geometryUserPtr;
+    const rt_isect_ctx *c = (const rt_isect_ctx *)args->context;
+    struct RTCRay *r = (struct RTCRay *)args->ray;
+    double t;
+    if (cone_hit(&g->obj[g->cone_map[args->primID]], c->org, c->dir, r->tnear, r->tfar, &t))
+        r->tfar = -INFINITY;
+}
+
+/* ---- the cell's scene ------------------------------------------------------------ */
+
+static vw_status attach(rt_cell_geo *g, RTCGeometry geom, int kind)
+{
+    rtcCommitGeometry(geom);
+    unsigned id = rtcAttachGeometry((RTCScene)g->scene, geom);
+    rtcReleaseGeometry(geom);
+    if (id >= 3) return VW_E_STATE;
+    g->geom_kind[id] = kind;
+    return VW_OK;
+}
+
+vw_status rt_cell_geo_build(void *device, const rt_object *objects, size_t n, rt_cell_geo *g)
+{
+    memset(g, 0, sizeof *g);
+    g->geom_kind[0] = g->geom_kind[1] = g->geom_kind[2] = -1;
+    g->obj = malloc((n ? n : 1) * sizeof *g->obj);
+    g->sph_map = malloc((n ? n : 1) * sizeof *g->sph_map);
+    g->tri_map = malloc((n ? n : 1) * sizeof *g->tri_map);
+    g->cone_map = malloc((n ? n : 1) * sizeof *g->cone_map);
+    if (!g->obj || !g->sph_map || !g->tri_map || !g->cone_map) return VW_E_NOMEM;
+    if (n) memcpy(g->obj, objects, n * sizeof *g->obj);
+    g->nobj = n;
+    size_t ns = 0, nt = 0, nc = 0;
+    for (size_t i = 0; i < n; i++) {
+        switch (g->obj[i].kind) {
+        case RT_SPHERE: g->sph_map[ns++] = (uint32_t)i; break;
+        case RT_TRIANGLE: g->tri_map[nt++] = (uint32_t)i; break;
+        case RT_CONE: g->cone_map[nc++] = (uint32_t)i; break;
+        default: break;
+        }
+    }
+    RTCDevice dev = (RTCDevice)device;
+    RTCScene sc = rtcNewScene(dev);
+    if (!sc) return VW_E_NOMEM;
+    g->scene = sc;
+    rtcSetSceneBuildQuality(sc, RTC_BUILD_QUALITY_MEDIUM);
+    vw_status st = VW_OK;
+    if (ns) {
+        RTCGeometry geom = rtcNewGeometry(dev, RTC_GEOMETRY_TYPE_SPHERE_POINT);
+        float *v = rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT4,
+                                           4 * sizeof(float), ns);
+        if (!v) return VW_E_NOMEM;
+        for (size_t i = 0; i < ns; i++) {
+            const rt_object *o = &g->obj[g->sph_map[i]];
+            for (int a = 0; a < 3; a++) v[4 * i + a] = (float)o->g.sphere.c[a];
+            v[4 * i + 3] = (float)o->g.sphere.r;
+        }
+        if ((st = attach(g, geom, RT_SPHERE)) != VW_OK) return st;
+    }
+    if (nt) {
+        RTCGeometry geom = rtcNewGeometry(dev, RTC_GEOMETRY_TYPE_TRIANGLE);
+        float *v = rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                                           3 * sizeof(float), 3 * nt);
+        unsigned *ix = rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0,
+                                               RTC_FORMAT_UINT3, 3 * sizeof(unsigned), nt);
+        if (!v || !ix) return VW_E_NOMEM;
+        /* Three vertices of its own per triangle: a triangle's float data (and so its
+           hits) must not depend on which other triangles share the cell. */
+        for (size_t i = 0; i < nt; i++) {
+            const rt_object *o = &g->obj[g->tri_map[i]];
+            for (int c = 0; c < 3; c++) {
+                for (int a = 0; a < 3; a++) v[9 * i + 3 * c + a] = (float)o->g.tri.v[c][a];
+                ix[3 * i + c] = (unsigned)(3 * i + c);
+            }
+        }
+        if ((st = attach(g, geom, RT_TRIANGLE)) != VW_OK) return st;
+    }
+    if (nc) {
+        RTCGeometry geom = rtcNewGeometry(dev, RTC_GEOMETRY_TYPE_USER);
+        rtcSetGeometryUserPrimitiveCount(geom, (unsigned)nc);
+        rtcSetGeometryUserData(geom, g);
+        rtcSetGeometryBoundsFunction(geom, cone_bounds, NULL);
+        rtcSetGeometryIntersectFunction(geom, cone_intersect);
+        rtcSetGeometryOccludedFunction(geom, cone_occluded);
+        if ((st = attach(g, geom, RT_CONE)) != VW_OK) return st;
+    }
+    rtcCommitScene(sc);
+    if (rtcGetDeviceError(dev) != RTC_ERROR_NONE) return VW_E_STATE;
+    return VW_OK;
+}
+
+void rt_cell_geo_free(rt_cell_geo *g)
+{
+    if (!g) return;
+    if (g->scene) rtcReleaseScene((RTCScene)g->scene);
+    free(g->obj);
+    free(g->sph_map);
+    free(g->tri_map);
+    free(g->cone_map);
+    memset(g, 0, sizeof *g);
+}
+
+static void make_ray(struct RTCRay *r, const double org[3], const double dir[3], double tn,
+                     double tf)
+{
+    r->org_x = (float)org[0];
+    r->org_y = (float)org[1];
+    r->org_z = (float)org[2];
+    r->dir_x = (float)dir[0];
+    r->dir_y = (float)dir[1];
+    r->dir_z = (float)dir[2];
+    r->tnear = (float)tn;
+    r->tfar = (float)tf;
+    r->time = 0;
+    r->mask = 0xFFFFFFFFu;
+    r->id = 0;
+    r->flags = 0;
+}
+
+int rt_cell_geo_intersect(const rt_cell_geo *g, const double org[3], const double dir[3],
+                          double tnear, double tfar, rt_hit *hit)
+{
+    if (!g->scene || !(tnear <= tfar)) return 0;
+    rt_isect_ctx c;
+    rtcInitIntersectContext(&c.base);
+    c.org = org;
+    c.dir = dir;
+    struct RTCRayHit rh;
+    make_ray(&rh.ray, org, dir, tnear, tfar);
+    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.primID = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    rtcIntersect1((RTCScene)g->scene, &c.base, &rh);
+    if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID || rh.hit.geomID >= 3) return 0;
+    int kind = g->geom_kind[rh.hit.geomID];
+    const uint32_t *map = kind == RT_SPHERE ? g->sph_map
+                          : kind == RT_TRIANGLE ? g->tri_map : g->cone_map;
+    hit->obj = &g->obj[map[rh.hit.primID]];
+    hit->t = rh.ray.tfar;
+    hit->u = rh.hit.u;
+    hit->v = rh.hit.v;
+    return 1;
+}
+
+int rt_cell_geo_occluded(const rt_cell_geo *g, const double org[3], const double dir[3],
+                         double tnear, double tfar)
+{
+    if (!g->scene || !(tnear <= tfar)) return 0;
+    rt_isect_ctx c;
+    rtcInitIntersectContext(&c.base);
+    c.org = org;
+    c.dir = dir;
+    struct RTCRay r;
+    make_ray(&r, org, dir, tnear, tfar);
+    rtcOccluded1((RTCScene)g->scene, &c.base, &r);
+    return r.tfar == -INFINITY;
+}
+
+void *rt_device_new(void)
+{
+    /* Builds run on the worker thread that hosts the cell: the parallelism is in the
+       cells, and Embree's own thread pool would only compete with the workers. */
+    return rtcNewDevice("threads=1,set_affinity=0,verbose=0");
+}
+
+void rt_device_free(void *device)
+{
+    if (device) rtcReleaseDevice((RTCDevice)device);
+}

@@ -1,0 +1,38 @@
+/* geometry.h - a cell's ray-tracing geometry (an Embree scene over the cell's object
+ * records) and the two queries on it. App-local: only the ray tracer uses it.
+ */
+#ifndef RT_GEOMETRY_H
+#define RT_GEOMETRY_H
+
+#include "raytrace/raytrace.h"
+
+typedef struct rt_cell_geo {
+    void *scene;                 /* RTCScene */
+    rt_object *obj;              /* the cell's own copy of its records */
+    size_t nobj;
+    uint32_t *sph_map, *tri_map, *cone_map; /* Embree primID -> index in obj */
+    int geom_kind[3];            /* Embree geomID -> rt_kind */
+} rt_cell_geo;
+
+typedef struct rt_hit {
+    const rt_object *obj;
+    double t;                    /* as Embree found it (a float) */
+    float u, v;                  /* barycentrics of a triangle hit */
+} rt_hit;
+
+vw_status rt_cell_geo_build(void *device, const rt_object *objects, size_t n, rt_cell_geo *g);
+void rt_cell_geo_free(rt_cell_geo *g);
+/* The first hit with t in [tnear, tfar]; 0 when none. */
+int rt_cell_geo_intersect(const rt_cell_geo *g, const double org[3], const double dir[3],
+                          double tnear, double tfar, rt_hit *hit);
+/* Is there any hit with t in [tnear, tfar]? */
+int rt_cell_geo_occluded(const rt_cell_geo *g, const double org[3], const double dir[3],
+                         double tnear, double tfar);
+/* The unit outward normal of a cone's side at p (inward for RT_INSIDE cones). */
+void rt_cone_normal(const rt_object *o, const double p[3], double n[3]);
+
+/* One RTCDevice per process, shared by every cell (Embree's device is thread-safe). */
+void *rt_device_new(void);
+void rt_device_free(void *device);
+
+#endif

@@ -1,0 +1,358 @@
+/* job.c - one whole render: scene -> records, world box and grid decomposition, the
+ * world run to quiescence, and the pixel sums turned into images, the load overlay
+ * and the ray members of the stats JSON. The command line and the tests drive this.
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include "raytrace/geometry.h"
+#include "raytrace/raytrace.h"
+
+struct rt_job {
+    rt_shared sh;
+    vw_decomp *decomp;
+    vw_world *world;
+    int *owner;          /* output process: cell of each pixel's eye ray, -1 = misses */
+    int64_t primary;     /* pixels with an owner */
+    int ran;
+};
+
+void rt_job_free(rt_job *j)
+{
+    if (!j) return;
+    vw_world_free(j->world);
+    vw_decomp_free(j->decomp);
+    rt_device_free(j->sh.device);
+    free(j->sh.lights);
+    free(j->sh.accum);
+    free(j->owner);
+    free(j);
+}
+
+vw_status rt_job_create(const vw_scene *s, const rt_params *p, rt_job **out, char *err,
+                        size_t errlen)
+{
+    *out = NULL;
+    rt_job *j = calloc(1, sizeof *j);
+    if (!j) return VW_E_NOMEM;
+    rt_shared *sh = &j->sh;
+    atomic_init(&sh->pixels_done, 0);
+    atomic_init(&sh->entries, 0);
+    atomic_init(&sh->rays, 0);
+
+    double lo[3], hi[3];
+    vw_scene_bounds(s, lo, hi);
+    double diag = 0;
+    for (int a = 0; a < 3; a++) diag += (hi[a] - lo[a]) * (hi[a] - lo[a]);
+    diag = sqrt(diag);
+    if (!(diag > 0)) diag = 1;
+
+    vw_camera cam;
+    if (p->camera)
+        cam = *p->camera;
+    else if (s->camera.valid)
+        cam = s->camera;
+    else {
+        /* OBJ: a view framing the bounds (the scene library's convention). */
+        memset(&cam, 0, sizeof cam);
+        vw_scene_default_camera(s, &cam);
+    }
+    int w = p->width > 0 ? p->width : cam.width > 0 ? cam.width : 512;
+    int h = p->height > 0 ? p->height : cam.height > 0 ? cam.height : 512;
+    if (w > 16384 || h > 16384) {
+        snprintf(err, errlen, "image size %dx%d too large", w, h);
+        rt_job_free(j);
+        return VW_E_INVAL;
+    }
+    rt_view_init(&sh->view, &cam, w, h);
+    sh->max_depth = p->depth > 0 ? p->depth : 5;
+    /* Secondary rays start this far from their surface: far above Embree's float error
+       (~1e-7 of the scene size), far below any feature a scene file means. */
+    sh->eps = 1e-4 * diag;
+    sh->bpad = 1e-6 * diag;
+    for (int k = 0; k < 3; k++) sh->background[k] = s->background[k];
+
+    size_t nl = s->nlights ? s->nlights : 1;
+    sh->lights = calloc(nl, sizeof *sh->lights);
+    if (!sh->lights) goto nomem;
+    if (s->nlights) {
+        for (size_t i = 0; i < s->nlights; i++)
+            for (int a = 0; a < 3; a++) {
+                sh->lights[i].pos[a] = s->lights[i].pos[a];
+                sh->lights[i].color[a] = s->lights[i].color[a];
+            }
+    } else {
+        /* A scene without lights (OBJ): one white light above the eye. */
+        for (int a = 0; a < 3; a++) {
+            sh->lights[0].pos[a] = cam.from[a] + 0.5 * diag * sh->view.up[a];
+            sh->lights[0].color[a] = 1.0;
+        }
+    }
+    sh->nlights = (int)nl;
+
+    rt_object *objs = NULL;
+    size_t nobjs = 0;
+    vw_status st = rt_objects_from_scene(s, &objs, &nobjs);
+    if (st != VW_OK) goto fail;
+
+    /* The world box: the scene bounds padded so no primitive touches the outer walls,
+       and so a flat scene still gives cells of positive volume. */
+    vw_box world;
+    for (int a = 0; a < 3; a++) {
+        double pad = fmax(1e-3 * diag, 1e-3 * (hi[a] - lo[a]));
+        world.lo[a] = lo[a] - pad;
+        world.hi[a] = hi[a] + pad;
+    }
+    int dims[3];
+    for (int a = 0; a < 3; a++) dims[a] = p->dims[a] > 0 ? p->dims[a] : 1;
+    st = vw_decomp_create_grid(&world, dims, &j->decomp);
+    if (st != VW_OK) {
+        snprintf(err, errlen, "cannot create the %dx%dx%d decomposition: %s", dims[0], dims[1],
+                 dims[2], vw_status_message(st));
+        free(objs);
+        rt_job_free(j);
+        return st;
+    }
+    sh->device = rt_device_new();
+    if (!sh->device) {
+        snprintf(err, errlen, "cannot create the Embree device");
+        free(objs);
+        rt_job_free(j);
+        return VW_E_STATE;
+    }
+
+    vw_config cfg;
+    if (p->config)
+        cfg = *p->config;
+    else
+        vw_config_init(&cfg);
+    if (p->workers > 0) cfg.workers = p->workers;
+    st = vw_world_create(&rt_module, sh, j->decomp, &cfg, &j->world);
+    if (st != VW_OK) {
+        snprintf(err, errlen, "cannot create the world: %s", vw_status_message(st));
+        free(objs);
+        rt_job_free(j);
+        return st;
+    }
+    st = vw_world_add_objects(j->world, objs, nobjs);
+    free(objs);
+    if (st != VW_OK) {
+        snprintf(err, errlen, "%s", vw_world_errmsg(j->world));
+        rt_job_free(j);
+        return st;
+    }
+
+    if (vw_world_is_output(j->world)) {
+        size_t np = (size_t)w * (size_t)h;
+        sh->accum = calloc(np, sizeof *sh->accum);
+        j->owner = malloc(np * sizeof *j->owner);
+        if (!sh->accum || !j->owner) goto nomem;
+        /* The same walk every cell does in cell_build, so owners agree with them. */
+        for (int y = 0; y < h; y++)
+            for (int x = 0; x < w; x++) {
+                double dir[3];
+                vw_segment seg;
+                rt_view_ray(&sh->view, x, y, dir);
+                int hitw = vw_decomp_first_segment(j->decomp, sh->view.eye, dir, 0.0, INFINITY,
+                                                   &seg);
+                j->owner[(size_t)y * w + x] = hitw ? seg.cell : -1;
+                j->primary += hitw;
+            }
+    }
+    *out = j;
+    return VW_OK;
+nomem:
+    st = VW_E_NOMEM;
+fail:
+    snprintf(err, errlen, "%s", vw_status_message(st));
+    rt_job_free(j);
+    return st;
+}
+
+vw_status rt_job_commit(rt_job *j, char *err, size_t errlen)
+{
+    vw_status st = vw_world_commit(j->world);
+    if (st != VW_OK) snprintf(err, errlen, "building the cells: %s", vw_world_errmsg(j->world));
+    return st;
+}
+
+vw_status rt_job_run(rt_job *j, char *err, size_t errlen)
+{
+    vw_status st = vw_world_run(j->world);
+    if (st != VW_OK) {
+        snprintf(err, errlen, "rendering: %s", vw_world_errmsg(j->world));
+        return st;
+    }
+    if (j->sh.accum && !j->ran) {
+        /* Pixels whose eye ray misses the world have no cell: the background is added
+           here, once, as the same fixed-point value a cell would have sent. */
+        int64_t bg[3];
+        for (int k = 0; k < 3; k++) bg[k] = (int64_t)llround(j->sh.background[k] * RT_FIX_ONE);
+        size_t np = (size_t)j->sh.view.width * j->sh.view.height;
+        for (size_t i = 0; i < np; i++)
+            if (j->owner[i] < 0)
+                for (int k = 0; k < 3; k++) j->sh.accum[i][k] += bg[k];
+    }
+    j->ran = 1;
+    return VW_OK;
+}
+
+vw_world *rt_job_world(rt_job *j) { return j->world; }
+const rt_shared *rt_job_shared(const rt_job *j) { return &j->sh; }
+int rt_job_is_output(const rt_job *j) { return vw_world_is_output(j->world); }
+int64_t rt_job_primary_pixels(const rt_job *j) { return j->primary; }
+const int64_t *rt_job_sums(const rt_job *j) { return j->sh.accum ? &j->sh.accum[0][0] : NULL; }
+
+void rt_job_progress(const rt_job *j, int64_t *pixels_done, int64_t *rays)
+{
+    rt_job *m = (rt_job *)j; /* atomics are read-only here, but C11 wants non-const */
+    if (pixels_done) *pixels_done = atomic_load(&m->sh.pixels_done);
+    if (rays) *rays = atomic_load(&m->sh.rays);
+}
+
+void rt_job_rgb8(const rt_job *j, uint8_t *out)
+{
+    size_t n = (size_t)j->sh.view.width * j->sh.view.height * 3;
+    const int64_t *s = rt_job_sums(j);
+    for (size_t i = 0; i < n; i++) out[i] = s ? rt_fix_to_u8(s[i]) : 0;
+}
+
+void rt_job_rgbf(const rt_job *j, float *out)
+{
+    size_t n = (size_t)j->sh.view.width * j->sh.view.height * 3;
+    const int64_t *s = rt_job_sums(j);
+    for (size_t i = 0; i < n; i++) out[i] = s ? (float)((double)s[i] / RT_FIX_ONE) : 0.0f;
+}
+
+/* ---- the overlay ---------------------------------------------------------------------- */
+
+static void put(uint8_t *img, int w, int h, int x, int y, const uint8_t c[3])
+{
+    if (x < 0 || y < 0 || x >= w || y >= h) return;
+    memcpy(&img[((size_t)y * w + x) * 3], c, 3);
+}
+
+static void line(uint8_t *img, int w, int h, double x0, double y0, double x1, double y1,
+                 const uint8_t c[3])
+{
+    /* Clip generously first so huge projected coordinates cannot loop for long. */
+    double lim = 4.0 * (w + h);
+    if (fabs(x0) > lim || fabs(y0) > lim || fabs(x1) > lim || fabs(y1) > lim) {
+        int n = 0;
+        while ((fabs(x0) > lim || fabs(y0) > lim || fabs(x1) > lim || fabs(y1) > lim) && n < 60) {
+            /* Shorten towards the midpoint from whichever end is far. */
+            double mx = 0.5 * (x0 + x1), my = 0.5 * (y0 + y1);
+            if (fabs(x0) > lim || fabs(y0) > lim) {
+                x0 = mx;
+                y0 = my;
+            } else {
+                x1 = mx;
+                y1 = my;
+            }
+            n++;
+        }
+    }
+    double dx = x1 - x0, dy = y1 - y0;
+    int steps = (int)ceil(fmax(fabs(dx), fabs(dy)));
+    if (steps < 1) steps = 1;
+    for (int i = 0; i <= steps; i++) {
+        double t = (double)i / steps;
+        put(img, w, h, (int)floor(x0 + t * dx), (int)floor(y0 + t * dy), c);
+    }
+}
+
+void rt_job_overlay(const rt_job *j, uint8_t *out)
+{
+    const rt_view *v = &j->sh.view;
+    int w = v->width, h = v->height;
+    rt_job_rgb8(j, out);
+    int nc = vw_decomp_cell_count(j->decomp);
+    double *load = calloc((size_t)nc, sizeof *load);
+    if (!load) return;
+    double maxl = 0, minl = INFINITY;
+    for (int c = 0; c < nc; c++) {
+        vw_cell_stats cs;
+        if (vw_world_cell_stats(j->world, c, &cs) == VW_OK) load[c] = cs.load;
+        maxl = fmax(maxl, load[c]);
+        minl = fmin(minl, load[c]);
+    }
+    /* Tint: green for the lightest cell, red for the heaviest, half-transparent. */
+    if (j->owner)
+        for (size_t i = 0; i < (size_t)w * h; i++) {
+            int c = j->owner[i];
+            if (c < 0) continue;
+            double f = maxl > minl ? (load[c] - minl) / (maxl - minl) : 0.0;
+            double tint[3] = {255.0 * f, 255.0 * (1.0 - f), 0.0};
+            for (int k = 0; k < 3; k++)
+                out[i * 3 + k] = (uint8_t)lround(0.55 * out[i * 3 + k] + 0.45 * tint[k]);
+        }
+    free(load);
+    /* Walls: the edges of every cell box, clipped to the half-space in front of the eye. */
+    static const uint8_t white[3] = {255, 255, 255};
+    const double *F = vw_decomp_frame(j->decomp);
+    double near = 1e-6;
+    for (int c = 0; c < nc; c++) {
+        vw_box b = vw_decomp_cell_box(j->decomp, c);
+        double P[8][3];
+        for (int i = 0; i < 8; i++) {
+            double q[3] = {(i & 1) ? b.hi[0] : b.lo[0], (i & 2) ? b.hi[1] : b.lo[1],
+                           (i & 4) ? b.hi[2] : b.lo[2]};
+            for (int a = 0; a < 3; a++)
+                P[i][a] = F ? F[0 * 3 + a] * q[0] + F[1 * 3 + a] * q[1] + F[2 * 3 + a] * q[2]
+                            : q[a];
+        }
+        for (int i = 0; i < 8; i++)
+            for (int bit = 1; bit < 8; bit <<= 1) {
+                if (i & bit) continue;
+                double A[3], B[3];
+                memcpy(A, P[i], sizeof A);
+                memcpy(B, P[i | bit], sizeof B);
+                double za = 0, zb = 0;
+                for (int a = 0; a < 3; a++) {
+                    za += (A[a] - v->eye[a]) * v->fwd[a];
+                    zb += (B[a] - v->eye[a]) * v->fwd[a];
+                }
+                if (za <= near && zb <= near) continue;
+                if (za <= near || zb <= near) {
+                    double t = (near - za) / (zb - za) * 1.0001;
+                    double Cp[3];
+                    for (int a = 0; a < 3; a++) Cp[a] = A[a] + t * (B[a] - A[a]);
+                    if (za <= near)
+                        memcpy(A, Cp, sizeof A);
+                    else
+                        memcpy(B, Cp, sizeof B);
+                }
+                double ax, ay, bx, by;
+                if (rt_view_project(v, A, &ax, &ay) && rt_view_project(v, B, &bx, &by))
+                    line(out, w, h, ax, ay, bx, by, white);
+            }
+    }
+}
+
+/* ---- stats ------------------------------------------------------------------------------- */
+
+char *rt_job_stats_json(const rt_job *j)
+{
+    int nc = vw_decomp_cell_count(j->decomp);
+    size_t cap = 512 + (size_t)nc * 24;
+    char *s = malloc(cap);
+    if (!s) return NULL;
+    size_t n = (size_t)snprintf(
+        s, cap,
+        "\"rays\": {\"eye\": %lld, \"reflect\": %lld, \"refract\": %lld, \"shadow\": %lld, "
+        "\"ended\": %lld, \"segments\": %lld},\n  \"image\": {\"width\": %d, \"height\": %d, "
+        "\"depth\": %d, \"primary_pixels\": %lld},\n  \"pixels_per_cell\": [",
+        (long long)vw_world_counter(j->world, RT_C_EYE),
+        (long long)vw_world_counter(j->world, RT_C_REFLECT),
+        (long long)vw_world_counter(j->world, RT_C_REFRACT),
+        (long long)vw_world_counter(j->world, RT_C_SHADOW),
+        (long long)vw_world_counter(j->world, RT_C_ENDED),
+        (long long)vw_world_counter(j->world, RT_C_SEGMENTS), j->sh.view.width,
+        j->sh.view.height, j->sh.max_depth, (long long)vw_world_counter(j->world, RT_C_PIXELS));
+    for (int c = 0; c < nc && n < cap; c++)
+        n += (size_t)snprintf(s + n, cap - n, "%s%lld", c ? ", " : "",
+                              (long long)vw_world_cell_counter(j->world, c, RT_C_PIXELS));
+    if (n < cap) snprintf(s + n, cap - n, "]");
+    return s;
+}

@@ -1,0 +1,135 @@
+/* objects.c - the ray tracer's object records: a scene's spheres, cones and polygons as
+ * plain records with their material copied in, so any cell can shade any hit alone.
+ * Polygons are fan-triangulated; every triangle keeps its polygon's global id.
+ */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include "raytrace/raytrace.h"
+
+static void material_of(const vw_scene *s, int m, vw_material *out)
+{
+    if (m >= 0 && (size_t)m < s->nmaterials) {
+        *out = s->materials[m];
+    } else {
+        /* No material given: white diffuse, the NFF default before any 'f'. */
+        memset(out, 0, sizeof *out);
+        out->diffuse[0] = out->diffuse[1] = out->diffuse[2] = 1.0f;
+        out->ior = 1.0f;
+    }
+}
+
+static double tri_area2(const double a[3], const double b[3], const double c[3])
+{
+    double e1[3], e2[3];
+    for (int k = 0; k < 3; k++) {
+        e1[k] = b[k] - a[k];
+        e2[k] = c[k] - a[k];
+    }
+    double x = e1[1] * e2[2] - e1[2] * e2[1];
+    double y = e1[2] * e2[0] - e1[0] * e2[2];
+    double z = e1[0] * e2[1] - e1[1] * e2[0];
+    return x * x + y * y + z * z;
+}
+
+vw_status rt_objects_from_scene(const vw_scene *s, rt_object **out, size_t *n)
+{
+    size_t cap = s->nspheres + s->ncones;
+    for (size_t i = 0; i < s->npolygons; i++)
+        if (s->polygons[i].count >= 3) cap += (size_t)s->polygons[i].count - 2;
+    rt_object *o = calloc(cap ? cap : 1, sizeof *o);
+    if (!o) return VW_E_NOMEM;
+    size_t k = 0;
+    for (size_t i = 0; i < s->nspheres; i++) {
+        const vw_sphere *sp = &s->spheres[i];
+        rt_object *r = &o[k++];
+        r->kind = RT_SPHERE;
+        r->id = sp->id;
+        material_of(s, sp->material, &r->mat);
+        memcpy(r->g.sphere.c, sp->center, sizeof r->g.sphere.c);
+        r->g.sphere.r = fabs(sp->radius);
+    }
+    for (size_t i = 0; i < s->ncones; i++) {
+        const vw_cone *c = &s->cones[i];
+        rt_object *r = &o[k++];
+        r->kind = RT_CONE;
+        r->id = c->id;
+        material_of(s, c->material, &r->mat);
+        memcpy(r->g.cone.base, c->base, sizeof r->g.cone.base);
+        memcpy(r->g.cone.apex, c->apex, sizeof r->g.cone.apex);
+        r->g.cone.r0 = fabs(c->base_radius);
+        r->g.cone.r1 = fabs(c->apex_radius);
+        /* NFF: negative radii mean only the inside is visible; we shade both sides,
+           so the sign only turns the normal (it matters for refraction). */
+        if (c->base_radius < 0 || c->apex_radius < 0) r->flags |= RT_INSIDE;
+    }
+    for (size_t i = 0; i < s->npolygons; i++) {
+        const vw_polygon *p = &s->polygons[i];
+        if (p->count < 3) continue;
+        const int *idx = &s->indices[p->first];
+        for (int j = 1; j + 1 < p->count; j++) {
+            const int c3[3] = {0, j, j + 1};
+            rt_object *r = &o[k];
+            for (int v = 0; v < 3; v++) {
+                memcpy(r->g.tri.v[v], s->vertices[idx[c3[v]]], sizeof r->g.tri.v[v]);
+                if (p->has_normals && s->normals)
+                    memcpy(r->g.tri.n[v], s->normals[p->first + c3[v]], sizeof r->g.tri.n[v]);
+            }
+            /* A triangle of zero area can never be hit; leaving it out keeps NaN
+               normals out of the shading. */
+            if (!(tri_area2(r->g.tri.v[0], r->g.tri.v[1], r->g.tri.v[2]) > 0)) {
+                memset(r, 0, sizeof *r);
+                continue;
+            }
+            r->kind = RT_TRIANGLE;
+            r->id = p->id;
+            if (p->has_normals && s->normals) r->flags |= RT_SMOOTH;
+            material_of(s, p->material, &r->mat);
+            k++;
+        }
+    }
+    *out = o;
+    *n = k;
+    return VW_OK;
+}
+
+void rt_object_bounds(const rt_object *o, double pad, vw_box *out)
+{
+    switch (o->kind) {
+    case RT_SPHERE:
+        for (int a = 0; a < 3; a++) {
+            out->lo[a] = o->g.sphere.c[a] - o->g.sphere.r;
+            out->hi[a] = o->g.sphere.c[a] + o->g.sphere.r;
+        }
+        break;
+    case RT_CONE: {
+        /* Each end disc lies in the plane normal to the axis w; its extent along
+           coordinate axis a is r * sqrt(1 - w_a^2). */
+        double w[3], len = 0;
+        for (int a = 0; a < 3; a++) {
+            w[a] = o->g.cone.apex[a] - o->g.cone.base[a];
+            len += w[a] * w[a];
+        }
+        len = sqrt(len);
+        for (int a = 0; a < 3; a++) {
+            double wa = len > 0 ? w[a] / len : 0;
+            double e = sqrt(fmax(0.0, 1.0 - wa * wa));
+            double b0 = o->g.cone.base[a], b1 = o->g.cone.apex[a];
+            double r0 = o->g.cone.r0 * e, r1 = o->g.cone.r1 * e;
+            out->lo[a] = fmin(b0 - r0, b1 - r1);
+            out->hi[a] = fmax(b0 + r0, b1 + r1);
+        }
+        break;
+    }
+    default:
+        for (int a = 0; a < 3; a++) {
+            out->lo[a] = fmin(o->g.tri.v[0][a], fmin(o->g.tri.v[1][a], o->g.tri.v[2][a]));
+            out->hi[a] = fmax(o->g.tri.v[0][a], fmax(o->g.tri.v[1][a], o->g.tri.v[2][a]));
+        }
+        break;
+    }
+    for (int a = 0; a < 3; a++) {
+        out->lo[a] -= pad;
+        out->hi[a] += pad;
+    }
+}

@@ -1,0 +1,157 @@
+/* raytrace.h - the distributed ray tracer: a vwalls module (Menzel et al. 1994, sec. 3).
+ *
+ * Rays travel through the cells as messages. Invariants that keep images bit-identical
+ * for every decomposition, worker count and engine:
+ *  - a ray is owned by exactly one cell at a time; crossing a wall transfers ownership,
+ *    and the ray keeps its ORIGINAL origin and direction for its whole life (it is never
+ *    re-originated at a wall), so every cell computes the same hit for it;
+ *  - the t-interval a cell searches is the ray-walk segment, and the segments of one
+ *    ray are contiguous (decomp.h), so "first hit over all cells" is the global first hit;
+ *  - nothing in the shading depends on the cell: it reads only the ray, the hit object's
+ *    record (material copied in) and the lights;
+ *  - every contribution goes to the output process in 64-bit fixed point, where integer
+ *    addition makes the sum independent of arrival order.
+ */
+#ifndef RT_RAYTRACE_H
+#define RT_RAYTRACE_H
+
+#include <stdatomic.h>
+#include <stdint.h>
+#include "vwalls/vwalls.h"
+
+/* ---- objects ---------------------------------------------------------------------- */
+
+typedef enum rt_kind { RT_SPHERE = 0, RT_TRIANGLE = 1, RT_CONE = 2 } rt_kind;
+
+#define RT_SMOOTH 1 /* triangle with vertex normals (NFF pp, OBJ vn) */
+#define RT_INSIDE 2 /* cone given with negative radii: normals point inward */
+
+/* One primitive as copied into every cell it overlaps: plain data, material included,
+   so a cell needs nothing but its records to shade a hit. */
+typedef struct rt_object {
+    int32_t kind;  /* rt_kind */
+    int32_t id;    /* the scene's global id (a polygon's id for each of its triangles) */
+    int32_t flags; /* RT_SMOOTH, RT_INSIDE */
+    int32_t pad;
+    vw_material mat;
+    union {
+        struct { double c[3], r; } sphere;
+        struct { double base[3], r0, apex[3], r1; } cone; /* radii >= 0 */
+        struct { double v[3][3], n[3][3]; } tri;
+    } g;
+} rt_object;
+
+/* The scene's primitives as records (polygons fan-triangulated, degenerate triangles
+   dropped). *out is malloc'ed; returns VW_E_NOMEM on failure. */
+vw_status rt_objects_from_scene(const vw_scene *s, rt_object **out, size_t *n);
+/* Bounds of one record, widened by pad on every side. */
+void rt_object_bounds(const rt_object *o, double pad, vw_box *out);
+
+/* ---- camera ------------------------------------------------------------------------- */
+
+typedef struct rt_view {
+    double eye[3];
+    double right[3], up[3], fwd[3]; /* orthonormal; screen x grows along right */
+    double tan_half;                /* tan(vertical angle / 2) */
+    double aspect;                  /* width / height */
+    int width, height;
+} rt_view;
+
+void rt_view_init(rt_view *v, const vw_camera *cam, int width, int height);
+/* The unit direction of the eye ray through the centre of pixel (px, py), row 0 on top. */
+void rt_view_ray(const rt_view *v, int px, int py, double dir[3]);
+/* Screen position (pixel units, may be fractional or off-screen) of world point p;
+   returns 0 when p is not in front of the eye. */
+int rt_view_project(const rt_view *v, const double p[3], double *sx, double *sy);
+
+/* ---- the module ------------------------------------------------------------------------ */
+
+/* Fixed point of the pixel sums: a contribution c is added as llround(c * 2^32). */
+#define RT_FIX_ONE 4294967296.0
+
+/* Module counters, in this order. */
+enum {
+    RT_C_EYE = 0, RT_C_REFLECT, RT_C_REFRACT, RT_C_SHADOW, /* rays created, by kind */
+    RT_C_ENDED,                                            /* rays ended, any kind */
+    RT_C_PIXELS,                                           /* primary pixels of a cell */
+    RT_C_SEGMENTS,                                         /* cell visits of all rays */
+    RT_NCOUNTERS
+};
+
+typedef struct rt_light {
+    double pos[3], color[3];
+} rt_light;
+
+/* What every cell and the output handler of one process share (the module's user
+   pointer). Read-only while the world runs, except the output side (accum, done),
+   which only the output handler writes, one call at a time. */
+typedef struct rt_shared {
+    rt_view view;
+    rt_light *lights;
+    int nlights;
+    double background[3];
+    int max_depth;   /* an eye ray has depth 1; rays of depth max_depth spawn no others */
+    double eps;      /* minimum t of a secondary ray: avoids self-intersection */
+    double bpad;     /* objects' bounds are widened by this before placement */
+    void *device;    /* RTCDevice, one per process, shared by every cell */
+    /* Output process only: */
+    int64_t (*accum)[3];        /* width*height fixed-point sums */
+    atomic_llong pixels_done;   /* eye rays that have ended (progress) */
+    atomic_llong entries;       /* contributions received */
+    /* Every process: rays created so far, published by the cells in batches (for the
+       progress bar's rays/s; the exact counts are the module counters). */
+    atomic_llong rays;
+} rt_shared;
+
+extern const vw_module rt_module;
+
+/* ---- a whole render (what the command line and the tests drive) ------------------------- */
+
+typedef struct rt_params {
+    int width, height;   /* 0: the camera's resolution, else 512x512 */
+    int depth;           /* 0: 5 */
+    int dims[3];         /* grid layout; 0s mean 1 */
+    int workers;         /* per process; 0 = cores */
+    const vw_camera *camera; /* NULL: the scene's (or a default framing for OBJ) */
+    vw_config *config;   /* NULL: vw_config_init() defaults (incl. VW_STRESS) */
+} rt_params;
+
+typedef struct rt_job rt_job;
+
+/* Phases, each timed by the caller if it wishes: create (objects, decomposition, world,
+   objects added), commit (cells built), run (rays traced). err gets a message. */
+vw_status rt_job_create(const vw_scene *s, const rt_params *p, rt_job **out, char *err,
+                        size_t errlen);
+vw_status rt_job_commit(rt_job *j, char *err, size_t errlen);
+vw_status rt_job_run(rt_job *j, char *err, size_t errlen);
+void rt_job_free(rt_job *j);
+
+vw_world *rt_job_world(rt_job *j);
+const rt_shared *rt_job_shared(const rt_job *j);
+int rt_job_is_output(const rt_job *j);
+/* Pixels whose eye ray enters the world (progress denominator; output process). */
+int64_t rt_job_primary_pixels(const rt_job *j);
+/* Thread-safe progress: eye rays ended so far (output process), rays created so far
+   (this process). */
+void rt_job_progress(const rt_job *j, int64_t *pixels_done, int64_t *rays);
+/* After run, output process: the fixed-point sums (background of pixels that miss the
+   world included), width*height*3, row-major from the top row. */
+const int64_t *rt_job_sums(const rt_job *j);
+/* 8-bit RGB (clamp(sum / 2^32) * 255, rounded half up) and float RGB (sum / 2^32). */
+void rt_job_rgb8(const rt_job *j, uint8_t *out);
+void rt_job_rgbf(const rt_job *j, float *out);
+/* The overlay picture: the image with each cell's primary pixels tinted by the cell's
+   measured load (green = lightest, red = heaviest) and the cell walls drawn. */
+void rt_job_overlay(const rt_job *j, uint8_t *out);
+/* The "rays" and per-cell pixel members for the stats JSON (malloc'ed string). */
+char *rt_job_stats_json(const rt_job *j);
+
+/* The fixed-point -> 8-bit rule, shared with the tests. */
+static inline uint8_t rt_fix_to_u8(int64_t q)
+{
+    if (q <= 0) return 0;
+    if (q >= (int64_t)1 << 32) return 255;
+    return (uint8_t)((q * 255 + ((int64_t)1 << 31)) >> 32);
+}
+
+#endif

@@ -1,0 +1,33 @@
+# raytrace.cmake - tests of the distributed ray tracer (apps/raytrace) and the
+# Embree-raw benchmark helper. Images are compared bit for bit: DESIGN.md promises
+# identical images for every decomposition, worker count and engine.
+
+add_executable(vw_test_raytrace ${PROJECT_SOURCE_DIR}/tests/raytrace/rt_test.c)
+target_link_libraries(vw_test_raytrace PRIVATE vwalls_apps)
+
+set(VW_RT_MIXED ${PROJECT_SOURCE_DIR}/tests/raytrace/mixed.nff)
+
+add_test(NAME raytrace_cone COMMAND vw_test_raytrace cone)
+add_test(NAME raytrace_analytic COMMAND vw_test_raytrace analytic)
+# Layouts 1, 2, 2x4, 2x2x2, 4x4x4 x workers 1, 2, 4 against 1 cell on 1 worker; also
+# checks that every ray created is ended and that every layout creates the same rays.
+add_test(NAME raytrace_identical_balls COMMAND vw_test_raytrace identical gen:balls:2 96x96)
+add_test(NAME raytrace_identical_mixed COMMAND vw_test_raytrace identical ${VW_RT_MIXED} 96x96)
+# The same under the stress switch (random delays and reordering of deliveries).
+add_test(NAME raytrace_stress_balls COMMAND vw_test_raytrace identical gen:balls:2 64x64)
+add_test(NAME raytrace_stress_mixed COMMAND vw_test_raytrace identical ${VW_RT_MIXED} 64x64)
+set_tests_properties(raytrace_stress_balls PROPERTIES ENVIRONMENT "VW_STRESS=7")
+set_tests_properties(raytrace_stress_mixed PROPERTIES ENVIRONMENT "VW_STRESS=1994;VW_STRESS_SPLIT=1")
+
+# The command line: PNG files byte-identical across layouts and workers, the stats JSON,
+# exit status 2 and no output file for a bad scene.
+add_test(NAME raytrace_cli
+  COMMAND ${CMAKE_COMMAND} -DVWALLS=$<TARGET_FILE:vwalls_tool> -DSCENE=${VW_RT_MIXED}
+          -DWORK=${CMAKE_CURRENT_BINARY_DIR}/raytrace_cli
+          -P ${PROJECT_SOURCE_DIR}/tests/raytrace/cli.cmake)
+
+# bench/raytrace.sh: Embree's raw ray-casting rate for the same rays (the kernel limit).
+if(EXISTS ${PROJECT_SOURCE_DIR}/bench/embree_raw.c)
+  add_executable(vw_bench_embree_raw ${PROJECT_SOURCE_DIR}/bench/embree_raw.c)
+  target_link_libraries(vw_bench_embree_raw PRIVATE vwalls_apps)
+endif()

@@ -1,0 +1,63 @@
+# cli.cmake - runs `vwalls render` on one scene with several layouts and worker counts
+# and compares the PNG files byte for byte; checks the stats JSON and that a bad scene
+# gives exit status 2, the parser's file:line message and no output file.
+# Variables: VWALLS (the binary), SCENE, WORK (a scratch directory).
+file(REMOVE_RECURSE ${WORK})
+file(MAKE_DIRECTORY ${WORK})
+
+function(render out cells workers)
+  execute_process(COMMAND ${VWALLS} render ${SCENE} -o ${out} --size 80x60 --cells ${cells}
+                          --workers ${workers} --quiet ${ARGN}
+                  RESULT_VARIABLE rc ERROR_VARIABLE err)
+  if(NOT rc EQUAL 0)
+    message(FATAL_ERROR "render --cells ${cells} --workers ${workers}: exit ${rc}: ${err}")
+  endif()
+endfunction()
+
+render(${WORK}/ref.png 1 1 --stats ${WORK}/ref.json --overlay ${WORK}/ref_overlay.png)
+foreach(case "2;2" "2x4;1" "2x2x2;2" "4x4x4;4" "3x1x2;3")
+  list(GET case 0 cells)
+  list(GET case 1 workers)
+  render(${WORK}/img_${cells}_${workers}.png ${cells} ${workers})
+  execute_process(COMMAND ${CMAKE_COMMAND} -E compare_files ${WORK}/ref.png
+                          ${WORK}/img_${cells}_${workers}.png RESULT_VARIABLE same)
+  if(NOT same EQUAL 0)
+    message(FATAL_ERROR "--cells ${cells} --workers ${workers}: PNG differs from 1 cell, 1 worker")
+  endif()
+endforeach()
+
+# PFM output and the stats JSON.
+render(${WORK}/img.pfm 2x2x2 2 --stats ${WORK}/s.json --overlay ${WORK}/overlay.png)
+foreach(f img.pfm s.json overlay.png ref_overlay.png)
+  if(NOT EXISTS ${WORK}/${f})
+    message(FATAL_ERROR "${f} was not written")
+  endif()
+endforeach()
+file(READ ${WORK}/s.json json)
+foreach(key "\"rays\"" "\"eye\": " "\"shadow\"" "\"cells\"" "\"pixels\"" "\"compute\"")
+  string(FIND "${json}" "${key}" at)
+  if(at LESS 0)
+    message(FATAL_ERROR "stats JSON lacks ${key}")
+  endif()
+endforeach()
+
+# Bad input: exit 2, file:line on stderr, no output file.
+file(WRITE ${WORK}/bad.nff "v\nfrom 0 0 5\nat 0 0 0\nup 0 1 0\nangle 30\nhither 1\nresolution 8 8\ns 0 0 zero 1\n")
+execute_process(COMMAND ${VWALLS} render ${WORK}/bad.nff -o ${WORK}/bad.png --quiet
+                RESULT_VARIABLE rc ERROR_VARIABLE err)
+if(NOT rc EQUAL 2)
+  message(FATAL_ERROR "bad scene: exit ${rc}, expected 2 (${err})")
+endif()
+if(NOT err MATCHES "bad.nff:[0-9]+:")
+  message(FATAL_ERROR "bad scene: no file:line message: ${err}")
+endif()
+if(EXISTS ${WORK}/bad.png)
+  message(FATAL_ERROR "bad scene: an output file was left behind")
+endif()
+# Bad usage.
+execute_process(COMMAND ${VWALLS} render ${SCENE} -o ${WORK}/x.jpg RESULT_VARIABLE rc
+                OUTPUT_QUIET ERROR_QUIET)
+if(NOT rc EQUAL 2)
+  message(FATAL_ERROR "-o x.jpg: exit ${rc}, expected 2")
+endif()
+message(STATUS "raytrace_cli: all images identical")

@@ -1,0 +1,315 @@
+/* rt_test.c - tests of the distributed ray tracer, one executable, one test per
+ * subcommand (registered in tests/raytrace.cmake):
+ *   identical SCENE WxH   the same fixed-point sums for every layout and worker count,
+ *                         and every ray created is ended (SCENE: a file or gen:NAME:SIZE)
+ *   analytic              one diffuse sphere and one light against the formula, 1/255
+ *   cone                  the cone/cylinder intersection against sampled points
+ *   write SCENE WxH LAYOUT WORKERS OUT.png   (a helper for looking at pictures)
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "raytrace/geometry.h"
+#include "raytrace/raytrace.h"
+#include "vwalls/gen.h"
+#include "vwalls/image.h"
+
+static int failures;
+
+#define CHECK(cond, ...)                                                        \
+    do {                                                                        \
+        if (!(cond)) {                                                          \
+            fprintf(stderr, "%s:%d: check failed: %s: ", __FILE__, __LINE__, #cond); \
+            fprintf(stderr, __VA_ARGS__);                                       \
+            fputc('\n', stderr);                                                \
+            failures++;                                                         \
+        }                                                                       \
+    } while (0)
+
+static vw_scene *load(const char *spec)
+{
+    char err[512];
+    vw_scene *s = NULL;
+    if (!strncmp(spec, "gen:", 4)) {
+        char name[64];
+        int size = 0;
+        const char *colon = strchr(spec + 4, ':');
+        size_t n = colon ? (size_t)(colon - spec - 4) : strlen(spec + 4);
+        if (n >= sizeof name) n = sizeof name - 1;
+        memcpy(name, spec + 4, n);
+        name[n] = 0;
+        if (colon) size = atoi(colon + 1);
+        vw_gen_params p;
+        vw_gen_params_init(&p);
+        p.size = size;
+        if (vw_gen(name, &p, &s, err, sizeof err) != VW_OK) {
+            fprintf(stderr, "gen %s: %s\n", spec, err);
+            exit(1);
+        }
+    } else if (vw_scene_read_file(spec, &s, err, sizeof err) != VW_OK) {
+        fprintf(stderr, "%s\n", err);
+        exit(1);
+    }
+    return s;
+}
+
+/* Renders; returns the malloc'ed fixed-point sums (w*h*3) and the ray counters. */
+static int64_t *render(const vw_scene *s, int w, int h, const int dims[3], int workers,
+                       int64_t counters[RT_NCOUNTERS], rt_job **keep)
+{
+    rt_params p;
+    memset(&p, 0, sizeof p);
+    p.width = w;
+    p.height = h;
+    memcpy(p.dims, dims, sizeof p.dims);
+    p.workers = workers;
+    char err[512];
+    rt_job *j;
+    if (rt_job_create(s, &p, &j, err, sizeof err) != VW_OK || rt_job_commit(j, err, sizeof err) ||
+        rt_job_run(j, err, sizeof err)) {
+        fprintf(stderr, "render failed: %s\n", err);
+        exit(1);
+    }
+    size_t n = (size_t)w * h * 3;
+    int64_t *sums = malloc(n * sizeof *sums);
+    memcpy(sums, rt_job_sums(j), n * sizeof *sums);
+    for (int k = 0; k < RT_NCOUNTERS; k++) counters[k] = vw_world_counter(rt_job_world(j), k);
+    if (keep)
+        *keep = j;
+    else
+        rt_job_free(j);
+    return sums;
+}
+
+static int test_identical(const char *spec, const char *size)
+{
+    int w = 96, h = 96;
+    if (size && sscanf(size, "%dx%d", &w, &h) != 2) return 2;
+    vw_scene *s = load(spec);
+    static const int layouts[][3] = {{1, 1, 1}, {2, 1, 1}, {2, 4, 1}, {2, 2, 2}, {4, 4, 4}};
+    static const int workers[] = {1, 2, 4};
+    int64_t c0[RT_NCOUNTERS];
+    int64_t *ref = render(s, w, h, layouts[0], 1, c0, NULL);
+    size_t n = (size_t)w * h * 3;
+    int64_t rays = c0[RT_C_EYE] + c0[RT_C_REFLECT] + c0[RT_C_REFRACT] + c0[RT_C_SHADOW];
+    printf("%s %dx%d: eye %lld reflect %lld refract %lld shadow %lld\n", spec, w, h,
+           (long long)c0[RT_C_EYE], (long long)c0[RT_C_REFLECT], (long long)c0[RT_C_REFRACT],
+           (long long)c0[RT_C_SHADOW]);
+    CHECK(rays == c0[RT_C_ENDED], "created %lld, ended %lld", (long long)rays,
+          (long long)c0[RT_C_ENDED]);
+    CHECK(c0[RT_C_EYE] == c0[RT_C_PIXELS], "eye %lld, pixels %lld", (long long)c0[RT_C_EYE],
+          (long long)c0[RT_C_PIXELS]);
+    CHECK(c0[RT_C_EYE] > 0, "no eye rays");
+    for (size_t li = 0; li < sizeof layouts / sizeof layouts[0]; li++)
+        for (size_t wi = 0; wi < sizeof workers / sizeof workers[0]; wi++) {
+            if (li == 0 && wi == 0) continue;
+            int64_t c[RT_NCOUNTERS];
+            int64_t *img = render(s, w, h, layouts[li], workers[wi], c, NULL);
+            size_t diff = 0, first = n;
+            for (size_t i = 0; i < n; i++)
+                if (img[i] != ref[i]) {
+                    if (!diff) first = i;
+                    diff++;
+                }
+            CHECK(diff == 0, "layout %dx%dx%d workers %d: %zu sums differ (first: pixel %zu)",
+                  layouts[li][0], layouts[li][1], layouts[li][2], workers[wi], diff, first / 3);
+            int64_t r = c[RT_C_EYE] + c[RT_C_REFLECT] + c[RT_C_REFRACT] + c[RT_C_SHADOW];
+            CHECK(r == c[RT_C_ENDED], "layout %dx%dx%d workers %d: created %lld, ended %lld",
+                  layouts[li][0], layouts[li][1], layouts[li][2], workers[wi], (long long)r,
+                  (long long)c[RT_C_ENDED]);
+            /* The same rays, whatever the walls. */
+            for (int k = RT_C_EYE; k <= RT_C_PIXELS; k++)
+                CHECK(c[k] == c0[k], "layout %dx%dx%d workers %d: counter %d is %lld, not %lld",
+                      layouts[li][0], layouts[li][1], layouts[li][2], workers[wi], k,
+                      (long long)c[k], (long long)c0[k]);
+            free(img);
+        }
+    free(ref);
+    vw_scene_free(s);
+    return failures ? 1 : 0;
+}
+
+/* One diffuse sphere lit by one light, no specular, no ambient: every pixel is either
+   the background or Kd * colour * max(0, N.L) * light, by the formula alone. */
+static int test_analytic(void)
+{
+    static const char nff[] =
+        "v\nfrom 0.3 0.2 5\nat 0 0 0\nup 0 1 0\nangle 30\nhither 1\nresolution 64 48\n"
+        "b 0.1 0.2 0.3\n"
+        "l 3 4 5\n"
+        "f 1 0.5 0.25 0.8 0 0 0 1\n"
+        "s 0 0 0 1\n";
+    char err[256];
+    vw_scene *s;
+    if (vw_scene_read_nff("analytic.nff", nff, sizeof nff - 1, &s, err, sizeof err) != VW_OK) {
+        fprintf(stderr, "%s\n", err);
+        return 1;
+    }
+    int W = 64, H = 48;
+    int dims[3] = {2, 2, 1};
+    int64_t c[RT_NCOUNTERS];
+    int64_t *sums = render(s, W, H, dims, 2, c, NULL);
+    const double eye[3] = {0.3, 0.2, 5}, L[3] = {3, 4, 5}, col[3] = {0.8, 0.4, 0.2},
+                 bg[3] = {0.1, 0.2, 0.3};
+    /* The camera frame, written out independently of view.c. */
+    double f[3] = {-0.3, -0.2, -5}, lf = sqrt(0.09 + 0.04 + 25);
+    for (int a = 0; a < 3; a++) f[a] /= lf;
+    double r[3] = {f[1] * 0 - f[2] * 1, f[2] * 0 - f[0] * 0, f[0] * 1 - f[1] * 0};
+    double lr = sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2]);
+    for (int a = 0; a < 3; a++) r[a] /= lr;
+    double u[3] = {r[1] * f[2] - r[2] * f[1], r[2] * f[0] - r[0] * f[2], r[0] * f[1] - r[1] * f[0]};
+    double th = tan(15.0 * 3.14159265358979323846 / 180.0), aspect = (double)W / H;
+    int checked = 0, worst = 0;
+    for (int y = 0; y < H; y++)
+        for (int x = 0; x < W; x++) {
+            double sx = ((x + 0.5) / W * 2 - 1) * th * aspect, sy = (1 - (y + 0.5) / H * 2) * th;
+            double d[3], ld = 0;
+            for (int a = 0; a < 3; a++) {
+                d[a] = f[a] + sx * r[a] + sy * u[a];
+                ld += d[a] * d[a];
+            }
+            ld = sqrt(ld);
+            for (int a = 0; a < 3; a++) d[a] /= ld;
+            /* |e + t d| = 1 */
+            double b = eye[0] * d[0] + eye[1] * d[1] + eye[2] * d[2];
+            double cc = eye[0] * eye[0] + eye[1] * eye[1] + eye[2] * eye[2] - 1;
+            double disc = b * b - cc;
+            if (fabs(disc) < 1e-3) continue; /* grazing: float hit tests may go either way */
+            double expect[3];
+            if (disc < 0) {
+                memcpy(expect, bg, sizeof expect);
+            } else {
+                double t = -b - sqrt(disc), p[3], l[3], ll = 0;
+                for (int a = 0; a < 3; a++) {
+                    p[a] = eye[a] + t * d[a];
+                    l[a] = L[a] - p[a];
+                    ll += l[a] * l[a];
+                }
+                ll = sqrt(ll);
+                double ndl = (p[0] * l[0] + p[1] * l[1] + p[2] * l[2]) / ll;
+                for (int a = 0; a < 3; a++) expect[a] = ndl > 0 ? col[a] * ndl : 0;
+            }
+            for (int a = 0; a < 3; a++) {
+                int got = rt_fix_to_u8(sums[((size_t)y * W + x) * 3 + a]);
+                int want = (int)lround(fmin(1, fmax(0, expect[a])) * 255);
+                int e = abs(got - want);
+                if (e > worst) worst = e;
+                CHECK(e <= 1, "pixel (%d,%d) channel %d: got %d, expected %d", x, y, a, got, want);
+            }
+            checked++;
+        }
+    printf("analytic: %d pixels checked, worst difference %d/255\n", checked, worst);
+    CHECK(checked > W * H / 2, "only %d pixels checked", checked);
+    int64_t rays = c[RT_C_EYE] + c[RT_C_REFLECT] + c[RT_C_REFRACT] + c[RT_C_SHADOW];
+    CHECK(rays == c[RT_C_ENDED], "created %lld, ended %lld", (long long)rays, (long long)c[RT_C_ENDED]);
+    free(sums);
+    vw_scene_free(s);
+    return failures ? 1 : 0;
+}
+
+/* Rays aimed at points sampled on a cone's side must hit it there, from outside. */
+static int test_cone(void)
+{
+    rt_object o;
+    memset(&o, 0, sizeof o);
+    o.kind = RT_CONE;
+    double base[3] = {0.2, -1, 0.1}, apex[3] = {-0.1, 1.5, 0.3};
+    memcpy(o.g.cone.base, base, sizeof base);
+    memcpy(o.g.cone.apex, apex, sizeof apex);
+    o.g.cone.r0 = 0.8;
+    o.g.cone.r1 = 0.3;
+    void *dev = rt_device_new();
+    rt_cell_geo g;
+    CHECK(rt_cell_geo_build(dev, &o, 1, &g) == VW_OK, "build");
+    int hits = 0, n = 0;
+    for (int i = 0; i < 200; i++) {
+        double s = (i % 20 + 0.5) / 20.0, phi = (i / 20) * 0.6283 + 0.1;
+        double w[3], hgt = 0;
+        for (int a = 0; a < 3; a++) {
+            w[a] = apex[a] - base[a];
+            hgt += w[a] * w[a];
+        }
+        hgt = sqrt(hgt);
+        for (int a = 0; a < 3; a++) w[a] /= hgt;
+        double e1[3] = {w[1], -w[0], 0}, l1 = sqrt(w[0] * w[0] + w[1] * w[1]);
+        for (int a = 0; a < 3; a++) e1[a] /= l1;
+        double e2[3] = {w[1] * e1[2] - w[2] * e1[1], w[2] * e1[0] - w[0] * e1[2],
+                        w[0] * e1[1] - w[1] * e1[0]};
+        double rad = 0.8 + (0.3 - 0.8) * s, p[3], radial[3];
+        for (int a = 0; a < 3; a++) {
+            radial[a] = cos(phi) * e1[a] + sin(phi) * e2[a];
+            p[a] = base[a] + s * hgt * w[a] + rad * radial[a];
+        }
+        double org[3], dir[3];
+        for (int a = 0; a < 3; a++) {
+            org[a] = p[a] + 3 * radial[a];
+            dir[a] = -radial[a];
+        }
+        rt_hit h;
+        n++;
+        if (rt_cell_geo_intersect(&g, org, dir, 0, 100, &h)) {
+            double q[3], err = 0;
+            for (int a = 0; a < 3; a++) {
+                q[a] = org[a] + h.t * dir[a];
+                err += (q[a] - p[a]) * (q[a] - p[a]);
+            }
+            /* A ray along the outward radial of a cone whose sides slope: it meets the side
+               at p, exactly (float t). */
+            CHECK(sqrt(err) < 1e-5, "ray %d: hit %g away from the sampled point", i, sqrt(err));
+            double nn[3];
+            rt_cone_normal(&o, q, nn);
+            CHECK(nn[0] * radial[0] + nn[1] * radial[1] + nn[2] * radial[2] > 0.8,
+                  "ray %d: normal does not point outward", i);
+            hits++;
+        }
+        /* Shadow query agrees. */
+        CHECK(rt_cell_geo_occluded(&g, org, dir, 0, 100) == 1, "ray %d: not occluded", i);
+        CHECK(rt_cell_geo_occluded(&g, org, dir, 0, 2.9) == 0, "ray %d: occluded too early", i);
+    }
+    CHECK(hits == n, "%d of %d rays hit", hits, n);
+    rt_cell_geo_free(&g);
+    rt_device_free(dev);
+    printf("cone: %d of %d sampled points hit\n", hits, n);
+    return failures ? 1 : 0;
+}
+
+static int write_png(int argc, char **argv)
+{
+    if (argc < 7) return 2;
+    vw_scene *s = load(argv[2]);
+    int w, h, dims[3];
+    char err[256];
+    if (sscanf(argv[3], "%dx%d", &w, &h) != 2 || vw_layout_parse(argv[4], dims, err, sizeof err))
+        return 2;
+    rt_params p;
+    memset(&p, 0, sizeof p);
+    p.width = w;
+    p.height = h;
+    memcpy(p.dims, dims, sizeof dims);
+    p.workers = atoi(argv[5]);
+    rt_job *j;
+    if (rt_job_create(s, &p, &j, err, sizeof err) || rt_job_commit(j, err, sizeof err) ||
+        rt_job_run(j, err, sizeof err)) {
+        fprintf(stderr, "%s\n", err);
+        return 1;
+    }
+    uint8_t *img = malloc((size_t)w * h * 3);
+    rt_job_rgb8(j, img);
+    vw_status st = vw_image_write_png(argv[6], w, h, img, err, sizeof err);
+    free(img);
+    rt_job_free(j);
+    vw_scene_free(s);
+    return st == VW_OK ? 0 : 1;
+}
+
+int main(int argc, char **argv)
+{
+    if (argc >= 3 && !strcmp(argv[1], "identical")) return test_identical(argv[2], argc > 3 ? argv[3] : NULL);
+    if (argc >= 2 && !strcmp(argv[1], "analytic")) return test_analytic();
+    if (argc >= 2 && !strcmp(argv[1], "cone")) return test_cone();
+    if (argc >= 2 && !strcmp(argv[1], "write")) return write_png(argc, argv);
+    fprintf(stderr, "usage: rt_test identical SCENE [WxH] | analytic | cone | write ...\n");
+    return 2;
+}

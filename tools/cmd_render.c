@@ -1,0 +1,296 @@
+/* cmd_render.c - vwalls render: the distributed ray tracer on an NFF or OBJ scene,
+ * writing a PNG or PFM (atomically, by the output process only), and optionally the
+ * stats JSON and a picture of the walls tinted by each cell's measured load.
+ */
+#define _POSIX_C_SOURCE 200809L
+#include <pthread.h>
+#include <stdatomic.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+#include <time.h>
+
+#include "cli.h"
+#include "commands.h"
+#include "raytrace/raytrace.h"
+#include "vwalls/image.h"
+
+static const char *const CMD = "render";
+
+static void help(void)
+{
+    printf("usage: vwalls render SCENE.(nff|obj) -o OUT.(png|pfm) [options]\n"
+           "\n"
+           "Ray traces the scene (Whitted: Phong lights with shadow rays, mirror reflection,\n"
+           "refraction) with rays travelling as messages between the cells of a grid of\n"
+           "virtual walls. The image is bit-identical for every layout and worker count.\n"
+           "  -o FILE          output image, .png (8-bit) or .pfm (float, unclamped)\n"
+           "  --cells L        layout of cells, like 4, 2x4, 2x2x2 (default 1)\n"
+           "  --workers W      worker threads per process (default: number of cores)\n"
+           "  --size WxH       image size (default: the scene's, else 512x512)\n"
+           "  --depth D        maximum ray depth, eye rays being depth 1 (default 5)\n"
+           "  --from X,Y,Z --at X,Y,Z --up X,Y,Z --angle DEG\n"
+           "                   override the camera (angle: full vertical field of view)\n"
+           "  --stats FILE     write the stats JSON\n"
+           "  --overlay FILE   write a PNG of the image with the walls drawn and each cell's\n"
+           "                   pixels tinted by its measured load (green light .. red heavy)\n"
+           "  --quiet          no progress bar and no summary\n"
+           "Runs under mpirun too; only the first process writes files.\n");
+}
+
+static int ends_with(const char *s, const char *suf)
+{
+    size_t n = strlen(s), m = strlen(suf);
+    return n >= m && !strcasecmp(s + n - m, suf);
+}
+
+static int parse_vec(const char *opt, const char *s, double v[3])
+{
+    char tail;
+    if (!s || sscanf(s, "%lf,%lf,%lf%c", &v[0], &v[1], &v[2], &tail) != 3) {
+        vw_cli_error(CMD, "%s: bad value '%s' (expected X,Y,Z)", opt, s ? s : "");
+        return -1;
+    }
+    return 0;
+}
+
+/* The progress bar: a small thread polls the output handler's atomic counter, so the
+   workers never wait for the terminal. */
+typedef struct progress_ctx {
+    rt_job *job;
+    vw_progress bar;
+    atomic_int stop;
+    double t0;
+} progress_ctx;
+
+static void *progress_main(void *arg)
+{
+    progress_ctx *p = arg;
+    int64_t total = rt_job_primary_pixels(p->job);
+    while (!atomic_load(&p->stop)) {
+        struct timespec ts = {0, 100 * 1000 * 1000};
+        nanosleep(&ts, NULL);
+        int64_t done, rays;
+        rt_job_progress(p->job, &done, &rays);
+        double el = vw_cli_now() - p->t0;
+        char note[64];
+        snprintf(note, sizeof note, "%.2f Mrays/s", el > 0 ? rays / el * 1e-6 : 0.0);
+        vw_progress_update(&p->bar, total > 0 ? (double)done / (double)total : 1.0, note);
+    }
+    return NULL;
+}
+
+int vw_cmd_render(int argc, char **argv)
+{
+    const char *scene_path = NULL, *out = NULL, *stats = NULL, *overlay = NULL;
+    int dims[3] = {1, 1, 1}, width = 0, height = 0, quiet = 0;
+    long workers = 0, depth = 5;
+    double from[3], at[3], up[3], angle = 0;
+    int has_from = 0, has_at = 0, has_up = 0, has_angle = 0;
+    for (int i = 1; i < argc; i++) {
+        const char *a = argv[i], *v;
+        if (!strcmp(a, "--help") || !strcmp(a, "-h")) {
+            help();
+            return VW_EXIT_OK;
+        } else if (!strcmp(a, "--quiet") || !strcmp(a, "-q")) {
+            quiet = 1;
+        } else if (!strcmp(a, "-o") || !strcmp(a, "--output")) {
+            if (!(out = vw_cli_value(CMD, argc, argv, &i))) return VW_EXIT_USAGE;
+        } else if (!strcmp(a, "--cells")) {
+            if (!(v = vw_cli_value(CMD, argc, argv, &i)) || vw_cli_layout(CMD, a, v, dims))
+                return VW_EXIT_USAGE;
+        } else if (!strcmp(a, "--workers")) {
+            if (!(v = vw_cli_value(CMD, argc, argv, &i)) || vw_cli_int(CMD, a, v, 1, 1024, &workers))
+                return VW_EXIT_USAGE;
+        } else if (!strcmp(a, "--size")) {
+            if (!(v = vw_cli_value(CMD, argc, argv, &i)) || vw_cli_size(CMD, a, v, &width, &height))
+                return VW_EXIT_USAGE;
+        } else if (!strcmp(a, "--depth")) {
+            if (!(v = vw_cli_value(CMD, argc, argv, &i)) || vw_cli_int(CMD, a, v, 1, 64, &depth))
+                return VW_EXIT_USAGE;
+        } else if (!strcmp(a, "--stats")) {
+            if (!(stats = vw_cli_value(CMD, argc, argv, &i))) return VW_EXIT_USAGE;
+        } else if (!strcmp(a, "--overlay")) {
+            if (!(overlay = vw_cli_value(CMD, argc, argv, &i))) return VW_EXIT_USAGE;
+        } else if (!strcmp(a, "--from")) {
+            if (parse_vec(a, vw_cli_value(CMD, argc, argv, &i), from)) return VW_EXIT_USAGE;
+            has_from = 1;
+        } else if (!strcmp(a, "--at")) {
+            if (parse_vec(a, vw_cli_value(CMD, argc, argv, &i), at)) return VW_EXIT_USAGE;
+            has_at = 1;
+        } else if (!strcmp(a, "--up")) {
+            if (parse_vec(a, vw_cli_value(CMD, argc, argv, &i), up)) return VW_EXIT_USAGE;
+            has_up = 1;
+        } else if (!strcmp(a, "--angle")) {
+            if (!(v = vw_cli_value(CMD, argc, argv, &i)) ||
+                vw_cli_double(CMD, a, v, 1e-3, 179, &angle))
+                return VW_EXIT_USAGE;
+            has_angle = 1;
+        } else if (a[0] == '-' && a[1]) {
+            vw_cli_error(CMD, "unknown option '%s' (try --help)", a);
+            return VW_EXIT_USAGE;
+        } else if (!scene_path) {
+            scene_path = a;
+        } else {
+            vw_cli_error(CMD, "more than one scene: '%s' and '%s'", scene_path, a);
+            return VW_EXIT_USAGE;
+        }
+    }
+    if (!scene_path || !out) {
+        vw_cli_error(CMD, "need a scene and -o OUT.png (try --help)");
+        return VW_EXIT_USAGE;
+    }
+    int pfm = ends_with(out, ".pfm");
+    if (!pfm && !ends_with(out, ".png")) {
+        vw_cli_error(CMD, "-o %s: the output must end in .png or .pfm", out);
+        return VW_EXIT_USAGE;
+    }
+    if (overlay && !ends_with(overlay, ".png")) {
+        vw_cli_error(CMD, "--overlay %s: the overlay must end in .png", overlay);
+        return VW_EXIT_USAGE;
+    }
+
+    double t_load0 = vw_cli_now();
+    char err[1024];
+    vw_scene *scene = NULL;
+    if (vw_scene_read_file(scene_path, &scene, err, sizeof err) != VW_OK) {
+        /* The parser's "file:line: message", as it is. */
+        if (vw_cli_is_output()) fprintf(stderr, "%s\n", err);
+        return VW_EXIT_USAGE;
+    }
+    vw_camera cam = scene->camera;
+    if (!cam.valid) {
+        cam.width = cam.height = 0;
+        vw_scene_default_camera(scene, &cam);
+    }
+    if (has_from) memcpy(cam.from, from, sizeof from);
+    if (has_at) memcpy(cam.at, at, sizeof at);
+    if (has_up) memcpy(cam.up, up, sizeof up);
+    if (has_angle) cam.angle = angle;
+
+    rt_params p;
+    memset(&p, 0, sizeof p);
+    p.width = width;
+    p.height = height;
+    p.depth = (int)depth;
+    memcpy(p.dims, dims, sizeof dims);
+    p.workers = (int)workers;
+    p.camera = &cam;
+    rt_job *job = NULL;
+    vw_status st = rt_job_create(scene, &p, &job, err, sizeof err);
+    size_t nobjects = vw_scene_count_objects(scene);
+    vw_scene_free(scene);
+    if (st != VW_OK) {
+        vw_cli_error(CMD, "%s", err);
+        return st == VW_E_INVAL ? VW_EXIT_USAGE : VW_EXIT_FAIL;
+    }
+    vw_world *w = rt_job_world(job);
+    double t_build0 = vw_cli_now();
+    int rc = VW_EXIT_OK;
+    if (rt_job_commit(job, err, sizeof err) != VW_OK) {
+        vw_cli_error(CMD, "%s", err);
+        rt_job_free(job);
+        return VW_EXIT_FAIL;
+    }
+    double t_run0 = vw_cli_now();
+
+    progress_ctx pc;
+    memset(&pc, 0, sizeof pc);
+    pc.job = job;
+    pc.t0 = t_run0;
+    atomic_init(&pc.stop, 0);
+    vw_progress_begin(&pc.bar, "render", quiet || !rt_job_is_output(job));
+    pthread_t th;
+    int have_thread = pc.bar.enabled && pthread_create(&th, NULL, progress_main, &pc) == 0;
+    st = rt_job_run(job, err, sizeof err);
+    if (have_thread) {
+        atomic_store(&pc.stop, 1);
+        pthread_join(th, NULL);
+    }
+    vw_progress_end(&pc.bar);
+    double t_run1 = vw_cli_now();
+    if (st != VW_OK) {
+        vw_cli_error(CMD, "%s", err);
+        rt_job_free(job);
+        return VW_EXIT_FAIL;
+    }
+    vw_world_add_time(w, "load", t_build0 - t_load0);
+    vw_world_add_time(w, "build", t_run0 - t_build0);
+    vw_world_add_time(w, "compute", t_run1 - t_run0);
+
+    if (rt_job_is_output(job)) {
+        const rt_shared *sh = rt_job_shared(job);
+        int W = sh->view.width, H = sh->view.height;
+        size_t n = (size_t)W * H * 3;
+        if (pfm) {
+            float *img = malloc(n * sizeof *img);
+            if (!img) {
+                vw_cli_error(CMD, "out of memory for a %dx%d image", W, H);
+                rc = VW_EXIT_FAIL;
+            } else {
+                rt_job_rgbf(job, img);
+                if (vw_image_write_pfm(out, W, H, img, err, sizeof err) != VW_OK) {
+                    vw_cli_error(CMD, "%s", err);
+                    rc = VW_EXIT_FAIL;
+                }
+                free(img);
+            }
+        } else {
+            uint8_t *img = malloc(n);
+            if (!img) {
+                vw_cli_error(CMD, "out of memory for a %dx%d image", W, H);
+                rc = VW_EXIT_FAIL;
+            } else {
+                rt_job_rgb8(job, img);
+                if (vw_image_write_png(out, W, H, img, err, sizeof err) != VW_OK) {
+                    vw_cli_error(CMD, "%s", err);
+                    rc = VW_EXIT_FAIL;
+                }
+                free(img);
+            }
+        }
+        if (overlay && rc == VW_EXIT_OK) {
+            uint8_t *img = malloc(n);
+            if (img) {
+                rt_job_overlay(job, img);
+                if (vw_image_write_png(overlay, W, H, img, err, sizeof err) != VW_OK) {
+                    vw_cli_error(CMD, "%s", err);
+                    rc = VW_EXIT_FAIL;
+                }
+                free(img);
+            }
+        }
+        double t_end = vw_cli_now();
+        vw_world_add_time(w, "write", t_end - t_run1);
+        if (stats && rc == VW_EXIT_OK) {
+            char *extra = rt_job_stats_json(job);
+            if (vw_world_write_stats(w, stats, CMD, extra) != VW_OK) {
+                vw_cli_error(CMD, "%s", vw_world_errmsg(w));
+                rc = VW_EXIT_FAIL;
+            }
+            free(extra);
+        }
+        if (!quiet && rc == VW_EXIT_OK) {
+            long long eye = vw_world_counter(w, RT_C_EYE), refl = vw_world_counter(w, RT_C_REFLECT);
+            long long refr = vw_world_counter(w, RT_C_REFRACT), shad = vw_world_counter(w, RT_C_SHADOW);
+            long long total = eye + refl + refr + shad;
+            double comp = t_run1 - t_run0;
+            char layout[64];
+            vw_decomp_layout_string(vw_world_decomp(w), layout, sizeof layout);
+            printf("render %s -> %s: %dx%d, depth %d, %zu objects\n", scene_path, out, W, H,
+                   sh->max_depth, nobjects);
+            printf("cells %s (%d), workers %d x %d process%s, imbalance lambda %.3f\n", layout,
+                   vw_decomp_cell_count(vw_world_decomp(w)), vw_world_workers(w),
+                   vw_world_processes(w), vw_world_processes(w) == 1 ? "" : "es",
+                   vw_world_imbalance(w));
+            printf("time: load %.3f s, build %.3f s, compute %.3f s, write %.3f s, total %.3f s\n",
+                   t_build0 - t_load0, t_run0 - t_build0, comp, t_end - t_run1, t_end - t_load0);
+            printf("rays: eye %lld, reflect %lld, refract %lld, shadow %lld; %lld in all, "
+                   "%.3f Mrays/s\n",
+                   eye, refl, refr, shad, total, comp > 0 ? total / comp * 1e-6 : 0.0);
+        }
+    }
+    rt_job_free(job);
+    return rc;
+}

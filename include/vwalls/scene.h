@@ -88,13 +88,36 @@ VW_API vw_status vw_scene_read_obj(const char *name, const char *text, size_t le
                                    const char *dir, vw_scene **out, char *err, size_t errlen);
 VW_API void vw_scene_free(vw_scene *s);
 
-/* Writers */
+/* Writers. The NFF written reads back to the same scene, bit for bit (numbers are
+   printed with 17 significant digits). Two things NFF cannot say are handled so:
+   a scene without a camera (OBJ) gets the vw_scene_default_camera() view, and
+   per-channel specular colours and emission are written as extension comments,
+       #vw Ks r g b        #vw Ke r g b
+   right after the 'f' they belong to. Other NFF readers skip them as comments;
+   ours applies them to the current material. Returns VW_E_IO if writing fails. */
 VW_API vw_status vw_scene_write_nff(const vw_scene *s, FILE *f);
+/* The same into a file, atomically: a failure leaves no file (nor a partial one). */
+VW_API vw_status vw_scene_write_nff_file(const vw_scene *s, const char *path,
+                                         char *err, size_t errlen);
 
 /* Queries */
 VW_API size_t vw_scene_count_objects(const vw_scene *s);
-/* Axis-aligned bounds of every primitive together (lights excluded). */
+/* Axis-aligned bounds of every primitive together (lights excluded). Spheres count
+   as center +- r, cones as both end discs enclosed in boxes of half-size |r|, polygons
+   by their vertices. An empty scene gives lo = hi = (0,0,0). */
 VW_API void vw_scene_bounds(const vw_scene *s, double lo[3], double hi[3]);
+/* Finds the primitive with global id `id`: its kind and its index in the array of
+   that kind. VW_E_INVAL when there is no such id. O(log n). */
+VW_API vw_status vw_scene_find_object(const vw_scene *s, int id, vw_prim_kind *kind,
+                                      size_t *index);
+/* Bounds of one primitive (same rules as vw_scene_bounds). */
+VW_API void vw_scene_object_bounds(const vw_scene *s, vw_prim_kind kind, size_t index,
+                                   double lo[3], double hi[3]);
+/* A camera that sees the whole scene: for scenes without one (OBJ). It looks at the
+   centre of the bounds from the +z side, slightly above (+y up, the OBJ convention),
+   with a 45 degree field of view; width and height are kept from *cam when positive,
+   otherwise 512x512. cam->valid is set to 0 (it did not come from the file). */
+VW_API void vw_scene_default_camera(const vw_scene *s, vw_camera *cam);
 
 #ifdef __cplusplus
 }

@@ -1,0 +1,35 @@
+/* vwalls/image.h - writing rendered images (PNG, PFM) and reading PNG back.
+ *
+ * Pixels are row-major, top row first, RGB interleaved. Writers are atomic: they
+ * write "path.tmp.XXXXXX" in the same directory and rename it over path only when
+ * everything was written, so a failure never leaves a partial file behind.
+ */
+#ifndef VWALLS_IMAGE_H
+#define VWALLS_IMAGE_H
+
+#include <stddef.h>
+#include <stdint.h>
+#include "vwalls/common.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* 8-bit RGB PNG. VW_E_INVAL for bad sizes, VW_E_IO when the file cannot be written;
+   err gets "path: reason". */
+VW_API vw_status vw_image_write_png(const char *path, int w, int h, const uint8_t *rgb8,
+                                    char *err, size_t errlen);
+/* Portable float map: header "PF\n<w> <h>\n-1.0\n" (negative scale: little-endian),
+   then rows bottom first, as the format prescribes. */
+VW_API vw_status vw_image_write_pfm(const char *path, int w, int h, const float *rgb,
+                                    char *err, size_t errlen);
+/* Reads any PNG as 8-bit RGB (palette, grey and 16-bit are converted, alpha is
+   dropped). *rgb8 is allocated; release it with vw_image_free. */
+VW_API vw_status vw_image_read_png(const char *path, int *w, int *h, uint8_t **rgb8,
+                                   char *err, size_t errlen);
+VW_API void vw_image_free(void *pixels);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

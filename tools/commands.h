@@ -8,4 +8,7 @@
 int vw_cmd_example_pairs(int argc, char **argv);
 int vw_cmd_render(int argc, char **argv);
 
+int vw_cmd_gen(int argc, char **argv);
+int vw_cmd_info(int argc, char **argv);
+
 #endif

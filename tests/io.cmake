@@ -1,0 +1,20 @@
+# tests/io.cmake - tests of src/io: NFF and OBJ readers, the NFF writer, images, the
+# scene generators and the gen/info subcommands. Every test is named io_*.
+
+foreach(t bad nff obj image gen)
+  add_executable(test_io_${t} ${PROJECT_SOURCE_DIR}/tests/io/test_io_${t}.c)
+  target_include_directories(test_io_${t} PRIVATE ${PROJECT_SOURCE_DIR}/tests)
+  target_link_libraries(test_io_${t} PRIVATE vwalls_static m)
+  add_test(NAME io_${t} COMMAND test_io_${t} ${PROJECT_SOURCE_DIR}/tests/data)
+endforeach()
+
+# The subcommands are tested in-process: their sources are compiled with a test main,
+# so this does not depend on tools/vwalls.c registering them.
+add_executable(test_io_cli ${PROJECT_SOURCE_DIR}/tests/io/test_io_cli.c
+  ${PROJECT_SOURCE_DIR}/tools/cmd_gen.c ${PROJECT_SOURCE_DIR}/tools/cmd_info.c
+  ${PROJECT_SOURCE_DIR}/tools/cli.c)
+target_include_directories(test_io_cli PRIVATE ${PROJECT_SOURCE_DIR}/tests ${PROJECT_SOURCE_DIR}/tools)
+target_link_libraries(test_io_cli PRIVATE vwalls_static m)
+# cli.c uses clock_gettime, which -std=c11 hides without a feature macro.
+target_compile_definitions(test_io_cli PRIVATE _GNU_SOURCE)
+add_test(NAME io_cli COMMAND test_io_cli ${PROJECT_SOURCE_DIR}/tests/data)

@@ -1,0 +1,107 @@
+/* io_test_util.h - helpers for the io tests: bit-exact scene comparison, writing a
+ * scene's NFF to a string, reading a test data file.
+ */
+#ifndef VW_IO_TEST_UTIL_H
+#define VW_IO_TEST_UTIL_H
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "vwalls/scene.h"
+
+/* Bit-exact comparison, field by field (structs may have padding). Prints the first
+   difference to stderr. */
+static inline int scene_equal(const vw_scene *a, const vw_scene *b)
+{
+#define DIFF(what)                                                                  \
+    do {                                                                            \
+        fprintf(stderr, "scenes differ: %s\n", what);                               \
+        return 0;                                                                   \
+    } while (0)
+    const vw_camera *ca = &a->camera, *cb = &b->camera;
+    if (memcmp(ca->from, cb->from, sizeof ca->from) || memcmp(ca->at, cb->at, sizeof ca->at) ||
+        memcmp(ca->up, cb->up, sizeof ca->up) || memcmp(&ca->angle, &cb->angle, 8) ||
+        memcmp(&ca->hither, &cb->hither, 8) || ca->width != cb->width ||
+        ca->height != cb->height || ca->valid != cb->valid)
+        DIFF("camera");
+    if (memcmp(a->background, b->background, sizeof a->background))
+        DIFF("background");
+    if (a->nlights != b->nlights)
+        DIFF("number of lights");
+    for (size_t i = 0; i < a->nlights; i++)
+        if (memcmp(a->lights[i].pos, b->lights[i].pos, sizeof a->lights[i].pos) ||
+            memcmp(a->lights[i].color, b->lights[i].color, sizeof a->lights[i].color))
+            DIFF("a light");
+    if (a->nmaterials != b->nmaterials)
+        DIFF("number of materials");
+    if (a->nmaterials && memcmp(a->materials, b->materials, a->nmaterials * sizeof *a->materials))
+        DIFF("materials");
+    if (a->nspheres != b->nspheres || a->ncones != b->ncones || a->npolygons != b->npolygons)
+        DIFF("object counts");
+    if (a->nspheres && memcmp(a->spheres, b->spheres, a->nspheres * sizeof *a->spheres))
+        DIFF("spheres");
+    if (a->ncones && memcmp(a->cones, b->cones, a->ncones * sizeof *a->cones))
+        DIFF("cones");
+    if (a->npolygons && memcmp(a->polygons, b->polygons, a->npolygons * sizeof *a->polygons))
+        DIFF("polygons");
+    if (a->nvertices != b->nvertices || a->nindices != b->nindices)
+        DIFF("vertex or index counts");
+    if (a->nvertices && memcmp(a->vertices, b->vertices, a->nvertices * sizeof *a->vertices))
+        DIFF("vertices");
+    if (a->nindices && memcmp(a->indices, b->indices, a->nindices * sizeof *a->indices))
+        DIFF("indices");
+    if (!a->normals != !b->normals)
+        DIFF("presence of normals");
+    if (a->normals && memcmp(a->normals, b->normals, a->nindices * sizeof *a->normals))
+        DIFF("normals");
+    return 1;
+#undef DIFF
+}
+
+/* The scene's NFF as a malloc'd string. */
+static inline char *nff_string(const vw_scene *s, size_t *len)
+{
+    char *buf = NULL;
+    size_t n = 0;
+    FILE *f = open_memstream(&buf, &n);
+    if (!f)
+        return NULL;
+    if (vw_scene_write_nff(s, f) != VW_OK) {
+        fclose(f);
+        free(buf);
+        return NULL;
+    }
+    fclose(f);
+    if (len)
+        *len = n;
+    return buf;
+}
+
+static inline char *slurp(const char *path, size_t *len)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f)
+        return NULL;
+    char *buf = NULL;
+    size_t n = 0, cap = 0;
+    int c;
+    while ((c = fgetc(f)) != EOF) {
+        if (n + 1 >= cap) {
+            cap = cap ? cap * 2 : 4096;
+            buf = realloc(buf, cap);
+            if (!buf)
+                exit(3);
+        }
+        buf[n++] = (char)c;
+    }
+    fclose(f);
+    if (!buf)
+        buf = calloc(1, 1);
+    else
+        buf[n] = '\0';
+    *len = n;
+    return buf;
+}
+
+#endif

@@ -1,0 +1,89 @@
+/* test_io_bad.c - every file in tests/data/bad must be rejected with VW_E_INPUT, a
+ * "name:LINE: " prefix and the message its first line promises ("# expect: ...").
+ * Usage: test_io_bad DATA_DIR
+ */
+#define _GNU_SOURCE
+#include <dirent.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "vw_test.h"
+#include "vwalls/scene.h"
+
+static int has_ext(const char *name, const char *ext)
+{
+    size_t n = strlen(name), m = strlen(ext);
+    return n > m && !strcmp(name + n - m, ext);
+}
+
+/* Does err begin with "NAME:DIGITS: " where NAME is the file itself or, for errors
+   inside a material library, an .mtl file? */
+static int good_prefix(const char *err, const char *path)
+{
+    const char *p;
+    size_t n = strlen(path);
+    if (!strncmp(err, path, n) && err[n] == ':') {
+        p = err + n + 1;
+    } else {
+        p = strstr(err, ".mtl:");
+        if (!p)
+            return 0;
+        p += 5;
+    }
+    if (*p < '0' || *p > '9')
+        return 0;
+    while (*p >= '0' && *p <= '9')
+        p++;
+    return p[0] == ':' && p[1] == ' ';
+}
+
+int main(int argc, char **argv)
+{
+    CHECK(argc == 2);
+    char dirpath[4096];
+    snprintf(dirpath, sizeof dirpath, "%s/bad", argv[1]);
+    DIR *d = opendir(dirpath);
+    CHECK(d != NULL);
+    int files = 0;
+    struct dirent *e;
+    while ((e = readdir(d))) {
+        if (!has_ext(e->d_name, ".nff") && !has_ext(e->d_name, ".obj"))
+            continue;
+        char path[8192], line[512], err[1024] = "";
+        snprintf(path, sizeof path, "%s/%s", dirpath, e->d_name);
+        FILE *f = fopen(path, "r");
+        CHECK(f != NULL);
+        CHECK(fgets(line, sizeof line, f) != NULL);
+        fclose(f);
+        line[strcspn(line, "\r\n")] = '\0';
+        const char *tag = "# expect: ";
+        if (strncmp(line, tag, strlen(tag)) != 0) {
+            fprintf(stderr, "%s: first line lacks '%s'\n", path, tag);
+            return 1;
+        }
+        const char *expect = line + strlen(tag);
+        vw_scene *s = (vw_scene *)1;
+        vw_status st = vw_scene_read_file(path, &s, err, sizeof err);
+        printf("%-28s -> %s\n", e->d_name, err);
+        if (st != VW_E_INPUT || s != NULL || !strstr(err, expect) || !good_prefix(err, path)) {
+            fprintf(stderr, "%s: status %d (want %d), scene %p\n  message:  '%s'\n"
+                            "  expected: 'NAME:LINE: ...%s...'\n",
+                    path, (int)st, (int)VW_E_INPUT, (void *)s, err, expect);
+            return 1;
+        }
+        files++;
+    }
+    closedir(d);
+    printf("%d bad files rejected as promised\n", files);
+    CHECK(files >= 15);
+
+    /* A file that does not exist: "path: cannot open: reason". */
+    char err[512];
+    vw_scene *s;
+    CHECK(vw_scene_read_file("/nonexistent/x.nff", &s, err, sizeof err) == VW_E_INPUT);
+    CHECK(strstr(err, "/nonexistent/x.nff: cannot open: ") == err);
+    CHECK(vw_scene_read_file("scene.txt", &s, err, sizeof err) == VW_E_INPUT);
+    CHECK(strstr(err, "unknown scene format") != NULL);
+    TEST_DONE();
+}

@@ -1,0 +1,238 @@
+/* test_io_nff.c - the NFF reader and writer: every entity, token reading (line breaks
+ * do not matter), the light intensity rule, ids and bounds, error line numbers,
+ * bit-exact write/read round trips, and no crash on any prefix of a valid file.
+ * Usage: test_io_nff DATA_DIR
+ */
+#define _GNU_SOURCE
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "io_test_util.h"
+#include "vw_test.h"
+
+/* Rewrites NFF text with different whitespace: mode 0 puts all tokens on one line,
+   mode 1 every token on its own line with tabs and CRLF. Plain comments are dropped;
+   "#vw" extension comments are line-based by nature and stay lines of their own. */
+static char *reflow(const char *text, int mode)
+{
+    size_t n = strlen(text), o = 0;
+    char *out = malloc(3 * n + 16);
+    const char *p = text;
+    while (*p) {
+        const char *eol = strchr(p, '\n');
+        if (!eol)
+            eol = p + strlen(p);
+        const char *q = p;
+        while (q < eol && (*q == ' ' || *q == '\t'))
+            q++;
+        if (!strncmp(q, "#vw", 3)) {
+            out[o++] = '\n';
+            memcpy(out + o, q, (size_t)(eol - q));
+            o += (size_t)(eol - q);
+            out[o++] = '\n';
+        } else {
+            for (const char *r = p; r < eol && *r != '#';) {
+                if (*r == ' ' || *r == '\t' || *r == '\r') {
+                    r++;
+                    continue;
+                }
+                while (r < eol && *r != ' ' && *r != '\t' && *r != '\r')
+                    out[o++] = *r++;
+                if (mode == 0) {
+                    out[o++] = ' ';
+                } else {
+                    memcpy(out + o, "\t\r\n", 3);
+                    o += 3;
+                }
+            }
+        }
+        p = *eol ? eol + 1 : eol;
+    }
+    out[o] = '\0';
+    return out;
+}
+
+static vw_scene *read_text(const char *name, const char *text)
+{
+    char err[512];
+    vw_scene *s = NULL;
+    vw_status st = vw_scene_read_nff(name, text, strlen(text), &s, err, sizeof err);
+    if (st != VW_OK)
+        fprintf(stderr, "unexpected error: %s\n", err);
+    CHECK_EQ_INT(st, VW_OK);
+    return s;
+}
+
+static void expect_error(const char *text, const char *want)
+{
+    char err[512] = "";
+    vw_scene *s = (vw_scene *)1;
+    vw_status st = vw_scene_read_nff("t.nff", text, strlen(text), &s, err, sizeof err);
+    if (st != VW_E_INPUT || s || strcmp(err, want) != 0) {
+        fprintf(stderr, "got  '%s' (status %d)\nwant '%s'\n", err, (int)st, want);
+        exit(1);
+    }
+}
+
+#define VIEW "v from 0 -5 0 at 0 0 0 up 0 0 1 angle 45 hither 0.1 resolution 8 8\n"
+
+int main(int argc, char **argv)
+{
+    CHECK(argc == 2);
+    char path[4096], err[512];
+    snprintf(path, sizeof path, "%s/good/mixed.nff", argv[1]);
+    size_t len;
+    char *text = slurp(path, &len);
+    CHECK(text != NULL);
+    vw_scene *s = read_text(path, text);
+
+    /* Every entity of mixed.nff. */
+    CHECK_EQ_INT(s->camera.valid, 1);
+    CHECK_EQ_INT(s->camera.width, 64);
+    CHECK_EQ_INT(s->camera.height, 48);
+    CHECK(s->camera.angle == 40.0 && s->camera.hither == 0.01 && s->camera.up[2] == 1.0);
+    CHECK(s->camera.from[1] == -6.0 && s->camera.at[2] == 0.5);
+    CHECK(s->background[0] == 0.1f && s->background[1] == 0.2f && s->background[2] == 0.3f);
+    CHECK_EQ_INT(s->nlights, 2);
+    CHECK(s->lights[0].color[0] == (float)(1.0 / sqrt(2.0)));   /* 1/sqrt(#lights) */
+    CHECK(s->lights[0].color[2] == s->lights[0].color[0]);
+    CHECK(s->lights[1].color[0] == 0.9f && s->lights[1].color[2] == 0.7f);
+    CHECK_EQ_INT(s->nspheres, 2);
+    CHECK_EQ_INT(s->ncones, 1);
+    CHECK_EQ_INT(s->npolygons, 2);
+    CHECK_EQ_INT(vw_scene_count_objects(s), 5);
+    CHECK_EQ_INT(s->nmaterials, 2);
+    /* ids dense, in file order across kinds */
+    CHECK_EQ_INT(s->spheres[0].id, 0);
+    CHECK_EQ_INT(s->cones[0].id, 1);
+    CHECK_EQ_INT(s->polygons[0].id, 2);
+    CHECK_EQ_INT(s->polygons[1].id, 3);
+    CHECK_EQ_INT(s->spheres[1].id, 4);
+    for (int id = 0; id < 5; id++) {
+        vw_prim_kind k;
+        size_t i;
+        CHECK_EQ_INT(vw_scene_find_object(s, id, &k, &i), VW_OK);
+    }
+    vw_prim_kind kind;
+    size_t idx;
+    CHECK(vw_scene_find_object(s, 3, &kind, &idx) == VW_OK && kind == VW_PRIM_POLYGON && idx == 1);
+    CHECK(vw_scene_find_object(s, 5, &kind, &idx) == VW_E_INVAL);
+    /* materials: diffuse = rgb*Kd, specular = Ks, plus the #vw Ke extension */
+    const vw_material *m0 = &s->materials[0], *m1 = &s->materials[1];
+    CHECK(m0->diffuse[0] == (float)(0.8 * 0.7) && m0->diffuse[1] == (float)(0.2 * 0.7));
+    CHECK(m0->specular[0] == 0.3f && m0->specular[2] == 0.3f && m0->shine == 12.0f);
+    CHECK(m0->transmit == 0.0f && m0->ior == 1.0f && m0->emission[0] == 0.0f);
+    CHECK(m1->diffuse[2] == (float)(0.9 * 0.9) && m1->transmit == 0.4f && m1->ior == 1.5f);
+    CHECK(m1->emission[0] == 0.25f && m1->emission[1] == 0.5f && m1->emission[2] == 1.0f);
+    CHECK_EQ_INT(s->spheres[0].material, 0);
+    CHECK_EQ_INT(s->cones[0].material, 1);
+    CHECK_EQ_INT(s->spheres[1].material, 1);
+    CHECK(s->cones[0].apex_radius == -0.2 && s->cones[0].base_radius == 0.4);
+    CHECK(s->spheres[0].radius == 0.5 && s->spheres[0].center[2] == 0.5);
+    /* p without normals, pp with */
+    CHECK_EQ_INT(s->polygons[0].count, 4);
+    CHECK_EQ_INT(s->polygons[0].has_normals, 0);
+    CHECK_EQ_INT(s->polygons[1].count, 3);
+    CHECK_EQ_INT(s->polygons[1].has_normals, 1);
+    CHECK(s->normals != NULL);
+    CHECK(s->normals[s->polygons[1].first + 2][1] == -0.5);
+    CHECK(s->vertices[s->indices[s->polygons[1].first + 2]][2] == 1.5);
+    /* bounds: plane in xy, cone base disc down to z = -0.4, pp up to z = 1.5 */
+    double lo[3], hi[3];
+    vw_scene_bounds(s, lo, hi);
+    CHECK(lo[0] == -3 && lo[1] == -3 && lo[2] == -0.4 && hi[0] == 3 && hi[1] == 3 && hi[2] == 1.5);
+    vw_scene_object_bounds(s, VW_PRIM_SPHERE, 1, lo, hi);
+    CHECK_NEAR(lo[0], -1.5, 1e-15);
+    CHECK_NEAR(hi[0], -0.9, 1e-15);
+
+    /* Token reading: the same scene with other line breaks parses identically. */
+    for (int mode = 0; mode < 2; mode++) {
+        char *t2 = reflow(text, mode);
+        vw_scene *s2 = read_text("reflowed.nff", t2);
+        CHECK(scene_equal(s, s2));
+        vw_scene_free(s2);
+        free(t2);
+    }
+
+    /* Round trip: write, read back, compare bit for bit; writing again gives the same
+       text. */
+    size_t n1 = 0, n2 = 0;
+    char *w1 = nff_string(s, &n1);
+    CHECK(w1 != NULL);
+    vw_scene *back = read_text("written.nff", w1);
+    CHECK(scene_equal(s, back));
+    char *w2 = nff_string(back, &n2);
+    CHECK(n1 == n2 && memcmp(w1, w2, n1) == 0);
+    free(w1);
+    free(w2);
+    vw_scene_free(back);
+
+    /* Numbers that need all 17 digits survive the round trip. */
+    {
+        const char *t = VIEW "l 0.1 0.30000000000000004 1e-300 0.1 0.2 0.3\n"
+                             "f 0.1 0.2 0.3 0.7 0.11 3.0827 0.1 1.33\n"
+                             "s 0.1 0.2 0.30000000000000004 0.1\n";
+        vw_scene *a = read_text("digits.nff", t);
+        char *w = nff_string(a, NULL);
+        vw_scene *b = read_text("digits2.nff", w);
+        CHECK(scene_equal(a, b));
+        CHECK(b->spheres[0].center[2] == 0.30000000000000004 && b->lights[0].pos[2] == 1e-300);
+        free(w);
+        vw_scene_free(a);
+        vw_scene_free(b);
+    }
+
+    /* Unused 'f' leaves no material; equal 'f's share one. */
+    {
+        const char *t = VIEW "f 1 0 0 1 0 0 0 1\nf 0 1 0 1 0 0 0 1\ns 0 0 0 1\n"
+                             "f 0 0 1 1 0 0 0 1\ns 1 0 0 1\nf 0 1 0 1 0 0 0 1\ns 2 0 0 1\n";
+        vw_scene *a = read_text("mats.nff", t);
+        CHECK_EQ_INT(a->nmaterials, 2);
+        CHECK_EQ_INT(a->spheres[0].material, 0);
+        CHECK_EQ_INT(a->spheres[1].material, 1);
+        CHECK_EQ_INT(a->spheres[2].material, 0);
+        vw_scene_free(a);
+    }
+
+    /* The light rule and the default material (nocolor.nff). */
+    snprintf(path, sizeof path, "%s/good/nocolor.nff", argv[1]);
+    vw_scene *nc;
+    CHECK_EQ_INT(vw_scene_read_file(path, &nc, err, sizeof err), VW_OK);
+    CHECK_EQ_INT(nc->nlights, 4);
+    for (int i = 0; i < 4; i++)
+        for (int k = 0; k < 3; k++)
+            CHECK(nc->lights[i].color[k] == 0.5f);
+    CHECK_EQ_INT(nc->nmaterials, 1);
+    CHECK(nc->materials[0].diffuse[0] == 1.0f && nc->materials[0].specular[0] == 0.0f &&
+          nc->materials[0].ior == 1.0f);
+    vw_scene_free(nc);
+
+    /* Exact messages and line numbers, also for entities split across lines. */
+    expect_error(VIEW "s 0 0\n0\n\n1 foo\n", "t.nff:5: unknown keyword 'foo'");
+    expect_error(VIEW "s 0 0\n0\n\nl 1 1 1\n", "t.nff:5: wrong number of values for 's'");
+    expect_error(VIEW "s 0 0\n0\n\nq\n", "t.nff:5: bad number 'q' in 's'");
+    expect_error(VIEW "\n\np 3 0 0 0\n1 0 0\n", "t.nff:4: file ends in the middle of 'p'");
+    expect_error(VIEW "p -1\n", "t.nff:2: polygon needs at least 3 vertices");
+    expect_error(VIEW "p 99999999999\n", "t.nff:2: vertex count 99999999999 out of range in 'p' (3..2147483647)");
+    expect_error(VIEW "b 1 2 3e39\n", "t.nff:2: number 3e+39 out of range in 'b'");
+    expect_error("", "t.nff:1: missing 'v' block (NFF needs a camera)");
+    expect_error(VIEW "s 0 0 0 1\n7\n", "t.nff:3: wrong number of values for 's'");
+    expect_error(VIEW "s 0 0 0 1\x01\n", "t.nff:2: bad number '1?' in 's'");
+
+    /* Every prefix of a valid file either parses or fails cleanly with "name:line:". */
+    for (size_t cut = 0; cut <= len; cut++) {
+        vw_scene *p = NULL;
+        vw_status st = vw_scene_read_nff("cut.nff", text, cut, &p, err, sizeof err);
+        CHECK(st == VW_OK || (st == VW_E_INPUT && p == NULL && !strncmp(err, "cut.nff:", 8)));
+        vw_scene_free(p);
+    }
+    /* NULL err is allowed. */
+    vw_scene *p = NULL;
+    CHECK(vw_scene_read_nff("x", "q", 1, &p, NULL, 0) == VW_E_INPUT && p == NULL);
+
+    vw_scene_free(s);
+    free(text);
+    TEST_DONE();
+}

@@ -1,0 +1,97 @@
+/* test_io_obj.c - the OBJ/MTL reader: face-vertex forms, negative indices, normals,
+ * materials from the library, no camera, and OBJ -> NFF -> scene conversion.
+ * Usage: test_io_obj DATA_DIR
+ */
+#define _GNU_SOURCE
+#include <stdio.h>
+#include <string.h>
+
+#include "io_test_util.h"
+#include "vw_test.h"
+
+static int corner(const vw_scene *s, size_t poly, int k)
+{
+    return s->indices[s->polygons[poly].first + k];
+}
+
+int main(int argc, char **argv)
+{
+    CHECK(argc == 2);
+    char path[4096], err[512] = "";
+    snprintf(path, sizeof path, "%s/good/cube.obj", argv[1]);
+    vw_scene *s;
+    vw_status st = vw_scene_read_file(path, &s, err, sizeof err);
+    if (st != VW_OK)
+        fprintf(stderr, "%s\n", err);
+    CHECK_EQ_INT(st, VW_OK);
+    CHECK_EQ_INT(s->camera.valid, 0);
+    CHECK_EQ_INT(s->nlights, 0);
+    CHECK_EQ_INT(s->nvertices, 8);
+    CHECK_EQ_INT(s->npolygons, 7);
+    CHECK_EQ_INT(s->nspheres + s->ncones, 0);
+    CHECK_EQ_INT(s->nmaterials, 3);   /* red, white, glowing; no default needed */
+    for (int i = 0; i < 7; i++)
+        CHECK_EQ_INT(s->polygons[i].id, i);
+    /* f 1 4 3 2 (quad kept as a polygon) */
+    CHECK_EQ_INT(s->polygons[0].count, 4);
+    CHECK(corner(s, 0, 0) == 0 && corner(s, 0, 1) == 3 && corner(s, 0, 3) == 1);
+    /* v/vt: no normals; v/vt/vn and v//vn: normals */
+    CHECK_EQ_INT(s->polygons[1].has_normals, 0);
+    CHECK_EQ_INT(s->polygons[2].has_normals, 1);
+    CHECK_EQ_INT(s->polygons[3].has_normals, 1);
+    CHECK(s->normals[s->polygons[2].first][2] == 1.0);
+    CHECK(s->normals[s->polygons[3].first][2] == -1.0);
+    /* negative indices: after 8 vertices, -7 -6 -2 -3 are 2 3 7 6 (1-based) */
+    CHECK(corner(s, 4, 0) == 1 && corner(s, 4, 1) == 2 && corner(s, 4, 2) == 6 &&
+          corner(s, 4, 3) == 5);
+    CHECK(corner(s, 6, 1) == 0 && corner(s, 6, 2) == 4);
+    /* materials */
+    const vw_material *red = &s->materials[s->polygons[0].material];
+    const vw_material *white = &s->materials[s->polygons[1].material];
+    const vw_material *glow = &s->materials[s->polygons[5].material];
+    CHECK(red->diffuse[0] == 0.8f && red->diffuse[1] == 0.1f && red->specular[2] == 0.4f &&
+          red->shine == 25.0f);
+    CHECK(white->diffuse[0] == 0.7f && white->diffuse[2] == 0.7f);   /* "Kd 0.7" = grey */
+    CHECK(white->transmit == 0.25f && white->ior == 1.33f);          /* d 0.75 */
+    CHECK(glow->emission[0] == 4.0f && glow->emission[2] == 2.0f && glow->transmit == 0.1f);
+    double lo[3], hi[3];
+    vw_scene_bounds(s, lo, hi);
+    CHECK(lo[0] == 0 && lo[1] == 0 && lo[2] == 0 && hi[0] == 1 && hi[1] == 1 && hi[2] == 1);
+
+    /* OBJ -> NFF: the camera is invented (valid then), and the geometry and materials,
+       including per-channel Ks and Ke, survive; vertices are no longer shared. */
+    char *w = nff_string(s, NULL);
+    CHECK(w != NULL);
+    vw_scene *n;
+    st = vw_scene_read_nff("from_obj.nff", w, strlen(w), &n, err, sizeof err);
+    if (st != VW_OK)
+        fprintf(stderr, "%s\n%s\n", err, w);
+    CHECK_EQ_INT(st, VW_OK);
+    CHECK_EQ_INT(n->camera.valid, 1);
+    CHECK_EQ_INT(n->npolygons, 7);
+    CHECK_EQ_INT(n->nmaterials, 3);
+    CHECK(memcmp(n->materials, s->materials, 3 * sizeof *s->materials) == 0);
+    for (size_t i = 0; i < 7; i++)
+        for (int k = 0; k < s->polygons[i].count; k++)
+            CHECK(memcmp(n->vertices[corner(n, i, k)], s->vertices[corner(s, i, k)],
+                         sizeof n->vertices[0]) == 0);
+    vw_scene_free(n);
+    free(w);
+
+    /* Without a directory the mtllib is not loaded; faces get the default grey. */
+    const char *t = "mtllib nothere.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl x\nf 1 2 -1\n";
+    CHECK_EQ_INT(vw_scene_read_obj("m.obj", t, strlen(t), NULL, &n, err, sizeof err), VW_OK);
+    CHECK_EQ_INT(n->nmaterials, 1);
+    CHECK(n->materials[0].diffuse[0] == 0.8f);
+    vw_scene_free(n);
+    /* With one, the missing library is an error naming it. */
+    CHECK_EQ_INT(vw_scene_read_obj("m.obj", t, strlen(t), "/nonexistent", &n, err, sizeof err),
+                 VW_E_INPUT);
+    CHECK(strstr(err, "m.obj:1: ") == err && strstr(err, "/nonexistent/nothere.mtl") != NULL);
+    /* Exact message for an index out of range. */
+    t = "v 0 0 0\nv 1 0 0\nv 0 1 0\n# comment\nf 1 2 4\n";
+    CHECK_EQ_INT(vw_scene_read_obj("r.obj", t, strlen(t), NULL, &n, err, sizeof err), VW_E_INPUT);
+    CHECK(!strcmp(err, "r.obj:5: vertex index 4 out of range (3 vertices)"));
+    vw_scene_free(s);
+    TEST_DONE();
+}

@@ -2,6 +2,7 @@
  * and the progress bar.
  */
 #include "cli.h"
+#include "vwalls/engine.h"
 
 #include <errno.h>
 #include <math.h>
@@ -100,13 +101,19 @@ double vw_cli_now(void)
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
+/* MPI only when a launcher started us (the library decides: vw_engine_init does nothing
+   otherwise), so a plain run of the binary is exactly the threads engine. */
 void vw_cli_engine_init(int *argc, char ***argv)
 {
-    (void)argc;
-    (void)argv;
+    char msg[400];
+    if (vw_engine_init(argc, argv, msg, sizeof msg) != VW_OK) {
+        fprintf(stderr, "vwalls: rank %d: %s\n", vw_engine_rank(), msg);
+        vw_engine_abort(VW_EXIT_FAIL, NULL);
+    }
+    cli_rank = vw_engine_rank();
 }
 
-void vw_cli_engine_finish(void) {}
+void vw_cli_engine_finish(void) { vw_engine_finish(); }
 
 void vw_progress_begin(vw_progress *p, const char *label, int quiet)
 {

@@ -7,8 +7,14 @@
  * only with an empty inbox, no open packets and no step work. So active == 0 means no
  * worker can ever receive anything again: global quiescence, under any interleaving
  * or delay. Whoever brings it to zero wakes everybody.
+ *
+ * Under MPI the same count covers this process only: the transport's communication
+ * thread (the thread that called run) holds one extra count, so workers never end the
+ * run on local quiescence; it gives the count back once all processes agree (see
+ * transport/mpi.c). The threads engine has no such thread and never polls.
  */
 #include "core/world_internal.h"
+#include "vwalls/engine.h"
 
 #include <stdio.h>
 #include <stdlib.h>
@@ -28,7 +34,7 @@ double vw__now(void)
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
-static uint64_t rng_next(uint64_t *s)
+uint64_t vw__rng_next(uint64_t *s)
 {
     uint64_t z = (*s += 0x9e3779b97f4a7c15ull);
     z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
@@ -66,12 +72,12 @@ static void finish_run(vw_world *w)
     }
 }
 
-static void uncount(vw_world *w)
+void vw__uncount(vw_world *w)
 {
     if (atomic_fetch_sub(&w->active, 1) == 1) finish_run(w);
 }
 
-static void run_output(vw_world *w, vw__packet *p)
+void vw__run_output(vw_world *w, const vw__packet *p)
 {
     pthread_mutex_lock(&w->output_mu);
     size_t off = 0;
@@ -95,23 +101,32 @@ void vw__deliver(vw_world *w, vw__worker *from, vw__packet *p)
     }
     if (w->transport && (p->dest == VW__OUTPUT ? w->rank != 0
                                                : vw__worker_process(w, p->dest) != w->rank)) {
+        if (from) {
+            from->msgs_remote += p->nmsgs;
+            from->bytes_remote += p->used;
+        }
         w->transport->send(w, from, p);
         return;
     }
     if (p->dest == VW__OUTPUT) {
         /* Output packets are handled at once by the output process's lock: they create
            no work, so they need no counting. */
-        run_output(w, p);
+        vw__run_output(w, p);
         free(p);
         return;
     }
-    vw__worker *to = &w->workers[p->dest - w->rank * w->nworkers];
     if (from) atomic_fetch_add(&from->outstanding, p->used);
+    vw__deliver_local(w, p, from ? &from->rng : NULL);
+}
+
+void vw__deliver_local(vw_world *w, vw__packet *p, uint64_t *rng)
+{
+    vw__worker *to = &w->workers[p->dest - w->rank * w->nworkers];
     atomic_fetch_add(&w->active, 1);
     pthread_mutex_lock(&to->mu);
-    if (w->cfg.stress_seed && from && to->head && (rng_next(&from->rng) & 1)) {
+    if (w->cfg.stress_seed && rng && to->head && (vw__rng_next(rng) & 1)) {
         /* Stress: insert at a random place, so packets overtake each other. */
-        uint64_t n = rng_next(&from->rng) % 8;
+        uint64_t n = vw__rng_next(rng) % 8;
         vw__packet **at = &to->head;
         while (*at && n--) at = &(*at)->next;
         p->next = *at;
@@ -319,7 +334,7 @@ static vw__packet *take(vw__worker *wk)
 static void stress_pause(vw__worker *wk)
 {
     if (!wk->w->cfg.stress_seed) return;
-    uint64_t r = rng_next(&wk->rng);
+    uint64_t r = vw__rng_next(&wk->rng);
     if ((r & 7) == 0) {
         struct timespec ts = {0, (long)(r >> 40) % 200000};
         nanosleep(&ts, NULL);
@@ -339,7 +354,7 @@ static void *worker_main(void *arg)
             stress_pause(wk);
             handle_packet(wk, &ctx, p);
             free(p);
-            uncount(w);
+            vw__uncount(w);
             continue;
         }
         if (flush_all(wk)) continue;
@@ -352,7 +367,7 @@ static void *worker_main(void *arg)
         }
         wk->busy = 0;
         pthread_mutex_unlock(&wk->mu);
-        uncount(w);
+        vw__uncount(w);
         pthread_mutex_lock(&wk->mu);
         while (!wk->head && !atomic_load(&w->finished)) pthread_cond_wait(&wk->cv, &wk->mu);
         if (!wk->head) {
@@ -370,7 +385,8 @@ static void *worker_main(void *arg)
 vw_status vw__runtime_run(vw_world *w)
 {
     atomic_store(&w->finished, 0);
-    atomic_store(&w->active, w->nworkers);
+    /* With a transport, its thread (this one) is counted too: see the top of the file. */
+    atomic_store(&w->active, w->nworkers + (w->transport ? 1 : 0));
     for (int i = 0; i < w->nworkers; i++) w->workers[i].busy = 1;
     /* Posted messages: counted like any packet. */
     while (w->posted) {
@@ -390,10 +406,22 @@ vw_status vw__runtime_run(vw_world *w)
     if (st != VW_OK) {
         /* The threads that did start cannot end without the others: count the missing
            ones out so quiescence is still reached. */
-        for (int i = started; i < w->nworkers; i++) uncount(w);
+        for (int i = started; i < w->nworkers; i++) vw__uncount(w);
+    }
+    if (w->transport) {
+        /* Other processes cannot finish without this one's workers; a process that
+           cannot run them must end the job rather than leave the others waiting. */
+        if (st != VW_OK) {
+            char msg[600];
+            snprintf(msg, sizeof msg, "vwalls: rank %d: %s", w->rank, w->errmsg);
+            vw_engine_abort(1, msg);
+        }
+        st = w->transport->run(w);
     }
     for (int i = 0; i < started; i++) pthread_join(w->workers[i].thread, NULL);
     w->runs++;
+    vw__stats_local(w);
+    if (w->transport && st == VW_OK) st = w->transport->sync(w);
     return st;
 }
 

@@ -29,11 +29,28 @@ static void json_string(FILE *f, const char *s)
     fputc('"', f);
 }
 
-static long peak_rss_bytes(void)
+uint64_t vw__peak_rss(void)
 {
     struct rusage ru;
     if (getrusage(RUSAGE_SELF, &ru) != 0) return 0;
-    return ru.ru_maxrss * 1024L;
+    return (uint64_t)ru.ru_maxrss * 1024u;
+}
+
+void vw__stats_local(vw_world *w)
+{
+    memset(w->wstats, 0, sizeof *w->wstats * (size_t)w->gworkers);
+    uint64_t rss = vw__peak_rss();
+    for (int i = 0; i < w->nworkers; i++) {
+        const vw__worker *wk = &w->workers[i];
+        vw__worker_stats *ws = &w->wstats[wk->global];
+        ws->busy_s = wk->busy_s;
+        ws->msgs_sent = wk->msgs_sent;
+        ws->bytes_sent = wk->bytes_sent;
+        ws->packets_sent = wk->packets_sent;
+        ws->msgs_remote = wk->msgs_remote;
+        ws->bytes_remote = wk->bytes_remote;
+        ws->peak_rss = rss;
+    }
 }
 
 static void write_body(vw_world *w, FILE *f, const char *command, const char *extra)
@@ -67,13 +84,14 @@ static void write_body(vw_world *w, FILE *f, const char *command, const char *ex
     else
         fprintf(f, "\"phases\": %d", w->nphases);
     fprintf(f, "},\n");
+    /* Whole-job figures: w->wstats holds every process's workers after a run. */
     uint64_t msgs = 0, bytes = 0, packets = 0, mr = 0, br = 0;
-    for (int i = 0; i < w->nworkers; i++) {
-        msgs += w->workers[i].msgs_sent;
-        bytes += w->workers[i].bytes_sent;
-        packets += w->workers[i].packets_sent;
-        mr += w->workers[i].msgs_remote;
-        br += w->workers[i].bytes_remote;
+    for (int g = 0; g < w->gworkers; g++) {
+        msgs += w->wstats[g].msgs_sent;
+        bytes += w->wstats[g].bytes_sent;
+        packets += w->wstats[g].packets_sent;
+        mr += w->wstats[g].msgs_remote;
+        br += w->wstats[g].bytes_remote;
     }
     fprintf(f, "  \"messages\": {\"count\": %llu, \"bytes\": %llu, \"packets\": %llu, \"remote_count\": %llu, \"remote_bytes\": %llu},\n",
             (unsigned long long)msgs, (unsigned long long)bytes, (unsigned long long)packets,
@@ -104,11 +122,33 @@ static void write_body(vw_world *w, FILE *f, const char *command, const char *ex
         fprintf(f, "}%s\n", c + 1 < w->ncells ? "," : "");
     }
     fprintf(f, "  ],\n  \"workers\": [\n");
-    long rss = peak_rss_bytes();
+    uint64_t rss_here = vw__peak_rss();
     for (int g = 0; g < w->gworkers; g++) {
-        fprintf(f, "    {\"id\": %d, \"process\": %d, \"busy_s\": %.6f, \"peak_rss_bytes\": %ld}%s\n", g,
-                vw__worker_process(w, g), vw_world_worker_busy(w, g), rss,
+        const vw__worker_stats *ws = &w->wstats[g];
+        uint64_t rss = vw__worker_process(w, g) == w->rank || !ws->peak_rss ? rss_here : ws->peak_rss;
+        fprintf(f, "    {\"id\": %d, \"process\": %d, \"busy_s\": %.6f, \"peak_rss_bytes\": %llu, \"messages\": %llu, \"bytes\": %llu, \"remote_count\": %llu, \"remote_bytes\": %llu}%s\n",
+                g, vw__worker_process(w, g), vw_world_worker_busy(w, g), (unsigned long long)rss,
+                (unsigned long long)ws->msgs_sent, (unsigned long long)ws->bytes_sent,
+                (unsigned long long)ws->msgs_remote, (unsigned long long)ws->bytes_remote,
                 g + 1 < w->gworkers ? "," : "");
+    }
+    /* Per process: the sums of its workers (messages sent, and what left the process). */
+    fprintf(f, "  ],\n  \"processes\": [\n");
+    for (int p = 0; p < w->nprocs; p++) {
+        double busy = 0;
+        uint64_t pm = 0, pb = 0, prm = 0, prb = 0, rss = p == w->rank ? rss_here : 0;
+        for (int g = p * w->nworkers; g < (p + 1) * w->nworkers; g++) {
+            busy += vw_world_worker_busy(w, g);
+            pm += w->wstats[g].msgs_sent;
+            pb += w->wstats[g].bytes_sent;
+            prm += w->wstats[g].msgs_remote;
+            prb += w->wstats[g].bytes_remote;
+            if (p != w->rank && w->wstats[g].peak_rss > rss) rss = w->wstats[g].peak_rss;
+        }
+        fprintf(f, "    {\"id\": %d, \"workers\": %d, \"busy_s\": %.6f, \"messages\": %llu, \"bytes\": %llu, \"remote_count\": %llu, \"remote_bytes\": %llu, \"peak_rss_bytes\": %llu}%s\n",
+                p, w->nworkers, busy, (unsigned long long)pm, (unsigned long long)pb,
+                (unsigned long long)prm, (unsigned long long)prb, (unsigned long long)rss,
+                p + 1 < w->nprocs ? "," : "");
     }
     fprintf(f, "  ]\n}\n");
 }

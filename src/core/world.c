@@ -144,10 +144,17 @@ vw_status vw_world_create(const vw_module *m, void *user, const vw_decomp *d, co
         free(w);
         return VW_E_LIMIT;
     }
-    w->gworkers = w->nworkers * w->nprocs;
     w->cfg.cell_worker = NULL; /* copied into w->cell_worker below */
     pthread_mutex_init(&w->output_mu, NULL);
-    vw_status st = vw_decomp_clone(d, &w->decomp);
+    /* Under MPI: rank, nprocs and the transport. Every process must pass the same
+       worker count, decomposition and mapping (checked by the transport). */
+    vw_status st = vw__mpi_attach(w);
+    w->gworkers = w->nworkers * w->nprocs;
+    if (st == VW_OK) {
+        w->wstats = calloc((size_t)w->gworkers, sizeof *w->wstats);
+        if (!w->wstats) st = VW_E_NOMEM;
+    }
+    if (st == VW_OK) st = vw_decomp_clone(d, &w->decomp);
     if (st == VW_OK) st = alloc_cells(w);
     if (st == VW_OK) {
         w->workers = calloc((size_t)w->nworkers, sizeof *w->workers);
@@ -177,6 +184,8 @@ vw_status vw_world_create(const vw_module *m, void *user, const vw_decomp *d, co
 void vw_world_free(vw_world *w)
 {
     if (!w) return;
+    if (w->transport) w->transport->free(w);
+    free(w->wstats);
     free_cells(w);
     if (w->workers) {
         for (int i = 0; i < w->nworkers; i++) {
@@ -395,6 +404,8 @@ vw_status vw_world_cell_stats(const vw_world *w, int cell, vw_cell_stats *out)
     out->load = c->busy_s;
     if (w->m->load && c->built && vw__worker_process(w, c->worker) == w->rank)
         out->load = vw__cell_load((vw_world *)w, cell);
+    else if (w->m->load && w->nprocs > 1)
+        out->load = c->load; /* the hosting process's figure at the last run's end */
     return VW_OK;
 }
 
@@ -444,6 +455,7 @@ void vw_world_reset_stats(vw_world *w)
         wk->msgs_sent = wk->bytes_sent = wk->packets_sent = 0;
         wk->msgs_remote = wk->bytes_remote = 0;
     }
+    memset(w->wstats, 0, sizeof *w->wstats * (size_t)w->gworkers);
 }
 
 void vw_world_add_time(vw_world *w, const char *phase, double seconds)
@@ -466,3 +478,42 @@ void vw_world_set_balance_info(vw_world *w, const char *strategy, double before,
     w->imbalance_after = after;
     w->migrated = migrated;
 }
+
+/* ---- without MPI: the engine is this one process ------------------------------------ */
+
+#if !VW_HAVE_MPI
+#include "vwalls/engine.h"
+
+vw_status vw__mpi_attach(vw_world *w)
+{
+    (void)w;
+    return VW_OK;
+}
+
+int vw_engine_launched(void) { return 0; }
+vw_status vw_engine_init(int *argc, char ***argv, char *msg, size_t len)
+{
+    (void)argc, (void)argv;
+    if (msg && len) msg[0] = 0;
+    return VW_OK;
+}
+void vw_engine_finish(void) {}
+void vw_engine_abort(int status, const char *msg)
+{
+    if (msg) fprintf(stderr, "%s\n", msg);
+    fflush(NULL);
+    _exit(status ? status : 1);
+}
+int vw_engine_rank(void) { return 0; }
+int vw_engine_size(void) { return 1; }
+vw_status vw_engine_agree(vw_status local, char *msg, size_t len)
+{
+    (void)msg, (void)len;
+    return local;
+}
+vw_status vw_world_agree(vw_world *w, vw_status local, char *msg, size_t len)
+{
+    (void)w, (void)msg, (void)len;
+    return local;
+}
+#endif

@@ -6,6 +6,11 @@
  *    open, the destination's inbox, then the worker handling it (which frees it);
  *  - w->active counts busy workers plus packets sent and not yet handled; it reaches
  *    zero exactly once per run, at global quiescence, and only then does run() end.
+ *    With MPI the communication thread holds one count of its own for the whole run
+ *    and gives it back only when the processes have agreed on global quiescence, so
+ *    local quiescence alone never ends a run;
+ *  - a cell's measurements (messages_in, busy_s, counters) are written only by the
+ *    process hosting it; after every run the other processes receive copies.
  */
 #ifndef VW_WORLD_INTERNAL_H
 #define VW_WORLD_INTERNAL_H
@@ -43,6 +48,7 @@ typedef struct vw__cell {
     uint64_t messages_in;
     double busy_s;
     int64_t *counters;       /* module counters, ncounters */
+    double load;             /* load() of the hosting process at the last run's end */
 } vw__cell;
 
 typedef struct vw__worker {
@@ -64,13 +70,28 @@ typedef struct vw__worker {
     vw_status build_status;
 } vw__worker;
 
+/* Per-worker figures of all processes (index: global worker), gathered after each run
+   so that every process, and the stats JSON at rank 0, sees the whole job. */
+typedef struct vw__worker_stats {
+    double busy_s;
+    uint64_t msgs_sent, bytes_sent, packets_sent;
+    uint64_t msgs_remote, bytes_remote; /* that crossed a process boundary */
+    uint64_t peak_rss;                  /* of the worker's process */
+} vw__worker_stats;
+
 /* How packets leave this process (the MPI engine); NULL for the threads engine.
    A table of functions, like SQLite's VFS: one contract, one implementation per engine. */
 typedef struct vw__transport {
     const char *name;
     /* Takes ownership of a packet for a worker of another process (or the output
-       process); must keep the termination protocol's counts. */
+       process); must keep the termination protocol's counts. Called by workers. */
     void (*send)(struct vw_world *w, struct vw__worker *from, struct vw__packet *p);
+    /* Drives the exchange while the workers run, on the thread that called run(), and
+       returns at global quiescence (after giving back its count in w->active). */
+    vw_status (*run)(struct vw_world *w);
+    /* After a run, collectively: makes every process's cell and worker figures global. */
+    vw_status (*sync)(struct vw_world *w);
+    void (*free)(struct vw_world *w);
     void *impl;
 } vw__transport;
 
@@ -95,6 +116,7 @@ struct vw_world {
     atomic_int finished;
     pthread_mutex_t output_mu; /* output handlers run one at a time */
     vw__transport *transport;
+    vw__worker_stats *wstats;  /* gworkers entries, valid after a run */
     char errmsg[512];
     vw_status err;
     /* stats */
@@ -118,7 +140,20 @@ vw_status vw__runtime_run(vw_world *w);
 vw_status vw__runtime_build(vw_world *w);
 vw__packet *vw__packet_new(int dest, int src, size_t cap);
 void vw__deliver(vw_world *w, vw__worker *from, vw__packet *p);
+/* Queues a packet for a worker of this process, counting it in w->active; rng (may be
+   NULL) drives the stress switch's reordering. */
+void vw__deliver_local(vw_world *w, vw__packet *p, uint64_t *rng);
+void vw__run_output(vw_world *w, const vw__packet *p);
+void vw__uncount(vw_world *w);
+uint64_t vw__rng_next(uint64_t *s);
 double vw__cell_load(vw_world *w, int cell);
+/* Fills w->wstats from this process's workers (the other processes' entries zero). */
+void vw__stats_local(vw_world *w);
+uint64_t vw__peak_rss(void);
+
+/* transport/mpi.c (stubs in world.c without MPI). vw__mpi_attach decides the engine at
+   create: it sets rank, nprocs and w->transport when the world runs under MPI. */
+vw_status vw__mpi_attach(vw_world *w);
 
 double vw__now(void);
 

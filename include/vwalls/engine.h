@@ -1,0 +1,50 @@
+/* vwalls/engine.h - the process-level engine: MPI start-up and shutdown, and agreement
+ * between processes (every rank learns whether every other rank is fine, and if not,
+ * which rank failed and why), so that no rank computes on input another rank rejected.
+ *
+ * All functions work in a build without MPI and in a process started without a launcher:
+ * there they describe a single process and agree with nobody but themselves.
+ */
+#ifndef VWALLS_ENGINE_H
+#define VWALLS_ENGINE_H
+
+#include <stddef.h>
+#include "vwalls/common.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct vw_world vw_world;
+
+/* Nonzero when the build has MPI and the process is part of an MPI job: MPI is already
+   initialised, or an MPI launcher (mpirun, mpiexec, srun) started it. */
+VW_API int vw_engine_launched(void);
+
+/* Initialises MPI when launched and not yet initialised, requesting the thread level the
+   engine needs (MPI_THREAD_FUNNELED: only the thread that calls vw_world_run and the
+   collective calls below makes MPI calls). Fails with VW_E_MPI and a message when MPI
+   offers less. Without a launcher it does nothing and returns VW_OK. */
+VW_API vw_status vw_engine_init(int *argc, char ***argv, char *msg, size_t len);
+/* Finalises MPI if vw_engine_init initialised it. */
+VW_API void vw_engine_finish(void);
+/* Ends the whole job at once with this status (MPI_Abort when launched, exit otherwise),
+   after printing msg; for failures the other ranks cannot learn about otherwise. */
+VW_API void vw_engine_abort(int status, const char *msg);
+
+/* Rank and size on MPI_COMM_WORLD (0 and 1 without MPI). */
+VW_API int vw_engine_rank(void);
+VW_API int vw_engine_size(void);
+
+/* Agreement (collective: every rank must call it). `local` is this rank's status and
+   msg its message. Returns VW_OK on every rank when every rank passed VW_OK; otherwise
+   every rank returns the status of the lowest failing rank, and msg (of size len) holds
+   "rank R: <its message>" on every rank. vw_engine_agree runs on MPI_COMM_WORLD (usable
+   before a world exists), vw_world_agree on the world's communicator. */
+VW_API vw_status vw_engine_agree(vw_status local, char *msg, size_t len);
+VW_API vw_status vw_world_agree(vw_world *w, vw_status local, char *msg, size_t len);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

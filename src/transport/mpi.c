@@ -1,0 +1,500 @@
+/* mpi.c - the MPI transport: packets between processes, funnelled through one
+ * communication thread per process (the thread that called vw_world_run), and
+ * termination detection across processes by waves of counts.
+ *
+ * Only the communication thread calls MPI (MPI_THREAD_FUNNELED suffices): workers hand
+ * packets over through a locked queue, and received packets go into the workers'
+ * inboxes through vw__deliver_local, counted in w->active like local ones.
+ *
+ * Termination (the four-counter method, Mattern 1987). Each process counts S, the
+ * packets its workers handed to MPI, and R, the packets it received from MPI, this run.
+ * A wave is one MPI_Iallreduce of (not idle, S, R) summed over processes, O(log P).
+ * A process is idle when w->active == 1 (only the communication thread's own count
+ * remains: no busy worker, no packet in any local inbox) and it holds no delayed
+ * packet. It reads `active` before S and R, and only the communication thread can make
+ * an idle process busy again (by delivering a received packet, which raises R first).
+ * The run ends after two consecutive waves that both report every process idle and the
+ * same totals with S == R. Why that is safe under any delay and order: a process's wave
+ * k+1 contribution is made after every process's wave k contribution (it starts wave
+ * k+1 only when wave k completed). Equal sums with monotone counters mean every
+ * process's S and R stayed constant between its two contributions, so it received
+ * nothing and stayed idle in between; at any instant between the last wave-k and the
+ * first wave-(k+1) contribution, every process is idle and sent == received in total,
+ * so no packet is in flight: nothing can ever happen again. Every process sees the
+ * same wave results, so all decide at the same wave.
+ */
+#include "transport/mpi_internal.h"
+#include "vwalls/engine.h"
+
+#include <sched.h>
+#include <stddef.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+enum { TAG_DATA = 7301 };
+
+/* Wire format: the packet record from `dest` to the end of its used data (dest, src,
+   nmsgs, used, cap, data). Every process runs the same binary, so the layout matches;
+   heterogeneous machines are not supported. */
+#define WIRE_OFF offsetof(vw__packet, dest)
+#define WIRE_HDR (offsetof(vw__packet, data) - WIRE_OFF)
+
+/* A packet the stress switch holds back on the communication thread. */
+typedef struct held {
+    vw__packet *p;
+    double until;
+    int outgoing; /* 1: not yet sent to MPI; 0: received, not yet delivered */
+} held;
+
+typedef struct mpi_tp {
+    vw__transport base;
+    MPI_Comm comm;
+    int level; /* thread level MPI gave */
+    pthread_mutex_t mu;
+    pthread_cond_t cv;
+    vw__packet *qhead, *qtail; /* handed over by workers, not yet posted; guarded by mu */
+    int sleeping;              /* the communication thread waits on cv; guarded by mu */
+    atomic_long sent;          /* S: packets handed to the transport this run */
+    long received;             /* R: packets received this run (communication thread) */
+    MPI_Request *reqs;         /* posted sends and their packets */
+    vw__packet **sending;
+    int nsend, capsend;
+    int *done_idx;
+    held *hold;
+    int nhold, caphold;
+    uint64_t rng;
+    uint64_t waves; /* all runs: how many termination waves it took */
+} mpi_tp;
+
+static mpi_tp *tp_of(vw_world *w) { return (mpi_tp *)w->transport; }
+
+MPI_Comm vw__mpi_world_comm(const vw_world *w)
+{
+    return w->transport ? ((const mpi_tp *)w->transport)->comm : MPI_COMM_NULL;
+}
+
+static void fatal(vw_world *w, const char *what)
+{
+    char msg[600];
+    snprintf(msg, sizeof msg, "vwalls: rank %d: %s", w->rank, what);
+    vw_engine_abort(1, msg);
+}
+
+static void *grow(void *p, int *cap, int need, size_t elem)
+{
+    if (need <= *cap) return p;
+    int n = *cap ? *cap : 64;
+    while (n < need) n *= 2;
+    void *q = realloc(p, (size_t)n * elem);
+    if (!q) {
+        fprintf(stderr, "vwalls: out of memory in the MPI transport\n");
+        abort();
+    }
+    *cap = n;
+    return q;
+}
+
+/* ---- the workers' side --------------------------------------------------------------- */
+
+/* Counted in S before the worker that sends can count itself idle, so a wave that sees
+   that worker idle also sees this packet in S. */
+static void tp_send(vw_world *w, vw__worker *from, vw__packet *p)
+{
+    mpi_tp *t = tp_of(w);
+    if (from) atomic_fetch_add(&from->outstanding, p->used);
+    atomic_fetch_add(&t->sent, 1);
+    pthread_mutex_lock(&t->mu);
+    p->next = NULL;
+    if (t->qtail)
+        t->qtail->next = p;
+    else
+        t->qhead = p;
+    t->qtail = p;
+    if (t->sleeping) pthread_cond_signal(&t->cv);
+    pthread_mutex_unlock(&t->mu);
+}
+
+/* ---- the communication thread ---------------------------------------------------------- */
+
+static void post_send(vw_world *w, mpi_tp *t, vw__packet *p)
+{
+    int to = p->dest == VW__OUTPUT ? 0 : vw__worker_process(w, p->dest);
+    if (t->nsend == t->capsend) {
+        /* reqs, sending and done_idx always have capsend entries. */
+        int cap = t->capsend;
+        t->reqs = grow(t->reqs, &cap, t->nsend + 1, sizeof *t->reqs);
+        cap = t->capsend;
+        t->done_idx = grow(t->done_idx, &cap, t->nsend + 1, sizeof *t->done_idx);
+        t->sending = grow(t->sending, &t->capsend, t->nsend + 1, sizeof *t->sending);
+    }
+    t->sending[t->nsend] = p;
+    MPI_Isend((char *)p + WIRE_OFF, (int)(WIRE_HDR + p->used), MPI_BYTE, to, TAG_DATA, t->comm,
+              &t->reqs[t->nsend]);
+    t->nsend++;
+}
+
+static void hold_packet(vw_world *w, mpi_tp *t, vw__packet *p, int outgoing)
+{
+    (void)w;
+    t->hold = grow(t->hold, &t->caphold, t->nhold + 1, sizeof *t->hold);
+    uint64_t r = vw__rng_next(&t->rng);
+    t->hold[t->nhold++] = (held){p, vw__now() + 1e-6 * (double)(r % 2000), outgoing};
+}
+
+static int stress_roll(vw_world *w, mpi_tp *t) { return w->cfg.stress_seed && (vw__rng_next(&t->rng) & 3) == 0; }
+
+/* Posts the packets the workers handed over (the stress switch holds some back). */
+static int post_sends(vw_world *w, mpi_tp *t)
+{
+    pthread_mutex_lock(&t->mu);
+    vw__packet *p = t->qhead;
+    t->qhead = t->qtail = NULL;
+    pthread_mutex_unlock(&t->mu);
+    int any = p != NULL;
+    while (p) {
+        vw__packet *next = p->next;
+        p->next = NULL;
+        if (stress_roll(w, t))
+            hold_packet(w, t, p, 1);
+        else
+            post_send(w, t, p);
+        p = next;
+    }
+    return any;
+}
+
+/* Frees the packets whose sends completed and gives their bytes back to the sender's
+   memory cap. */
+static int complete_sends(vw_world *w, mpi_tp *t)
+{
+    if (!t->nsend) return 0;
+    int ndone = 0;
+    MPI_Testsome(t->nsend, t->reqs, &ndone, t->done_idx, MPI_STATUSES_IGNORE);
+    if (ndone == MPI_UNDEFINED || ndone == 0) return 0;
+    for (int i = 0; i < ndone; i++) {
+        vw__packet *p = t->sending[t->done_idx[i]];
+        if (p->src >= 0 && vw__worker_process(w, p->src) == w->rank)
+            atomic_fetch_sub(&w->workers[p->src - w->rank * w->nworkers].outstanding, p->used);
+        free(p);
+        t->sending[t->done_idx[i]] = NULL;
+    }
+    int k = 0;
+    for (int i = 0; i < t->nsend; i++)
+        if (t->sending[i]) {
+            t->sending[k] = t->sending[i];
+            t->reqs[k] = t->reqs[i];
+            k++;
+        }
+    t->nsend = k;
+    return 1;
+}
+
+static void deliver_received(vw_world *w, mpi_tp *t, vw__packet *p)
+{
+    if (p->dest == VW__OUTPUT) {
+        vw__run_output(w, p); /* output creates no work: nothing to count */
+        free(p);
+        return;
+    }
+    vw__deliver_local(w, p, w->cfg.stress_seed ? &t->rng : NULL);
+}
+
+/* Receives what has arrived (at most a batch, so sends and waves keep moving). */
+static int receive(vw_world *w, mpi_tp *t)
+{
+    int any = 0;
+    for (int k = 0; k < 64; k++) {
+        int flag = 0, n = 0;
+        MPI_Status s;
+        MPI_Iprobe(MPI_ANY_SOURCE, TAG_DATA, t->comm, &flag, &s);
+        if (!flag) break;
+        MPI_Get_count(&s, MPI_BYTE, &n);
+        if (n < (int)WIRE_HDR) fatal(w, "received a truncated packet");
+        size_t cap = (size_t)n - WIRE_HDR;
+        vw__packet *p = vw__packet_new(0, 0, cap);
+        MPI_Recv((char *)p + WIRE_OFF, n, MPI_BYTE, s.MPI_SOURCE, TAG_DATA, t->comm, MPI_STATUS_IGNORE);
+        p->next = NULL;
+        p->cap = cap;
+        int dest_ok = p->dest == VW__OUTPUT ? w->rank == 0
+                                            : p->dest >= 0 && p->dest < w->gworkers &&
+                                                  vw__worker_process(w, p->dest) == w->rank;
+        if (p->used != cap || !dest_ok) {
+            char what[200];
+            snprintf(what, sizeof what, "packet from rank %d for worker %d is malformed "
+                     "(do all processes run the same binary and world?)", s.MPI_SOURCE, p->dest);
+            fatal(w, what);
+        }
+        t->received++;
+        any = 1;
+        if (stress_roll(w, t))
+            hold_packet(w, t, p, 0);
+        else
+            deliver_received(w, t, p);
+    }
+    return any;
+}
+
+/* Stress: lets held packets go once their time has come, in random order. */
+static int release_held(vw_world *w, mpi_tp *t)
+{
+    if (!t->nhold) return 0;
+    double now = vw__now();
+    int any = 0;
+    for (int i = 0; i < t->nhold;) {
+        uint64_t r = vw__rng_next(&t->rng);
+        int j = i + (int)(r % (uint64_t)(t->nhold - i));
+        held h = t->hold[j];
+        if (h.until > now) {
+            i++;
+            continue;
+        }
+        t->hold[j] = t->hold[--t->nhold];
+        if (h.outgoing)
+            post_send(w, t, h.p);
+        else
+            deliver_received(w, t, h.p);
+        any = 1;
+    }
+    return any;
+}
+
+/* Waits a little when nothing happened: a worker handing over a packet wakes us at
+   once; arrivals from MPI are seen after at most the current pause. */
+static void pause_idle(mpi_tp *t, int rounds)
+{
+    if (rounds < 32) {
+        sched_yield();
+        return;
+    }
+    long us = rounds < 64 ? 20 : rounds < 256 ? 100 : 400;
+    struct timespec ts;
+    clock_gettime(CLOCK_REALTIME, &ts);
+    ts.tv_nsec += us * 1000;
+    if (ts.tv_nsec >= 1000000000L) {
+        ts.tv_sec++;
+        ts.tv_nsec -= 1000000000L;
+    }
+    pthread_mutex_lock(&t->mu);
+    if (!t->qhead) {
+        t->sleeping = 1;
+        pthread_cond_timedwait(&t->cv, &t->mu, &ts);
+        t->sleeping = 0;
+    }
+    pthread_mutex_unlock(&t->mu);
+}
+
+static vw_status tp_run(vw_world *w)
+{
+    mpi_tp *t = tp_of(w);
+    int is_main = 0;
+    MPI_Is_thread_main(&is_main);
+    if (!is_main && t->level < MPI_THREAD_SERIALIZED)
+        fatal(w, "vw_world_run called from a thread other than the one that initialised MPI, "
+                 "which MPI_THREAD_FUNNELED forbids");
+    int64_t in[3], out[3], prev[3] = {1, -1, -1};
+    MPI_Request wave = MPI_REQUEST_NULL;
+    double wave_start = 0;
+    int rounds = 0;
+    for (;;) {
+        int progress = post_sends(w, t);
+        progress |= complete_sends(w, t);
+        progress |= receive(w, t);
+        progress |= release_held(w, t);
+        if (w->cfg.stress_seed && (vw__rng_next(&t->rng) & 15) == 0) {
+            struct timespec ts = {0, (long)(vw__rng_next(&t->rng) % 300000)};
+            nanosleep(&ts, NULL);
+        }
+        if (wave != MPI_REQUEST_NULL) {
+            int done = 0;
+            MPI_Test(&wave, &done, MPI_STATUS_IGNORE);
+            if (done) {
+                t->waves++;
+                if (out[0] == 0 && out[1] == out[2] && prev[0] == 0 && prev[1] == out[1] &&
+                    prev[2] == out[2])
+                    break;
+                memcpy(prev, out, sizeof prev);
+                progress = 1;
+            }
+        }
+        if (wave == MPI_REQUEST_NULL) {
+            /* Read `active` first: see the top of the file. */
+            int idle = atomic_load(&w->active) == 1 && t->nhold == 0;
+            double now = vw__now();
+            /* Busy processes join a wave at most every 2 ms, so waves cost nothing
+               while there is work; idle ones start the next one at once. */
+            if (idle || now - wave_start > 0.002) {
+                in[0] = !idle;
+                in[1] = (int64_t)atomic_load(&t->sent);
+                in[2] = (int64_t)t->received;
+                MPI_Iallreduce(in, out, 3, MPI_INT64_T, MPI_SUM, t->comm, &wave);
+                wave_start = now;
+            }
+        }
+        if (progress)
+            rounds = 0;
+        else
+            pause_idle(t, rounds++);
+    }
+    /* S == R: every posted send has been received, so its request completes. */
+    if (t->nsend) MPI_Waitall(t->nsend, t->reqs, MPI_STATUSES_IGNORE);
+    for (int i = 0; i < t->nsend; i++) {
+        vw__packet *p = t->sending[i];
+        if (p->src >= 0 && vw__worker_process(w, p->src) == w->rank)
+            atomic_fetch_sub(&w->workers[p->src - w->rank * w->nworkers].outstanding, p->used);
+        free(p);
+    }
+    t->nsend = 0;
+    atomic_store(&t->sent, 0);
+    t->received = 0;
+    vw__uncount(w); /* our count: this brings active to 0 and ends the workers' loops */
+    return VW_OK;
+}
+
+/* ---- after a run: every process gets the whole job's figures -------------------------- */
+
+/* A cell's figures are written only by its host, the others hold zeros or a copy from
+   the last sync, so a sum where only the host contributes gives the host's figures. */
+static vw_status tp_sync(vw_world *w)
+{
+    mpi_tp *t = tp_of(w);
+    int nc = w->m->ncounters;
+    size_t ni = (size_t)w->ncells * (size_t)(1 + nc), nd = (size_t)w->ncells * 2;
+    size_t nw = (size_t)w->gworkers;
+    int64_t *iv = calloc(ni + 6 * nw, sizeof *iv);
+    double *dv = calloc(nd + nw, sizeof *dv);
+    if (!iv || !dv) {
+        free(iv);
+        free(dv);
+        fatal(w, "out of memory gathering the run's figures");
+    }
+    for (int c = 0; c < w->ncells; c++) {
+        vw__cell *cl = &w->cells[c];
+        if (vw__worker_process(w, cl->worker) != w->rank) continue;
+        int64_t *row = iv + (size_t)c * (size_t)(1 + nc);
+        row[0] = (int64_t)cl->messages_in;
+        for (int k = 0; k < nc; k++) row[1 + k] = cl->counters[k];
+        dv[2 * c] = cl->busy_s;
+        dv[2 * c + 1] = w->m->load && cl->built ? vw__cell_load(w, c) : cl->busy_s;
+    }
+    int64_t *wv = iv + ni;
+    for (int i = 0; i < w->nworkers; i++) {
+        const vw__worker_stats *s = &w->wstats[w->workers[i].global];
+        int64_t *row = wv + 6 * (size_t)w->workers[i].global;
+        row[0] = (int64_t)s->msgs_sent;
+        row[1] = (int64_t)s->bytes_sent;
+        row[2] = (int64_t)s->packets_sent;
+        row[3] = (int64_t)s->msgs_remote;
+        row[4] = (int64_t)s->bytes_remote;
+        row[5] = (int64_t)s->peak_rss;
+        dv[nd + (size_t)w->workers[i].global] = s->busy_s;
+    }
+    MPI_Allreduce(MPI_IN_PLACE, iv, (int)(ni + 6 * nw), MPI_INT64_T, MPI_SUM, t->comm);
+    MPI_Allreduce(MPI_IN_PLACE, dv, (int)(nd + nw), MPI_DOUBLE, MPI_SUM, t->comm);
+    for (int c = 0; c < w->ncells; c++) {
+        vw__cell *cl = &w->cells[c];
+        const int64_t *row = iv + (size_t)c * (size_t)(1 + nc);
+        cl->messages_in = (uint64_t)row[0];
+        for (int k = 0; k < nc; k++) cl->counters[k] = row[1 + k];
+        cl->busy_s = dv[2 * c];
+        cl->load = dv[2 * c + 1];
+    }
+    for (size_t g = 0; g < nw; g++) {
+        vw__worker_stats *s = &w->wstats[g];
+        const int64_t *row = wv + 6 * g;
+        s->msgs_sent = (uint64_t)row[0];
+        s->bytes_sent = (uint64_t)row[1];
+        s->packets_sent = (uint64_t)row[2];
+        s->msgs_remote = (uint64_t)row[3];
+        s->bytes_remote = (uint64_t)row[4];
+        s->peak_rss = (uint64_t)row[5];
+        s->busy_s = dv[nd + g];
+    }
+    free(iv);
+    free(dv);
+    return VW_OK;
+}
+
+static void tp_free(vw_world *w)
+{
+    mpi_tp *t = tp_of(w);
+    int fin = 0;
+    MPI_Finalized(&fin);
+    if (!fin && t->comm != MPI_COMM_NULL) MPI_Comm_free(&t->comm);
+    while (t->qhead) {
+        vw__packet *p = t->qhead;
+        t->qhead = p->next;
+        free(p);
+    }
+    for (int i = 0; i < t->nhold; i++) free(t->hold[i].p);
+    free(t->hold);
+    free(t->reqs);
+    free(t->sending);
+    free(t->done_idx);
+    pthread_mutex_destroy(&t->mu);
+    pthread_cond_destroy(&t->cv);
+    free(t);
+    w->transport = NULL;
+}
+
+/* ---- choosing the engine at create ------------------------------------------------------ */
+
+vw_status vw__mpi_attach(vw_world *w)
+{
+    char msg[300] = "";
+    int init = 0, fin = 0;
+    MPI_Initialized(&init);
+    MPI_Finalized(&fin);
+    MPI_Comm base;
+    if (w->cfg.mpi_comm) {
+        if (!init || fin)
+            return vw__world_error(w, VW_E_STATE, "an MPI communicator was given but MPI is not initialised");
+        base = *(const MPI_Comm *)w->cfg.mpi_comm;
+    } else if (init && !fin) {
+        base = MPI_COMM_WORLD;
+    } else if (!fin && vw__mpi_launcher_env()) {
+        vw_status st = vw__mpi_autoinit(msg, sizeof msg);
+        if (st != VW_OK) return vw__world_error(w, st, "%s", msg);
+        base = MPI_COMM_WORLD;
+    } else {
+        return VW_OK; /* the threads engine alone */
+    }
+    int level = MPI_THREAD_SINGLE, size = 1, rank = 0;
+    MPI_Query_thread(&level);
+    MPI_Comm_size(base, &size);
+    MPI_Comm_rank(base, &rank);
+    if (level < VW__MPI_THREAD_LEVEL)
+        return vw__world_error(w, VW_E_MPI, "MPI was initialised with thread level %d; vwalls needs "
+                               "at least MPI_THREAD_FUNNELED", level);
+    if (size == 1) return VW_OK; /* one process: the threads engine, without polling */
+    /* Every process needs the same worker count (global worker = rank * W + local). With
+       workers = 0 (as many as cores) the machines may differ: take the smallest. */
+    int wmin = w->nworkers, wmax = w->nworkers, mine[2] = {w->nworkers, -w->nworkers}, all[2];
+    MPI_Allreduce(mine, all, 2, MPI_INT, MPI_MIN, base);
+    wmin = all[0];
+    wmax = -all[1];
+    if (wmin != wmax && w->cfg.workers > 0)
+        return vw__world_error(w, VW_E_INVAL, "processes were given different worker counts (%d to %d)",
+                               wmin, wmax);
+    mpi_tp *t = calloc(1, sizeof *t);
+    if (!t) return VW_E_NOMEM;
+    MPI_Comm_dup(base, &t->comm);
+    MPI_Comm_set_errhandler(t->comm, MPI_ERRORS_ARE_FATAL);
+    t->level = level;
+    pthread_mutex_init(&t->mu, NULL);
+    pthread_cond_init(&t->cv, NULL);
+    atomic_init(&t->sent, 0);
+    t->rng = w->cfg.stress_seed * 0x9e3779b97f4a7c15ull + (uint64_t)rank * 7919u + 3;
+    t->base.name = "mpi";
+    t->base.send = tp_send;
+    t->base.run = tp_run;
+    t->base.sync = tp_sync;
+    t->base.free = tp_free;
+    t->base.impl = t;
+    w->transport = &t->base;
+    w->rank = rank;
+    w->nprocs = size;
+    w->nworkers = wmin;
+    return VW_OK;
+}

@@ -1,0 +1,157 @@
+/* mpi_engine.c - the process-level MPI engine: is this an MPI job, start-up and shutdown
+ * at the thread level the transport needs, ending the job on a failure, and agreement
+ * between ranks (the lowest failing rank's status and message reach every rank).
+ */
+#include "transport/mpi_internal.h"
+#include "vwalls/engine.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+static int we_initialised; /* MPI_Init_thread was called by vw_engine_init / autoinit */
+
+/* Variables the launchers of Open MPI, MPICH (Hydra), PMIx-based and Slurm set in every
+   process they start. Without one of them (and MPI not initialised) the process runs
+   the threads engine and never touches MPI, not even for a singleton init. */
+int vw__mpi_launcher_env(void)
+{
+    static const char *const vars[] = {"OMPI_COMM_WORLD_SIZE", "PMI_SIZE", "PMI_RANK",
+                                       "PMIX_RANK", "MPI_LOCALNRANKS", "SLURM_PROCID"};
+    for (size_t i = 0; i < sizeof vars / sizeof vars[0]; i++) {
+        const char *v = getenv(vars[i]);
+        if (v && *v) return 1;
+    }
+    return 0;
+}
+
+static int mpi_up(void)
+{
+    int init = 0, fin = 0;
+    MPI_Initialized(&init);
+    MPI_Finalized(&fin);
+    return init && !fin;
+}
+
+int vw_engine_launched(void) { return mpi_up() || vw__mpi_launcher_env(); }
+
+static const char *level_name(int l)
+{
+    switch (l) {
+    case MPI_THREAD_SINGLE: return "MPI_THREAD_SINGLE";
+    case MPI_THREAD_FUNNELED: return "MPI_THREAD_FUNNELED";
+    case MPI_THREAD_SERIALIZED: return "MPI_THREAD_SERIALIZED";
+    case MPI_THREAD_MULTIPLE: return "MPI_THREAD_MULTIPLE";
+    default: return "an unknown thread level";
+    }
+}
+
+static vw_status check_level(int got, char *msg, size_t len)
+{
+    if (got >= VW__MPI_THREAD_LEVEL) return VW_OK;
+    if (msg && len)
+        snprintf(msg, len, "MPI offers only %s; vwalls needs %s (worker threads run beside "
+                 "the thread that makes the MPI calls)", level_name(got),
+                 level_name(VW__MPI_THREAD_LEVEL));
+    return VW_E_MPI;
+}
+
+vw_status vw_engine_init(int *argc, char ***argv, char *msg, size_t len)
+{
+    if (msg && len) msg[0] = 0;
+    int init = 0;
+    MPI_Initialized(&init);
+    if (init) {
+        int got;
+        MPI_Query_thread(&got);
+        return check_level(got, msg, len);
+    }
+    if (!vw__mpi_launcher_env()) return VW_OK;
+    int got = MPI_THREAD_SINGLE;
+    if (MPI_Init_thread(argc, argv, VW__MPI_THREAD_LEVEL, &got) != MPI_SUCCESS) {
+        if (msg && len) snprintf(msg, len, "MPI_Init_thread failed");
+        return VW_E_MPI;
+    }
+    we_initialised = 1;
+    return check_level(got, msg, len);
+}
+
+void vw_engine_finish(void)
+{
+    if (we_initialised && mpi_up()) MPI_Finalize();
+    we_initialised = 0;
+}
+
+static void finish_at_exit(void) { vw_engine_finish(); }
+
+vw_status vw__mpi_autoinit(char *msg, size_t len)
+{
+    vw_status st = vw_engine_init(NULL, NULL, msg, len);
+    if (we_initialised) atexit(finish_at_exit);
+    return st;
+}
+
+void vw_engine_abort(int status, const char *msg)
+{
+    if (msg) fprintf(stderr, "%s\n", msg);
+    fflush(NULL);
+    if (mpi_up()) MPI_Abort(MPI_COMM_WORLD, status ? status : 1);
+    _exit(status ? status : 1);
+}
+
+int vw_engine_rank(void)
+{
+    int r = 0;
+    if (mpi_up()) MPI_Comm_rank(MPI_COMM_WORLD, &r);
+    return r;
+}
+
+int vw_engine_size(void)
+{
+    int n = 1;
+    if (mpi_up()) MPI_Comm_size(MPI_COMM_WORLD, &n);
+    return n;
+}
+
+/* Two collectives: the lowest failing rank (MIN of rank-or-size), then its status and
+   message broadcast from it. Costs O(log P) when everybody is fine. */
+vw_status vw__mpi_agree(MPI_Comm comm, vw_status local, char *msg, size_t len)
+{
+    int rank, size;
+    MPI_Comm_rank(comm, &rank);
+    MPI_Comm_size(comm, &size);
+    int mine = local != VW_OK ? rank : size, first = size;
+    MPI_Allreduce(&mine, &first, 1, MPI_INT, MPI_MIN, comm);
+    if (first == size) return VW_OK;
+    struct {
+        int status;
+        char text[1020];
+    } b;
+    memset(&b, 0, sizeof b);
+    if (rank == first) {
+        b.status = (int)local;
+        snprintf(b.text, sizeof b.text, "rank %d: %s", first,
+                 msg && *msg ? msg : vw_status_message(local));
+    }
+    MPI_Bcast(&b, (int)sizeof b, MPI_BYTE, first, comm);
+    if (msg && len) snprintf(msg, len, "%s", b.text);
+    return (vw_status)b.status;
+}
+
+vw_status vw_engine_agree(vw_status local, char *msg, size_t len)
+{
+    if (!mpi_up()) return local;
+    int size;
+    MPI_Comm_size(MPI_COMM_WORLD, &size);
+    if (size == 1) return local;
+    return vw__mpi_agree(MPI_COMM_WORLD, local, msg, len);
+}
+
+vw_status vw_world_agree(vw_world *w, vw_status local, char *msg, size_t len)
+{
+    if (!w) return VW_E_INVAL;
+    MPI_Comm c = vw__mpi_world_comm(w);
+    if (c == MPI_COMM_NULL) return local;
+    return vw__mpi_agree(c, local, msg, len);
+}

@@ -1,0 +1,89 @@
+# mpi.cmake - tests of the MPI engine (only when the build found MPI): the example module
+# and a message storm under np 1, 2, 4, 8 with 1 and 2 workers per process, giving the
+# threads engine's results, also under the stress switches; agreement between ranks;
+# a rank that dies or exits mid-run (the job must end within 10 s with a message naming
+# it); and two "machines" in network namespaces. Label "mpi".
+
+if(NOT VW_HAVE_MPI)
+  return()
+endif()
+
+# Open MPI needs --oversubscribe to start more processes than cores (MPICH does not
+# know the flag), and refuses root unless told it is fine.
+set(VW_MPI_PREFLAGS ${MPIEXEC_PREFLAGS})
+set(VW_MPI_FLAVOUR mpich)
+execute_process(COMMAND ${MPIEXEC_EXECUTABLE} --version OUTPUT_VARIABLE _vw_mpiexec_version
+                ERROR_QUIET)
+if(_vw_mpiexec_version MATCHES "Open MPI|OpenRTE")
+  set(VW_MPI_FLAVOUR openmpi)
+  list(APPEND VW_MPI_PREFLAGS --oversubscribe)
+endif()
+set(VW_MPI_ENV "OMPI_ALLOW_RUN_AS_ROOT=1;OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1")
+
+add_executable(test_mpi_storm ${PROJECT_SOURCE_DIR}/tests/mpi/test_mpi_storm.c)
+target_include_directories(test_mpi_storm PRIVATE ${PROJECT_SOURCE_DIR}/tests)
+target_link_libraries(test_mpi_storm PRIVATE vwalls_static m)
+target_compile_definitions(test_mpi_storm PRIVATE _GNU_SOURCE)
+
+# vw_mpi_test(NAME NP [ENV list] COMMAND args...)
+function(vw_mpi_test name np)
+  cmake_parse_arguments(A "" "" "ENV;COMMAND" ${ARGN})
+  add_test(NAME ${name}
+           COMMAND ${MPIEXEC_EXECUTABLE} ${MPIEXEC_NUMPROC_FLAG} ${np} ${VW_MPI_PREFLAGS}
+                   ${A_COMMAND} ${MPIEXEC_POSTFLAGS})
+  set_tests_properties(${name} PROPERTIES LABELS "mpi" TIMEOUT 120
+                       ENVIRONMENT "${VW_MPI_ENV};${A_ENV}" PROCESSORS 2)
+endfunction()
+
+foreach(np 1 2 4 8)
+  foreach(w 1 2)
+    vw_mpi_test(mpi_storm_np${np}_w${w} ${np} COMMAND $<TARGET_FILE:test_mpi_storm> --workers ${w} --seeds 2)
+    vw_mpi_test(mpi_pairs_np${np}_w${w} ${np}
+                COMMAND $<TARGET_FILE:vwalls_tool> example-pairs --spheres 3000 --radius 0.03 --seed 5
+                        --cells 4x4x2 --workers ${w} --check --quiet)
+  endforeach()
+endforeach()
+foreach(np 2 4 8)
+  vw_mpi_test(mpi_storm_stress_np${np} ${np} ENV "VW_STRESS=${np}"
+              COMMAND $<TARGET_FILE:test_mpi_storm> --workers 2 --seeds 2)
+  vw_mpi_test(mpi_storm_split_np${np} ${np} ENV "VW_STRESS=1${np};VW_STRESS_SPLIT=1"
+              COMMAND $<TARGET_FILE:test_mpi_storm> --workers 1 --seeds 1)
+endforeach()
+vw_mpi_test(mpi_pairs_stress_np4 4 ENV "VW_STRESS=99"
+            COMMAND $<TARGET_FILE:vwalls_tool> example-pairs --spheres 3000 --radius 0.03 --cells 4x4x4
+                    --workers 2 --check --quiet)
+# The threads engine's storm test, unchanged, run by every rank of an MPI job.
+if(TARGET test_storm)
+  vw_mpi_test(mpi_core_storm_np3 3 COMMAND $<TARGET_FILE:test_storm> 2)
+endif()
+vw_mpi_test(mpi_agree_np1 1 COMMAND $<TARGET_FILE:test_mpi_storm> --agree)
+vw_mpi_test(mpi_agree_np3 3 COMMAND $<TARGET_FILE:test_mpi_storm> --agree)
+
+# Counters and per-cell messages of the stats JSON equal the threads engine's.
+set(VW_MPI_LAUNCH ${MPIEXEC_EXECUTABLE} ${MPIEXEC_NUMPROC_FLAG})
+foreach(np 2 4)
+  add_test(NAME mpi_pairs_same_stats_np${np}
+           COMMAND sh ${PROJECT_SOURCE_DIR}/tests/mpi/same_stats.sh $<TARGET_FILE:vwalls_tool>
+                   "${MPIEXEC_EXECUTABLE} ${MPIEXEC_NUMPROC_FLAG} ${np} ${VW_MPI_PREFLAGS}")
+  set_tests_properties(mpi_pairs_same_stats_np${np} PROPERTIES LABELS "mpi" TIMEOUT 120
+                       ENVIRONMENT "${VW_MPI_ENV}" PROCESSORS 2)
+endforeach()
+
+# Faults: the job ends within 10 s, non-zero, naming the rank.
+foreach(mode kill exit)
+  add_test(NAME mpi_fault_${mode}
+           COMMAND sh ${PROJECT_SOURCE_DIR}/tests/mpi/fault.sh ${mode} $<TARGET_FILE:test_mpi_storm>
+                   "${MPIEXEC_EXECUTABLE} ${MPIEXEC_NUMPROC_FLAG} 4 ${VW_MPI_PREFLAGS}")
+  set_tests_properties(mpi_fault_${mode} PROPERTIES LABELS "mpi" TIMEOUT 60
+                       ENVIRONMENT "${VW_MPI_ENV}" PROCESSORS 2)
+endforeach()
+
+# Two machines: network namespaces joined by a veth pair, TCP only (Open MPI's rsh
+# launcher into the namespaces). Skipped where namespaces cannot be made.
+if(VW_MPI_FLAVOUR STREQUAL "openmpi")
+  add_test(NAME mpi_two_hosts
+           COMMAND sh ${PROJECT_SOURCE_DIR}/tests/mpi/two_hosts.sh $<TARGET_FILE:vwalls_tool>
+                   ${MPIEXEC_EXECUTABLE})
+  set_tests_properties(mpi_two_hosts PROPERTIES LABELS "mpi" TIMEOUT 180 SKIP_RETURN_CODE 77
+                       ENVIRONMENT "${VW_MPI_ENV}" RUN_SERIAL TRUE)
+endif()

@@ -1,0 +1,287 @@
+/* test_mpi_storm.c - a message storm across processes: chains of tokens hop between
+ * random cells (so most hops cross a process boundary under MPI), some go to the output
+ * process, some are posted before the run. What arrives is a pure function of the seed,
+ * so every rank checks the global counters, per-cell figures and output against a
+ * sequential reference, over two runs of the same world. Also: agreement between ranks,
+ * and a rank that dies in the middle of a run (for the fault tests).
+ *
+ * usage: test_mpi_storm [--workers W] [--seeds N] [--agree] [--kill-rank R] [--exit-rank R]
+ * Runs alone (threads engine) or under mpirun; honours VW_STRESS / VW_STRESS_SPLIT.
+ */
+#include <signal.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "vw_test.h"
+#include "vwalls/engine.h"
+#include "vwalls/vwalls.h"
+
+enum { MSG_TOKEN, MSG_POSTED, NKINDS };
+enum { CNT_RECEIVED, CNT_SUM, CNT_CORRUPT, CNT_OUTPUT, CNT_POSTED, NCOUNTERS };
+
+typedef struct token {
+    uint64_t key;
+    uint32_t hops;
+    uint32_t len;
+    unsigned char payload[96];
+} token;
+
+typedef struct storm {
+    uint64_t seed;
+    int ncells, roots;
+    int64_t output_sum;   /* output handler only (serialised, rank 0) */
+    int kill_rank;        /* -1: nobody dies */
+} storm;
+
+static uint64_t mix(uint64_t z)
+{
+    z += 0x9e3779b97f4a7c15ull;
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+    return z ^ (z >> 31);
+}
+
+static void fill(token *t, uint64_t key, uint32_t hops)
+{
+    t->key = key;
+    t->hops = hops;
+    t->len = (uint32_t)(mix(key ^ 1) % sizeof t->payload);
+    for (uint32_t i = 0; i < t->len; i++) t->payload[i] = (unsigned char)mix(key + i);
+}
+
+static int nchildren(const token *t) { return t->hops ? 1 + (int)(mix(t->key ^ 2) % 2) : 0; }
+static int dest_of(uint64_t key, int ncells) { return (int)(mix(key ^ 3) % (uint64_t)ncells); }
+static uint64_t child_key(const token *t, int c) { return mix(t->key + 100 + (uint64_t)c); }
+static int64_t low(uint64_t k) { return (int64_t)(k & 0xffffffu); }
+
+/* The reference: deliveries per cell, key sum, output count and output key sum. */
+static void expect(uint64_t key, uint32_t hops, int ncells, int64_t *per_cell, int64_t *sum,
+                   int64_t *outputs, int64_t *outsum)
+{
+    token t;
+    fill(&t, key, hops);
+    per_cell[dest_of(key, ncells)]++;
+    *sum += low(key);
+    if ((key & 7) == 0) (*outputs)++, *outsum += low(key);
+    for (int c = 0; c < nchildren(&t); c++)
+        expect(child_key(&t, c), hops - 1, ncells, per_cell, sum, outputs, outsum);
+}
+
+static uint64_t root_key(const storm *st, int cell, int r)
+{
+    return mix(st->seed ^ ((uint64_t)cell << 24) ^ (uint64_t)r);
+}
+
+typedef struct tcell {
+    int roots_sent;
+} tcell;
+
+static vw_status build(vw_ctx *ctx, const void *objs, size_t n, void **state)
+{
+    (void)ctx, (void)objs, (void)n;
+    *state = calloc(1, sizeof(tcell));
+    return *state ? VW_OK : VW_E_NOMEM;
+}
+
+static void cell_free(void *state, void *user)
+{
+    (void)user;
+    free(state);
+}
+
+static int step(vw_ctx *ctx, void *state)
+{
+    tcell *tc = state;
+    storm *st = vw_ctx_user(ctx);
+    if (tc->roots_sent == st->roots) return 0;
+    uint64_t key = root_key(st, vw_ctx_cell(ctx), tc->roots_sent++);
+    token t;
+    fill(&t, key, 2 + (uint32_t)(key % 5));
+    vw_send_cell(ctx, dest_of(key, st->ncells), MSG_TOKEN, &t);
+    return 1;
+}
+
+static void on_token(vw_ctx *ctx, void *state, const void *msg)
+{
+    (void)state;
+    const token *t = msg;
+    storm *st = vw_ctx_user(ctx);
+    static _Atomic long handled;
+    if (st->kill_rank == vw_ctx_process(ctx) && ++handled == 500) raise(SIGKILL);
+    token check;
+    fill(&check, t->key, t->hops);
+    if (check.len != t->len || memcmp(check.payload, t->payload, t->len) != 0 ||
+        dest_of(t->key, st->ncells) != vw_ctx_cell(ctx))
+        vw_count(ctx, CNT_CORRUPT, 1);
+    vw_count(ctx, CNT_RECEIVED, 1);
+    vw_count(ctx, CNT_SUM, low(t->key));
+    if ((t->key & 7) == 0) {
+        vw_send_output(ctx, MSG_TOKEN, t);
+        vw_count(ctx, CNT_OUTPUT, 1);
+    }
+    for (int c = 0; c < nchildren(t); c++) {
+        token k;
+        uint64_t key = child_key(t, c);
+        fill(&k, key, t->hops - 1);
+        vw_send_cell(ctx, dest_of(key, st->ncells), MSG_TOKEN, &k);
+    }
+}
+
+static void on_posted(vw_ctx *ctx, void *state, const void *msg)
+{
+    (void)state;
+    const int64_t *v = msg;
+    vw_count(ctx, CNT_POSTED, *v);
+}
+
+static void on_output(void *user, const void *msg)
+{
+    storm *st = user;
+    st->output_sum += low(((const token *)msg)->key);
+}
+
+static const vw_msg_kind kinds[NKINDS] = {
+    [MSG_TOKEN] = {"token", sizeof(token), on_token, on_output},
+    [MSG_POSTED] = {"posted", sizeof(int64_t), on_posted, NULL},
+};
+static const char *const counters[NCOUNTERS] = {"received", "sum", "corrupt", "output", "posted"};
+static const vw_module storm_module = {
+    .abi = VW_MODULE_ABI,
+    .name = "mpi-storm",
+    .kinds = kinds,
+    .nkinds = NKINDS,
+    .counters = counters,
+    .ncounters = NCOUNTERS,
+    .cell_build = build,
+    .cell_free = cell_free,
+    .step = step,
+};
+
+/* Every rank passes a status; rank `bad` fails. All must agree on rank bad's message. */
+static void test_agree(int bad)
+{
+    int rank = vw_engine_rank(), size = vw_engine_size();
+    char msg[256];
+    snprintf(msg, sizeof msg, "%s", rank == bad ? "scene.nff:3: bad number 'x'" : "");
+    vw_status st = vw_engine_agree(rank == bad ? VW_E_INPUT : VW_OK, msg, sizeof msg);
+    if (bad < size) {
+        CHECK_EQ_INT(st, VW_E_INPUT);
+        char want[256];
+        snprintf(want, sizeof want, size > 1 ? "rank %d: scene.nff:3: bad number 'x'"
+                                             : "scene.nff:3: bad number 'x'", bad);
+        if (strcmp(msg, want) != 0) {
+            fprintf(stderr, "rank %d: agreed message '%s', expected '%s'\n", rank, msg, want);
+            exit(1);
+        }
+    } else {
+        CHECK_EQ_INT(st, VW_OK);
+    }
+    CHECK_EQ_INT(vw_engine_agree(VW_OK, NULL, 0), VW_OK);
+}
+
+int main(int argc, char **argv)
+{
+    int workers = 2, seeds = 3, agree = 0, kill_rank = -1, exit_rank = -1;
+    for (int i = 1; i < argc; i++) {
+        if (!strcmp(argv[i], "--workers") && i + 1 < argc) workers = atoi(argv[++i]);
+        else if (!strcmp(argv[i], "--seeds") && i + 1 < argc) seeds = atoi(argv[++i]);
+        else if (!strcmp(argv[i], "--agree")) agree = 1;
+        else if (!strcmp(argv[i], "--kill-rank") && i + 1 < argc) kill_rank = atoi(argv[++i]);
+        else if (!strcmp(argv[i], "--exit-rank") && i + 1 < argc) exit_rank = atoi(argv[++i]);
+        else {
+            fprintf(stderr, "test_mpi_storm: bad argument '%s'\n", argv[i]);
+            return 2;
+        }
+    }
+    char err[256];
+    if (vw_engine_init(&argc, &argv, err, sizeof err) != VW_OK) {
+        fprintf(stderr, "test_mpi_storm: %s\n", err);
+        return 1;
+    }
+    int rank = vw_engine_rank();
+    if (agree) {
+        for (int bad = 0; bad <= vw_engine_size(); bad++) test_agree(bad);
+        if (rank == 0) printf("agreement: %d checks passed\n", vw_test_checks);
+        vw_engine_finish();
+        return 0;
+    }
+    vw_box box = {{0, 0, 0}, {1, 1, 1}};
+    const char *layouts[] = {"1", "2x2", "3x1x2", "2x2x2", "4x4x2"};
+    int64_t total = 0;
+    for (int seed = 1; seed <= seeds; seed++)
+        for (size_t li = 0; li < sizeof layouts / sizeof layouts[0]; li++) {
+            int dims[3];
+            CHECK_EQ_INT(vw_layout_parse(layouts[li], dims, NULL, 0), VW_OK);
+            vw_decomp *d;
+            CHECK_EQ_INT(vw_decomp_create_grid(&box, dims, &d), VW_OK);
+            int ncells = vw_decomp_cell_count(d);
+            storm st = {(uint64_t)seed * 104729u + li, ncells, 5 + (seed * 7 + (int)li) % 30, 0, kill_rank};
+            int64_t *per_cell = calloc((size_t)ncells, sizeof *per_cell);
+            int64_t sum = 0, outputs = 0, outsum = 0;
+            for (int c = 0; c < ncells; c++)
+                for (int r = 0; r < st.roots; r++) {
+                    uint64_t key = root_key(&st, c, r);
+                    expect(key, 2 + (uint32_t)(key % 5), ncells, per_cell, &sum, &outputs, &outsum);
+                }
+            vw_config cfg;
+            vw_config_init(&cfg);
+            cfg.workers = workers;
+            cfg.packet_bytes = 64 + (size_t)(seed * 1499 + (int)li * 613) % 4096;
+            vw_world *w;
+            CHECK_EQ_INT(vw_world_create(&storm_module, &st, d, &cfg, &w), VW_OK);
+            if (exit_rank == vw_world_process(w) && seed == 1 && li == 1) {
+                fprintf(stderr, "test_mpi_storm: rank %d exits on purpose\n", exit_rank);
+                exit(3); /* without MPI_Finalize, while the others wait for it */
+            }
+            /* Every rank posts every message; each is kept by its cell's process only. */
+            for (int c = 0; c < ncells; c++) {
+                int64_t v = c + 1;
+                CHECK_EQ_INT(vw_world_post(w, c, MSG_POSTED, &v), VW_OK);
+            }
+            CHECK_EQ_INT(vw_world_run(w), VW_OK);
+            int64_t want = 0;
+            for (int c = 0; c < ncells; c++) want += per_cell[c];
+            CHECK_EQ_INT(vw_world_counter(w, CNT_RECEIVED), want);
+            CHECK_EQ_INT(vw_world_counter(w, CNT_SUM), sum);
+            CHECK_EQ_INT(vw_world_counter(w, CNT_CORRUPT), 0);
+            CHECK_EQ_INT(vw_world_counter(w, CNT_OUTPUT), outputs);
+            CHECK_EQ_INT(vw_world_counter(w, CNT_POSTED), (int64_t)ncells * (ncells + 1) / 2);
+            if (vw_world_is_output(w)) CHECK_EQ_INT(st.output_sum, outsum);
+            for (int c = 0; c < ncells; c++) {
+                vw_cell_stats cs;
+                CHECK_EQ_INT(vw_world_cell_stats(w, c, &cs), VW_OK);
+                CHECK_EQ_INT(cs.messages_in, per_cell[c] + 1); /* + its posted message */
+                CHECK_EQ_INT(vw_world_cell_counter(w, c, CNT_POSTED), c + 1);
+                CHECK(cs.busy_s >= 0);
+            }
+            double busy = 0;
+            for (int g = 0; g < vw_world_processes(w) * vw_world_workers(w); g++)
+                busy += vw_world_worker_busy(w, g);
+            CHECK(busy > 0);
+            CHECK(vw_world_imbalance(w) >= 1.0 - 1e-9);
+            /* Second run: only new posts; counters accumulate, nothing else moves. */
+            for (int c = 0; c < ncells; c++) {
+                int64_t v = 1000;
+                CHECK_EQ_INT(vw_world_post(w, c, MSG_POSTED, &v), VW_OK);
+            }
+            CHECK_EQ_INT(vw_world_run(w), VW_OK);
+            CHECK_EQ_INT(vw_world_counter(w, CNT_RECEIVED), want);
+            CHECK_EQ_INT(vw_world_counter(w, CNT_POSTED),
+                         (int64_t)ncells * (ncells + 1) / 2 + 1000 * (int64_t)ncells);
+            vw_cell_stats cs0;
+            CHECK_EQ_INT(vw_world_cell_stats(w, 0, &cs0), VW_OK);
+            CHECK_EQ_INT(cs0.messages_in, per_cell[0] + 2);
+            if (seed == 1 && li == 3 && vw_world_is_output(w)) {
+                const char *path = getenv("VW_TEST_STATS");
+                if (path) CHECK_EQ_INT(vw_world_write_stats(w, path, "test-mpi-storm", NULL), VW_OK);
+            }
+            total += want;
+            vw_world_free(w);
+            vw_decomp_free(d);
+            free(per_cell);
+        }
+    if (rank == 0) printf("%lld tokens delivered on %d process(es); %d checks passed\n",
+                          (long long)total, vw_engine_size(), vw_test_checks);
+    vw_engine_finish();
+    return 0;
+}

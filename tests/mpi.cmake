@@ -83,7 +83,7 @@ endforeach()
 if(VW_MPI_FLAVOUR STREQUAL "openmpi")
   add_test(NAME mpi_two_hosts
            COMMAND sh ${PROJECT_SOURCE_DIR}/tests/mpi/two_hosts.sh $<TARGET_FILE:vwalls_tool>
-                   ${MPIEXEC_EXECUTABLE})
+                   ${MPIEXEC_EXECUTABLE} ${PROJECT_SOURCE_DIR}/tests/data/good/mixed.nff)
   set_tests_properties(mpi_two_hosts PROPERTIES LABELS "mpi" TIMEOUT 180 SKIP_RETURN_CODE 77
                        ENVIRONMENT "${VW_MPI_ENV}" RUN_SERIAL TRUE)
 endif()

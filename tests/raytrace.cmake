@@ -16,8 +16,12 @@ add_test(NAME raytrace_identical_mixed COMMAND vw_test_raytrace identical ${VW_R
 # The same under the stress switch (random delays and reordering of deliveries).
 add_test(NAME raytrace_stress_balls COMMAND vw_test_raytrace identical gen:balls:2 64x64)
 add_test(NAME raytrace_stress_mixed COMMAND vw_test_raytrace identical ${VW_RT_MIXED} 64x64)
-set_tests_properties(raytrace_stress_balls PROPERTIES ENVIRONMENT "VW_STRESS=7")
-set_tests_properties(raytrace_stress_mixed PROPERTIES ENVIRONMENT "VW_STRESS=1994;VW_STRESS_SPLIT=1")
+set(VW_RT_TSAN "TSAN_OPTIONS=suppressions=${PROJECT_SOURCE_DIR}/tests/raytrace/tsan.supp")
+set_tests_properties(raytrace_cone raytrace_analytic raytrace_identical_balls
+  raytrace_identical_mixed PROPERTIES ENVIRONMENT "${VW_RT_TSAN}")
+set_tests_properties(raytrace_stress_balls PROPERTIES ENVIRONMENT "VW_STRESS=7;${VW_RT_TSAN}")
+set_tests_properties(raytrace_stress_mixed PROPERTIES
+  ENVIRONMENT "VW_STRESS=1994;VW_STRESS_SPLIT=1;${VW_RT_TSAN}")
 
 # The command line: PNG files byte-identical across layouts and workers, the stats JSON,
 # exit status 2 and no output file for a bad scene.
@@ -25,6 +29,7 @@ add_test(NAME raytrace_cli
   COMMAND ${CMAKE_COMMAND} -DVWALLS=$<TARGET_FILE:vwalls_tool> -DSCENE=${VW_RT_MIXED}
           -DWORK=${CMAKE_CURRENT_BINARY_DIR}/raytrace_cli
           -P ${PROJECT_SOURCE_DIR}/tests/raytrace/cli.cmake)
+set_tests_properties(raytrace_cli PROPERTIES ENVIRONMENT "${VW_RT_TSAN}")
 
 # bench/raytrace.sh: Embree's raw ray-casting rate for the same rays (the kernel limit).
 if(EXISTS ${PROJECT_SOURCE_DIR}/bench/embree_raw.c)

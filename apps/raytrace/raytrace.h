@@ -96,11 +96,15 @@ typedef struct rt_shared {
     void *device;    /* RTCDevice, one per process, shared by every cell */
     /* Output process only: */
     int64_t (*accum)[3];        /* width*height fixed-point sums */
-    atomic_llong pixels_done;   /* eye rays that have ended (progress) */
-    atomic_llong entries;       /* contributions received */
+    /* The counters below are written while every worker reads the fields above for
+       every ray: each gets a cache line of its own, or the writes would bounce the
+       read-mostly line between cores. */
+    _Alignas(64) atomic_llong pixels_done; /* eye rays that have ended (progress) */
+    _Alignas(64) atomic_llong entries;     /* contributions received */
     /* Every process: rays created so far, published by the cells in batches (for the
        progress bar's rays/s; the exact counts are the module counters). */
-    atomic_llong rays;
+    _Alignas(64) atomic_llong rays;
+    char pad_end[64 - sizeof(atomic_llong)];
 } rt_shared;
 
 extern const vw_module rt_module;

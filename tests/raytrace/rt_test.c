@@ -5,6 +5,7 @@
  *   analytic              one diffuse sphere and one light against the formula, 1/255
  *   cone                  the cone/cylinder intersection against sampled points
  *   write SCENE WxH LAYOUT WORKERS OUT.png   (a helper for looking at pictures)
+ *   nff SCENE             the scene as NFF on stdout (gen:balls:4 for the benchmark)
  */
 #include <math.h>
 #include <stdio.h>
@@ -304,8 +305,18 @@ static int write_png(int argc, char **argv)
     return st == VW_OK ? 0 : 1;
 }
 
+/* The NFF text of a scene spec (for the benchmark, which needs a file). */
+static int write_nff(const char *spec)
+{
+    vw_scene *s = load(spec);
+    vw_status st = vw_scene_write_nff(s, stdout);
+    vw_scene_free(s);
+    return st == VW_OK ? 0 : 1;
+}
+
 int main(int argc, char **argv)
 {
+    if (argc >= 3 && !strcmp(argv[1], "nff")) return write_nff(argv[2]);
     if (argc >= 3 && !strcmp(argv[1], "identical")) return test_identical(argv[2], argc > 3 ? argv[3] : NULL);
     if (argc >= 2 && !strcmp(argv[1], "analytic")) return test_analytic();
     if (argc >= 2 && !strcmp(argv[1], "cone")) return test_cone();

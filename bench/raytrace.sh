@@ -1,0 +1,96 @@
+#!/bin/bash
+# raytrace.sh - the ray tracer's benchmarks, measured side by side in one run:
+#  (a) vwalls render vs POV-Ray 3.7 on the same sphereflake (SIZE, 1 sample/pixel,
+#      depth 5, its 3 lights), one thread each and two threads each;
+#  (b) vwalls on 1 cell vs a raw rtcIntersect1/rtcOccluded1 loop over the same ray tree
+#      (bench/embree_raw.c): the framework's overhead over Embree's kernel;
+#  (c) 2x2x2 cells vs 1 cell on 1 worker, and 2 workers vs 1.
+# Whole processes are timed with date +%s.%N (best of REPEAT runs).
+# usage: bench/raytrace.sh [BUILD_DIR] [SIZE] [REPEAT]     (e.g. bench/raytrace.sh build 512 3)
+set -euo pipefail
+B=${1:-build}
+SIZE=${2:-512}
+REPEAT=${3:-3}
+HERE=$(cd "$(dirname "$0")" && pwd)
+VW=$B/vwalls
+RAW=$B/vw_bench_embree_raw
+T=$(mktemp -d)
+trap 'rm -rf "$T"' EXIT
+
+for x in "$VW" "$RAW"; do
+  [ -x "$x" ] || { echo "raytrace.sh: $x not built (cmake --build $B)" >&2; exit 1; }
+done
+
+# The scene: SPD "balls" (sphereflake, level 4: 7382 spheres, 3 lights).
+if "$VW" gen balls > "$T/balls.nff" 2>/dev/null; then :; else
+  "$B/vw_test_raytrace" nff gen:balls:4 > "$T/balls.nff"
+fi
+python3 "$HERE/nff2pov.py" "$T/balls.nff" "$SIZE" "$SIZE" 5 > "$T/balls.pov"
+
+# best-of-N wall time of a whole command, in seconds
+timeit() {
+  local best=""
+  for _ in $(seq "$REPEAT"); do
+    local s e
+    s=$(date +%s.%N)
+    "$@" > "$T/last.out" 2> "$T/last.err" || { cat "$T/last.err" >&2; exit 1; }
+    e=$(date +%s.%N)
+    best=$(awk -v a="$s" -v b="$e" -v best="$best" 'BEGIN { d = b - a; if (best == "" || d < best) best = d; printf "%.3f", best }')
+  done
+  echo "$best"
+}
+ratio() { awk -v a="$1" -v b="$2" 'BEGIN { printf "%.2f", a / b }'; }
+
+render() { "$VW" render "$T/balls.nff" -o "$T/vw.png" --size "${SIZE}x${SIZE}" --depth 5 --quiet "$@"; }
+pov() {
+  (cd "$T" && povray +I"$T/balls.pov" +O"$T/pov.png" +W"$SIZE" +H"$SIZE" -D -A +Q9 \
+     File_Gamma=1.0 +WT"$1")
+}
+
+echo "ray tracer benchmark: sphereflake (balls), ${SIZE}x${SIZE}, depth 5, best of $REPEAT"
+echo "machine: $(nproc) cores; $(uname -sr)"
+echo
+
+# (a) vs POV-Ray
+vw1=$(timeit render --cells 1 --workers 1)
+pov1=$(timeit pov 1)
+vw2=$(timeit render --cells 1 --workers 2)
+vw2c=$(timeit render --cells 2x2x2 --workers 2)
+pov2=$(timeit pov 2)
+echo "(a) vs POV-Ray 3.7 (whole process: parse + build + render + write)"
+printf "    1 thread : vwalls %6.3f s   povray %6.3f s   povray/vwalls = %s\n" "$vw1" "$pov1" "$(ratio "$pov1" "$vw1")"
+printf "    2 threads: vwalls %6.3f s   povray %6.3f s   povray/vwalls = %s  (vwalls 1 cell)\n" "$vw2" "$pov2" "$(ratio "$pov2" "$vw2")"
+printf "               vwalls %6.3f s (2x2x2 cells)          povray/vwalls = %s\n" "$vw2c" "$(ratio "$pov2" "$vw2c")"
+echo
+
+# (b) vs raw Embree: rays/s from vwalls' own compute phase and from the raw loop
+render --cells 1 --workers 1 --stats "$T/s1.json"
+vw_rays=$(python3 -c "import json,sys; j=json.load(open('$T/s1.json')); r=j['rays']; print(r['eye']+r['reflect']+r['refract']+r['shadow'], j['time_s']['compute'])")
+raw_out=$("$RAW" "$T/balls.nff" "${SIZE}x${SIZE}" 5)
+raw_rays=$(echo "$raw_out" | sed -n 's/.*rays \([0-9]*\),.*/\1/p')
+raw_time=$(echo "$raw_out" | sed -n 's/.*trace \([0-9.]*\) s.*/\1/p')
+set -- $vw_rays
+vw_rate=$(awk -v n="$1" -v t="$2" 'BEGIN { printf "%.3f", n / t * 1e-6 }')
+raw_rate=$(awk -v n="$raw_rays" -v t="$raw_time" 'BEGIN { printf "%.3f", n / t * 1e-6 }')
+echo "(b) vs raw Embree, 1 thread (compute phase only)"
+printf "    vwalls 1 cell: %s rays in %s s = %s Mrays/s\n" "$1" "$2" "$vw_rate"
+printf "    embree raw   : %s rays in %s s = %s Mrays/s\n" "$raw_rays" "$raw_time" "$raw_rate"
+printf "    vwalls/raw rate = %s\n" "$(ratio "$vw_rate" "$raw_rate")"
+echo
+
+# (c) cells and workers
+c1=$vw1
+c8=$(timeit render --cells 2x2x2 --workers 1)
+w2=$vw2
+echo "(c) cells and workers (whole process)"
+printf "    1 worker : 1 cell %6.3f s, 2x2x2 %6.3f s   2x2x2/1cell time = %s\n" "$c1" "$c8" "$(ratio "$c8" "$c1")"
+printf "    1 cell   : 1 worker %6.3f s, 2 workers %6.3f s   speedup = %s\n" "$c1" "$w2" "$(ratio "$c1" "$w2")"
+printf "    2x2x2    : 1 worker %6.3f s, 2 workers %6.3f s   speedup = %s\n" "$c8" "$vw2c" "$(ratio "$c8" "$vw2c")"
+render --cells 2x2x2 --workers 2 --stats "$T/s8.json"
+python3 - "$T/s8.json" <<'EOF'
+import json, sys
+j = json.load(open(sys.argv[1]))
+print("    2x2x2 on 2 workers: imbalance lambda %.3f, worker busy %s s, messages %d (%.1f MB)" % (
+    j["balance"]["imbalance"], ", ".join("%.3f" % w["busy_s"] for w in j["workers"]),
+    j["messages"]["count"], j["messages"]["bytes"] / 1e6))
+EOF

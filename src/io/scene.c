@@ -494,16 +494,32 @@ VW_API vw_status vw_scene_find_object(const vw_scene *s, int id, vw_prim_kind *k
 
 VW_API void vw_scene_default_camera(const vw_scene *s, vw_camera *cam)
 {
-    double lo[3], hi[3], c[3], d = 0.0;
+    double lo[3], hi[3], c[3], e[3], emax = 0.0, cmax = 0.0;
     vw_scene_bounds(s, lo, hi);
+    /* Halves first, so that neither the centre nor the extent overflows even for
+       coordinates near DBL_MAX. */
     for (int k = 0; k < 3; k++) {
-        c[k] = 0.5 * (lo[k] + hi[k]);
-        d += (hi[k] - lo[k]) * (hi[k] - lo[k]);
+        c[k] = 0.5 * lo[k] + 0.5 * hi[k];
+        e[k] = 0.5 * hi[k] - 0.5 * lo[k];
+        if (e[k] > emax)
+            emax = e[k];
+        if (fabs(c[k]) > cmax)
+            cmax = fabs(c[k]);
     }
-    d = sqrt(d);
+    double d = 0.0;   /* the diagonal, scaled to avoid overflow in the squares */
+    if (emax > 0.0) {
+        for (int k = 0; k < 3; k++)
+            d += (e[k] / emax) * (e[k] / emax);
+        d = 2.0 * emax * sqrt(d);
+    }
+    /* A flat or point-like scene far from the origin still needs 'from' to differ
+       from 'at' after rounding: never stand closer than 1e-6 of the distance to the
+       origin. */
+    if (d < 1e-6 * cmax)
+        d = 1e-6 * cmax;
     if (!(d > 0.0) || !isfinite(d))
         d = 1.0;
-    /* A bounding sphere of radius d/2 fits a 45 degree view from 1.31 d; 1.5 d
+    /* A bounding sphere of diameter d fits a 45 degree view from 1.31 d; 1.5 d
        leaves a margin. The direction is normalised (0.3, 0.4, 1). */
     static const double dir[3] = {0.27196414661021, 0.36261886214694, 0.90654715536736};
     int w = cam->width > 0 ? cam->width : 512, h = cam->height > 0 ? cam->height : 512;

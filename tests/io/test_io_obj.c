@@ -92,6 +92,24 @@ int main(int argc, char **argv)
     t = "v 0 0 0\nv 1 0 0\nv 0 1 0\n# comment\nf 1 2 4\n";
     CHECK_EQ_INT(vw_scene_read_obj("r.obj", t, strlen(t), NULL, &n, err, sizeof err), VW_E_INPUT);
     CHECK(!strcmp(err, "r.obj:5: vertex index 4 out of range (3 vertices)"));
+    /* Meshes far from the origin, huge or degenerate, still get a usable default
+       camera when written as NFF (the reader rejects 'from' equal to 'at'). */
+    const char *far[] = {"v 1e20 1e20 1e20\nv 1e20 1e20 1e20\nv 1e20 1e20 1e20\nf 1 2 3\n",
+                         "v -1e300 0 0\nv 1e300 0 0\nv 0 1e300 1e300\nf 1 2 3\n",
+                         "v 0 0 0\nv 0 0 0\nv 0 0 0\nf 1 2 3\n"};
+    for (int i = 0; i < 3; i++) {
+        CHECK_EQ_INT(vw_scene_read_obj("far.obj", far[i], strlen(far[i]), NULL, &n, err,
+                                       sizeof err), VW_OK);
+        char *fw = nff_string(n, NULL);
+        vw_scene *fb;
+        st = vw_scene_read_nff("far.nff", fw, strlen(fw), &fb, err, sizeof err);
+        if (st != VW_OK)
+            fprintf(stderr, "%s\n", err);
+        CHECK_EQ_INT(st, VW_OK);
+        vw_scene_free(fb);
+        vw_scene_free(n);
+        free(fw);
+    }
     vw_scene_free(s);
     TEST_DONE();
 }

@@ -36,3 +36,16 @@ if(EXISTS ${PROJECT_SOURCE_DIR}/bench/embree_raw.c)
   add_executable(vw_bench_embree_raw ${PROJECT_SOURCE_DIR}/bench/embree_raw.c)
   target_link_libraries(vw_bench_embree_raw PRIVATE vwalls_apps)
 endif()
+
+# Under mpirun (when the build has MPI; mpi.cmake, included before this file, sets the
+# launcher flags): the same PNG bytes as the threads engine.
+if(VW_HAVE_MPI AND MPIEXEC_EXECUTABLE)
+  string(REPLACE ";" "|" _vw_rt_pre "${VW_MPI_PREFLAGS}")
+  add_test(NAME raytrace_mpi
+    COMMAND ${CMAKE_COMMAND} -DVWALLS=$<TARGET_FILE:vwalls_tool> -DSCENE=${VW_RT_MIXED}
+            -DWORK=${CMAKE_CURRENT_BINARY_DIR}/raytrace_mpi -DMPIRUN=${MPIEXEC_EXECUTABLE}
+            -DNPFLAG=${MPIEXEC_NUMPROC_FLAG} "-DPREFLAGS=${_vw_rt_pre}"
+            -P ${PROJECT_SOURCE_DIR}/tests/raytrace/mpi.cmake)
+  set_tests_properties(raytrace_mpi PROPERTIES LABELS "mpi" TIMEOUT 120 PROCESSORS 2
+    ENVIRONMENT "${VW_MPI_ENV};${VW_RT_TSAN}")
+endif()

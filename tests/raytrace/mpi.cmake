@@ -1,0 +1,36 @@
+# mpi.cmake (raytrace) - `vwalls render` under mpirun with 2 and 3 processes must write
+# the very PNG bytes the threads engine writes on 1 cell and 1 worker; the files are
+# written by rank 0 only. Variables: VWALLS, SCENE, WORK, MPIRUN, NPFLAG, PREFLAGS
+# (PREFLAGS with '|' between flags).
+file(REMOVE_RECURSE ${WORK})
+file(MAKE_DIRECTORY ${WORK})
+string(REPLACE "|" ";" pre "${PREFLAGS}")
+execute_process(COMMAND ${VWALLS} render ${SCENE} -o ${WORK}/ref.png --size 80x60 --quiet
+                RESULT_VARIABLE rc ERROR_VARIABLE err)
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "threads engine: exit ${rc}: ${err}")
+endif()
+foreach(case "2;2x2x2;1" "2;4x1x2;2" "3;2x2;1")
+  list(GET case 0 np)
+  list(GET case 1 cells)
+  list(GET case 2 workers)
+  set(out ${WORK}/np${np}_${cells}_${workers}.png)
+  execute_process(COMMAND ${MPIRUN} ${NPFLAG} ${np} ${pre} ${VWALLS} render ${SCENE} -o ${out}
+                          --size 80x60 --cells ${cells} --workers ${workers} --quiet
+                          --stats ${WORK}/np${np}.json
+                  RESULT_VARIABLE rc ERROR_VARIABLE err TIMEOUT 60)
+  if(NOT rc EQUAL 0)
+    message(FATAL_ERROR "mpirun -np ${np} --cells ${cells}: exit ${rc}: ${err}")
+  endif()
+  execute_process(COMMAND ${CMAKE_COMMAND} -E compare_files ${WORK}/ref.png ${out}
+                  RESULT_VARIABLE same)
+  if(NOT same EQUAL 0)
+    message(FATAL_ERROR "mpirun -np ${np} --cells ${cells} --workers ${workers}: PNG differs")
+  endif()
+  file(READ ${WORK}/np${np}.json json)
+  string(FIND "${json}" "\"processes\": ${np}" at)
+  if(at LESS 0)
+    message(FATAL_ERROR "stats JSON does not say ${np} processes")
+  endif()
+endforeach()
+message(STATUS "raytrace_mpi: identical to the threads engine")

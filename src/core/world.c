@@ -6,6 +6,7 @@
  * cell owns that stretch of the ray.
  */
 #include "core/world_internal.h"
+#include "vwalls/engine.h"
 
 #include <stdarg.h>
 #include <stdio.h>
@@ -307,7 +308,12 @@ vw_status vw_world_commit(vw_world *w)
 {
     if (!w) return VW_E_INVAL;
     vw_status st = vw__runtime_build(w);
-    if (st != VW_OK) return vw__world_error(w, st, "building cells failed: %s", vw_status_message(st));
+    char msg[512] = "";
+    if (st != VW_OK) snprintf(msg, sizeof msg, "building cells failed: %s", vw_status_message(st));
+    /* Under MPI every process builds only its own cells; they agree before anyone runs,
+       so a cell that fails on one process fails the commit everywhere, naming it. */
+    if (w->transport) st = vw_world_agree(w, st, msg, sizeof msg);
+    if (st != VW_OK) return vw__world_error(w, st, "%s", msg);
     w->committed = 1;
     return VW_OK;
 }
@@ -482,7 +488,6 @@ void vw_world_set_balance_info(vw_world *w, const char *strategy, double before,
 /* ---- without MPI: the engine is this one process ------------------------------------ */
 
 #if !VW_HAVE_MPI
-#include "vwalls/engine.h"
 
 vw_status vw__mpi_attach(vw_world *w)
 {

@@ -10,5 +10,6 @@ int vw_cmd_render(int argc, char **argv);
 
 int vw_cmd_gen(int argc, char **argv);
 int vw_cmd_info(int argc, char **argv);
+int vw_cmd_radiosity(int argc, char **argv);
 
 #endif

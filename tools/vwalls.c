@@ -16,6 +16,7 @@ typedef struct vw_command {
 static const vw_command commands[] = {
     {"example-pairs", vw_cmd_example_pairs, "count touching sphere pairs (the example module)"},
     {"render", vw_cmd_render, "ray trace an NFF or OBJ scene, distributed over cells"},
+    {"radiosity", vw_cmd_radiosity, "progressive radiosity of an OBJ or NFF scene, distributed over cells"},
 };
 
 static void usage(FILE *f)

@@ -1,0 +1,405 @@
+/* mesh.c - meshing for the radiosity solver: polygons are cut into patches (the shooters)
+ * along a square grid in each polygon's own frame, and the patches are clipped at the
+ * walls (Sutherland-Hodgman against the planes of the cell boxes) into pieces.
+ *
+ * A piece is kept only by the cell vw_decomp_locate() gives for its centroid with the
+ * piece normal as direction, so a piece lying in a wall plane is kept once, by the cell
+ * it faces. Receiver elements are not stored here: every cell cuts them from its pieces
+ * along the same polygon grid (rad_elem_polygon), so element boundaries do not depend
+ * on the decomposition except where walls cut them.
+ */
+#include "radiosity/radiosity.h"
+#include "radiosity/vec.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+void rad_options_init(rad_options *o)
+{
+    memset(o, 0, sizeof *o);
+    o->sf = 1e-3;
+    o->res = 64;
+    o->elem_split = 2;
+    o->dims[0] = o->dims[1] = o->dims[2] = 1;
+    o->per_round = 4;
+    o->max_level = 3;
+    o->checkpoint_every = 60;
+}
+
+/* ---- polygon clipping ---- */
+
+/* Keeps the part of p where dot(a, x) >= b (one Sutherland-Hodgman pass). */
+static void clip_plane(const rad_poly *p, const double a[3], double b, rad_poly *out)
+{
+    out->n = 0;
+    for (int i = 0; i < p->n; i++) {
+        const double *s = p->v[i], *e = p->v[(i + 1) % p->n];
+        double ds = rad_dot(a, s) - b, de = rad_dot(a, e) - b;
+        if (ds >= 0 && out->n < RAD_MAXV) memcpy(out->v[out->n++], s, sizeof(double) * 3);
+        if ((ds >= 0) != (de >= 0) && out->n < RAD_MAXV) {
+            double t = ds / (ds - de);
+            for (int k = 0; k < 3; k++) out->v[out->n][k] = s[k] + t * (e[k] - s[k]);
+            out->n++;
+        }
+    }
+    /* Drop repeated vertices (a vertex on the plane is emitted twice). */
+    int k = 0;
+    for (int i = 0; i < out->n; i++) {
+        const double *prev = k ? out->v[k - 1] : NULL;
+        if (prev && prev[0] == out->v[i][0] && prev[1] == out->v[i][1] && prev[2] == out->v[i][2]) continue;
+        if (k != i) memcpy(out->v[k], out->v[i], sizeof(double) * 3);
+        k++;
+    }
+    while (k > 1 && !memcmp(out->v[0], out->v[k - 1], sizeof(double) * 3)) k--;
+    out->n = k < 3 ? 0 : k;
+}
+
+/* Clips p to the square [u0,u1] x [v0,v1] of the frame (origin, ua, va). */
+static void clip_rect(const rad_poly *p, const double origin[3], const double ua[3],
+                      const double va[3], double u0, double u1, double v0, double v1, rad_poly *out)
+{
+    rad_poly t;
+    double ou = rad_dot(ua, origin), ov = rad_dot(va, origin);
+    double nua[3] = {-ua[0], -ua[1], -ua[2]}, nva[3] = {-va[0], -va[1], -va[2]};
+    clip_plane(p, ua, ou + u0, &t);
+    clip_plane(&t, nua, -(ou + u1), out);
+    clip_plane(out, va, ov + v0, &t);
+    clip_plane(&t, nva, -(ov + v1), out);
+}
+
+/* Clips p to a cell box given in frame coordinates (frame rows are the box axes). */
+static void clip_box(const rad_poly *p, const vw_box *b, const double *frame, rad_poly *out)
+{
+    rad_poly t = *p;
+    for (int a = 0; a < 3; a++) {
+        double ax[3] = {a == 0, a == 1, a == 2};
+        if (frame) memcpy(ax, frame + 3 * a, sizeof ax);
+        double nax[3] = {-ax[0], -ax[1], -ax[2]};
+        clip_plane(&t, ax, b->lo[a], out);
+        clip_plane(out, nax, -b->hi[a], &t);
+    }
+    *out = t;
+}
+
+double rad_poly_area(const rad_poly *p, double normal[3], double centroid[3])
+{
+    double nw[3] = {0, 0, 0}, c[3] = {0, 0, 0}, total = 0;
+    for (int i = 0; i < p->n; i++) {
+        const double *a = p->v[i], *b = p->v[(i + 1) % p->n];
+        nw[0] += (a[1] - b[1]) * (a[2] + b[2]);
+        nw[1] += (a[2] - b[2]) * (a[0] + b[0]);
+        nw[2] += (a[0] - b[0]) * (a[1] + b[1]);
+    }
+    double area = 0.5 * rad_norm(nw);
+    if (normal) {
+        memcpy(normal, nw, sizeof nw);
+        rad_normalize(normal);
+    }
+    if (centroid) {
+        /* Area-weighted fan: exact for convex polygons. */
+        for (int i = 1; i + 1 < p->n; i++) {
+            double e1[3], e2[3], x[3];
+            rad_sub(p->v[i], p->v[0], e1);
+            rad_sub(p->v[i + 1], p->v[0], e2);
+            rad_cross(e1, e2, x);
+            double w = 0.5 * rad_norm(x);
+            for (int k = 0; k < 3; k++) c[k] += w * (p->v[0][k] + p->v[i][k] + p->v[i + 1][k]) / 3;
+            total += w;
+        }
+        for (int k = 0; k < 3; k++)
+            centroid[k] = total > 0 ? c[k] / total : (p->n ? p->v[0][k] : 0);
+    }
+    return area;
+}
+
+void rad_piece_grid(const rad_piece *pc, int lo[2], int hi[2])
+{
+    double umin = INFINITY, umax = -INFINITY, vmin = INFINITY, vmax = -INFINITY;
+    for (int i = 0; i < pc->nv; i++) {
+        double d[3];
+        rad_sub(pc->v[i], pc->origin, d);
+        double u = rad_dot(d, pc->uax), v = rad_dot(d, pc->vax);
+        umin = fmin(umin, u), umax = fmax(umax, u), vmin = fmin(vmin, v), vmax = fmax(vmax, v);
+    }
+    lo[0] = (int)floor(umin / pc->elem), hi[0] = (int)floor(umax / pc->elem);
+    lo[1] = (int)floor(vmin / pc->elem), hi[1] = (int)floor(vmax / pc->elem);
+}
+
+int rad_elem_polygon(const rad_piece *pc, int level, int gi, int gj, rad_poly *out)
+{
+    rad_poly p;
+    p.n = pc->nv;
+    memcpy(p.v, pc->v, sizeof(double) * 3 * (size_t)pc->nv);
+    double h = pc->elem / (double)(1 << level);
+    clip_rect(&p, pc->origin, pc->uax, pc->vax, gi * h, (gi + 1) * h, gj * h, (gj + 1) * h, out);
+    return out->n;
+}
+
+/* ---- scene-level helpers ---- */
+
+vw_box rad_world_box(const vw_scene *s)
+{
+    vw_box b;
+    vw_scene_bounds(s, b.lo, b.hi);
+    double ext = 0;
+    for (int k = 0; k < 3; k++) ext = fmax(ext, b.hi[k] - b.lo[k]);
+    double pad = 1e-3 * (ext > 0 ? ext : 1);
+    for (int k = 0; k < 3; k++) b.lo[k] -= pad, b.hi[k] += pad;
+    return b;
+}
+
+double rad_default_patch_size(const vw_scene *s)
+{
+    double lo[3], hi[3], ext = 0;
+    vw_scene_bounds(s, lo, hi);
+    for (int k = 0; k < 3; k++) ext = fmax(ext, hi[k] - lo[k]);
+    return ext > 0 ? ext / 10 : 1;
+}
+
+/* The line of the k-th polygon statement of a scene file (OBJ "f", NFF "p"/"pp"), so
+   that geometry errors found after parsing can still be reported as file:line. 0 when
+   it cannot be told. */
+static int polygon_line(const char *path, size_t k)
+{
+    FILE *f = path ? fopen(path, "r") : NULL;
+    if (!f) return 0;
+    char buf[4096];
+    int line = 0, found = 0;
+    size_t count = 0;
+    while (fgets(buf, sizeof buf, f)) {
+        line++;
+        const char *p = buf;
+        while (*p == ' ' || *p == '\t') p++;
+        int is_poly = (p[0] == 'f' && (p[1] == ' ' || p[1] == '\t')) ||
+                      (p[0] == 'p' && (p[1] == ' ' || p[1] == '\t' || p[1] == '\n' || p[1] == '\r')) ||
+                      (p[0] == 'p' && p[1] == 'p' && (p[2] == ' ' || p[2] == '\t' || p[2] == '\n'));
+        size_t n = strlen(buf);
+        while (n == sizeof buf - 1 && buf[n - 1] != '\n' && fgets(buf, sizeof buf, f)) n = strlen(buf);
+        if (is_poly && count++ == k) {
+            found = line;
+            break;
+        }
+    }
+    fclose(f);
+    return found;
+}
+
+static void where(char *out, size_t len, const char *path, size_t k)
+{
+    int line = polygon_line(path, k);
+    if (line > 0)
+        snprintf(out, len, "%s:%d", path ? path : "scene", line);
+    else
+        snprintf(out, len, "%s: polygon %zu", path ? path : "scene", k);
+}
+
+static int push_piece(rad_mesh *m, size_t *cap, const rad_piece *pc, int owner)
+{
+    if (m->npieces == *cap) {
+        size_t nc = *cap ? 2 * *cap : 256;
+        rad_piece *np = realloc(m->pieces, nc * sizeof *np);
+        int *no = realloc(m->owner, nc * sizeof *no);
+        if (np) m->pieces = np;
+        if (no) m->owner = no;
+        if (!np || !no) return -1;
+        *cap = nc;
+    }
+    m->pieces[m->npieces] = *pc;
+    m->pieces[m->npieces].id = (int64_t)m->npieces;
+    m->owner[m->npieces] = owner;
+    m->npieces++;
+    return 0;
+}
+
+/* Invariant: every piece appended lies in the box of the cell it is appended for, and
+   that cell is the one vw_decomp_locate() gives for its centroid and normal. */
+static vw_status mesh_polygon(rad_mesh *m, size_t *cap, const vw_decomp *d, const rad_poly *poly,
+                              const double normal[3], const double origin[3], const double ua[3],
+                              const double va[3], double S, double elem, int id,
+                              const vw_material *mat, int *cells, int ncap, double tiny)
+{
+    double umin = INFINITY, umax = -INFINITY, vmin = INFINITY, vmax = -INFINITY;
+    for (int i = 0; i < poly->n; i++) {
+        double q[3];
+        rad_sub(poly->v[i], origin, q);
+        double u = rad_dot(q, ua), v = rad_dot(q, va);
+        umin = fmin(umin, u), umax = fmax(umax, u), vmin = fmin(vmin, v), vmax = fmax(vmax, v);
+    }
+    const double *frame = vw_decomp_frame(d);
+    for (int i = (int)floor(umin / S); i <= (int)floor(umax / S); i++)
+        for (int j = (int)floor(vmin / S); j <= (int)floor(vmax / S); j++) {
+            rad_poly patch, piece;
+            clip_rect(poly, origin, ua, va, i * S, (i + 1) * S, j * S, (j + 1) * S, &patch);
+            if (patch.n < 3 || rad_poly_area(&patch, NULL, NULL) <= tiny) continue;
+            vw_box pb = {{INFINITY, INFINITY, INFINITY}, {-INFINITY, -INFINITY, -INFINITY}};
+            for (int k = 0; k < patch.n; k++)
+                for (int a = 0; a < 3; a++) {
+                    pb.lo[a] = fmin(pb.lo[a], patch.v[k][a]);
+                    pb.hi[a] = fmax(pb.hi[a], patch.v[k][a]);
+                }
+            int nc = vw_decomp_cells_overlapping(d, &pb, 0, cells, ncap);
+            for (int c = 0; c < nc && c < ncap; c++) {
+                vw_box cb = vw_decomp_cell_box(d, cells[c]);
+                clip_box(&patch, &cb, frame, &piece);
+                double area, cen[3];
+                if (piece.n < 3 || (area = rad_poly_area(&piece, NULL, cen)) <= tiny) continue;
+                int owner = vw_decomp_locate(d, cen, normal);
+                if (owner != cells[c]) continue;
+                rad_piece pc;
+                memset(&pc, 0, sizeof pc);
+                pc.poly = id;
+                pc.nv = piece.n;
+                pc.pi = i, pc.pj = j;
+                memcpy(pc.v, piece.v, sizeof(double) * 3 * (size_t)piece.n);
+                memcpy(pc.normal, normal, sizeof pc.normal);
+                memcpy(pc.centroid, cen, sizeof cen);
+                pc.area = area;
+                memcpy(pc.origin, origin, sizeof pc.origin);
+                memcpy(pc.uax, ua, sizeof pc.uax);
+                memcpy(pc.vax, va, sizeof pc.vax);
+                pc.elem = elem;
+                for (int k = 0; k < 3; k++) {
+                    pc.rho[k] = mat ? fmin(fmax(mat->diffuse[k], 0), 1) : 0.5;
+                    pc.emit[k] = mat ? fmax(mat->emission[k], 0) : 0;
+                    m->emitted[k] += pc.emit[k] * area;
+                }
+                m->area += area;
+                if (push_piece(m, cap, &pc, owner)) return VW_E_NOMEM;
+            }
+        }
+    return VW_OK;
+}
+
+vw_status rad_mesh_build(const vw_scene *s, const char *path, const vw_decomp *d,
+                         const rad_options *o, rad_mesh *m, char *err, size_t errlen)
+{
+    memset(m, 0, sizeof *m);
+    size_t cap = 0;
+    double S = o->patch_size > 0 ? o->patch_size : rad_default_patch_size(s);
+    double elem = S / (o->elem_split > 0 ? o->elem_split : 1);
+    double lo[3], hi[3], diag = 0;
+    vw_scene_bounds(s, lo, hi);
+    for (int k = 0; k < 3; k++) diag += (hi[k] - lo[k]) * (hi[k] - lo[k]);
+    diag = sqrt(diag);
+    double tiny = 1e-14 * diag * diag;
+    int ncells = vw_decomp_cell_count(d);
+    int *cells = malloc(sizeof(int) * (size_t)ncells);
+    if (!cells) return VW_E_NOMEM;
+    vw_status st = VW_OK;
+    int max_id = -1;
+    for (size_t k = 0; k < s->npolygons && st == VW_OK; k++) {
+        const vw_polygon *pg = &s->polygons[k];
+        if (pg->id > max_id) max_id = pg->id;
+        rad_poly all;
+        int nv = pg->count;
+        /* The polygon's plane from Newell's method over all its vertices. */
+        double nw[3] = {0, 0, 0}, cen[3] = {0, 0, 0}, size = 0;
+        for (int i = 0; i < nv; i++) {
+            const double *a = s->vertices[s->indices[pg->first + i]];
+            const double *b = s->vertices[s->indices[pg->first + (i + 1) % nv]];
+            nw[0] += (a[1] - b[1]) * (a[2] + b[2]);
+            nw[1] += (a[2] - b[2]) * (a[0] + b[0]);
+            nw[2] += (a[0] - b[0]) * (a[1] + b[1]);
+            for (int c = 0; c < 3; c++) cen[c] += a[c] / nv;
+        }
+        for (int i = 0; i < nv; i++) {
+            double q[3];
+            rad_sub(s->vertices[s->indices[pg->first + i]], cen, q);
+            size = fmax(size, rad_norm(q));
+        }
+        double area = 0.5 * rad_norm(nw), normal[3] = {nw[0], nw[1], nw[2]};
+        char at[512];
+        if (!(area > tiny) || !rad_normalize(normal)) {
+            if (!o->quiet) {
+                where(at, sizeof at, path, k);
+                fprintf(stderr, "%s: warning: zero-area polygon (id %d) skipped\n", at, pg->id);
+            }
+            continue;
+        }
+        /* Measured data (the Cornell box) is a little off planar: up to 5% of the
+           polygon's size is flattened onto its Newell plane with a warning, more is an
+           error. */
+        double off = 0;
+        int worst = 0;
+        for (int i = 0; i < nv; i++) {
+            double q[3];
+            rad_sub(s->vertices[s->indices[pg->first + i]], cen, q);
+            if (fabs(rad_dot(q, normal)) > off) off = fabs(rad_dot(q, normal)), worst = i;
+        }
+        if (off > 0.05 * size) {
+            where(at, sizeof at, path, k);
+            snprintf(err, errlen, "%s: polygon (id %d) is not planar (vertex %d is %.3g off its plane)", at,
+                     pg->id, worst + 1, off);
+            st = VW_E_INPUT;
+        } else if (off > 1e-3 * size && !o->quiet) {
+            where(at, sizeof at, path, k);
+            fprintf(stderr, "%s: warning: polygon (id %d) is not planar (%.3g off), flattened\n", at, pg->id, off);
+        }
+        if (st != VW_OK) break;
+        /* The polygon frame: u along its longest edge, origin at that edge's start, so
+           patches of rectangles are rectangles. */
+        double origin[3], ua[3] = {0, 0, 0}, va[3];
+        memcpy(origin, s->vertices[s->indices[pg->first]], sizeof origin);
+        for (int i = 0; i < nv; i++) {
+            double e[3];
+            const double *a = s->vertices[s->indices[pg->first + i]];
+            rad_sub(s->vertices[s->indices[pg->first + (i + 1) % nv]], a, e);
+            if (rad_norm(e) > rad_norm(ua)) memcpy(ua, e, sizeof e), memcpy(origin, a, sizeof origin);
+        }
+        {
+            double q[3];
+            rad_sub(origin, cen, q);
+            double dd = rad_dot(q, normal);
+            for (int c = 0; c < 3; c++) origin[c] -= dd * normal[c];
+        }
+        double proj = rad_dot(ua, normal);
+        for (int c = 0; c < 3; c++) ua[c] -= proj * normal[c];
+        rad_normalize(ua);
+        rad_cross(normal, ua, va);
+        const vw_material *mat =
+            pg->material >= 0 && (size_t)pg->material < s->nmaterials ? &s->materials[pg->material] : NULL;
+        /* Large polygons are fanned into chunks that fit RAD_MAXV after clipping. */
+        const int chunk = RAD_MAXV - 10;
+        for (int first = 1; first + 1 < nv && st == VW_OK; first += chunk - 2) {
+            all.n = 0;
+            memcpy(all.v[all.n++], s->vertices[s->indices[pg->first]], sizeof(double) * 3);
+            for (int i = first; i < nv && all.n < chunk; i++)
+                memcpy(all.v[all.n++], s->vertices[s->indices[pg->first + i]], sizeof(double) * 3);
+            for (int i = 0; i < all.n; i++) {
+                double q[3];
+                rad_sub(all.v[i], cen, q);
+                double dd = rad_dot(q, normal);
+                for (int c = 0; c < 3; c++) all.v[i][c] -= dd * normal[c];
+            }
+            if (all.n < 3 || rad_poly_area(&all, NULL, NULL) <= tiny) continue;
+            st = mesh_polygon(m, &cap, d, &all, normal, origin, ua, va, S, elem, pg->id, mat, cells,
+                              ncells, tiny);
+            if (all.n < chunk) break;
+        }
+    }
+    free(cells);
+    m->npolys = (size_t)(max_id + 1);
+    if (st == VW_E_NOMEM) snprintf(err, errlen, "%s: out of memory while meshing", path ? path : "scene");
+    if (st == VW_OK && m->npieces == 0) {
+        snprintf(err, errlen, "%s: no polygon to mesh (radiosity needs polygons)", path ? path : "scene");
+        st = VW_E_INPUT;
+    }
+    if (st == VW_OK && !(rad_sum3(m->emitted) > 0)) {
+        snprintf(err, errlen,
+                 "%s: no emitter: give some material an emission (MTL 'Ke r g b', NFF '#vw Ke r g b')",
+                 path ? path : "scene");
+        st = VW_E_INPUT;
+    }
+    if (st != VW_OK) rad_mesh_free(m);
+    return st;
+}
+
+void rad_mesh_free(rad_mesh *m)
+{
+    if (!m) return;
+    free(m->pieces);
+    free(m->owner);
+    memset(m, 0, sizeof *m);
+}

@@ -1,0 +1,755 @@
+/* module.c - the radiosity module: a cell's patches and receiver elements, shooting,
+ * and the front-to-back relay of hemicube coverage bitmaps between cells.
+ *
+ * Front-to-back rule. For a shot from point p with normal n, the cell across face f of
+ * cell C is "upstream" when p lies on its side of the wall (ties decided exactly as
+ * vw_decomp_locate decides them, with n as direction). Two face neighbours are split
+ * by their lowest common kd-tree split, which is that wall, so "upstream" follows the
+ * kd-tree front-to-back order from p: it has no cycle, and a ray from p meets every
+ * upstream cell before C. A cell takes part in a shot when its box meets the open half
+ * space in front of the shooter (and the neighbourhood cube, if any); every such cell
+ * except the source has at least one such upstream neighbour (walk back along a segment
+ * from a point of the cell to p), so counting only participating upstream neighbours
+ * makes every wait finite and exact: a cell rasterises a shot once it holds as many
+ * bitmaps as it has participating upstream neighbours, and every cell on a segment
+ * from p to one of its points is upstream of it, transitively. Visibility is then the
+ * one-cell hemicube's.
+ */
+#include "radiosity/solver_internal.h"
+#include "radiosity/vec.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+const char *const rad_counter_names[RAD_NCOUNTERS] = {
+    "shots", "shot_messages", "shot_bytes", "full_messages", "rasterised_elements",
+    "element_splits", "back_face_hits",
+};
+
+typedef struct rad_patch {
+    rad_piece pc;
+    double unshot[3];
+    int64_t nshots;
+} rad_patch;
+
+typedef struct rad_elem {
+    int patch;
+    int32_t level, gi, gj;
+    int vfirst, nv;
+    int alive;
+    double area;
+    double B[3], incident[3];
+    double won;          /* delta form factor won in the current shot */
+} rad_elem;
+
+typedef struct rad_pend {
+    uint64_t id;
+    int expected, received, full;
+    rad_shot_hdr h;
+    uint8_t *bits;
+} rad_pend;
+
+typedef struct rad_cell {
+    rad_solver *S;
+    int cell;
+    int nnb[6];
+    int *nb[6];
+    vw_box *nbbox[6];
+    rad_patch *patches;
+    int npatches;
+    rad_elem *el;
+    int nel, capel;
+    double (*vp)[3];
+    int nvp, capvp;
+    int *ht;             /* open addressing on (poly, level, gi, gj): element index or -1 */
+    int htcap, htused;
+    rad_pend *pend;
+    int npend, cappend;
+    rad_zbuf z;
+    uint8_t *mask;
+    int *touched;
+    char *pvis;          /* per patch: some vertex in front of the current shooter */
+    double (*hv)[3];
+    int round, budget;
+    double thr;
+    uint64_t seq;
+    int64_t nshots;
+    double absorbed[3], shot[3], won[3];
+} rad_cell;
+
+static void *xrealloc(void *p, size_t n)
+{
+    void *q = realloc(p, n ? n : 1);
+    if (!q) {
+        fprintf(stderr, "vwalls radiosity: out of memory (%zu bytes)\n", n);
+        abort();
+    }
+    return q;
+}
+
+/* ---- elements and their hash ---- */
+
+static uint64_t hkey(int32_t poly, int32_t level, int32_t gi, int32_t gj)
+{
+    uint64_t h = (uint64_t)(uint32_t)poly * 0x9e3779b97f4a7c15ull;
+    h ^= (uint64_t)(uint32_t)level * 0xc2b2ae3d27d4eb4full + (h << 6);
+    h ^= (uint64_t)(uint32_t)gi * 0x165667b19e3779f9ull + (h >> 3);
+    h ^= (uint64_t)(uint32_t)gj * 0x27d4eb2f165667c5ull;
+    return h ^ (h >> 29);
+}
+
+static void ht_insert(rad_cell *c, int e);
+
+static void ht_grow(rad_cell *c)
+{
+    free(c->ht);
+    c->htcap = c->htcap ? 2 * c->htcap : 64;
+    c->ht = xrealloc(NULL, sizeof(int) * (size_t)c->htcap);
+    for (int i = 0; i < c->htcap; i++) c->ht[i] = -1;
+    c->htused = 0;
+    for (int e = 0; e < c->nel; e++) ht_insert(c, e);
+}
+
+static void ht_insert(rad_cell *c, int e)
+{
+    if (2 * (c->htused + 1) > c->htcap) {
+        ht_grow(c); /* re-inserts every element up to nel, e included */
+        return;
+    }
+    const rad_elem *x = &c->el[e];
+    size_t i = hkey(c->patches[x->patch].pc.poly, x->level, x->gi, x->gj) & (size_t)(c->htcap - 1);
+    while (c->ht[i] >= 0) i = (i + 1) & (size_t)(c->htcap - 1);
+    c->ht[i] = e;
+    c->htused++;
+}
+
+/* An element of polygon poly at (level, gi, gj); with piece >= 0 only that piece's.
+   alive_only: skip split parents. -1 when none. */
+static int ht_find(const rad_cell *c, int32_t poly, int64_t piece, int32_t level, int32_t gi,
+                   int32_t gj, int alive_only)
+{
+    if (!c->htcap) return -1;
+    size_t i = hkey(poly, level, gi, gj) & (size_t)(c->htcap - 1);
+    for (; c->ht[i] >= 0; i = (i + 1) & (size_t)(c->htcap - 1)) {
+        const rad_elem *x = &c->el[c->ht[i]];
+        const rad_piece *pc = &c->patches[x->patch].pc;
+        if (pc->poly == poly && x->level == level && x->gi == gi && x->gj == gj &&
+            (piece < 0 || pc->id == piece) && (!alive_only || x->alive))
+            return c->ht[i];
+    }
+    return -1;
+}
+
+static int add_elem(rad_cell *c, int patch, int level, int gi, int gj, const double B[3])
+{
+    rad_poly poly;
+    const rad_piece *pc = &c->patches[patch].pc;
+    if (rad_elem_polygon(pc, level, gi, gj, &poly) < 3) return -1;
+    double area = rad_poly_area(&poly, NULL, NULL);
+    if (!(area > 1e-14 * pc->area)) return -1;
+    if (c->nel == c->capel) {
+        c->capel = c->capel ? 2 * c->capel : 64;
+        c->el = xrealloc(c->el, sizeof *c->el * (size_t)c->capel);
+    }
+    if (c->nvp + poly.n > c->capvp) {
+        while (c->nvp + poly.n > c->capvp) c->capvp = c->capvp ? 2 * c->capvp : 256;
+        c->vp = xrealloc(c->vp, sizeof *c->vp * (size_t)c->capvp);
+    }
+    rad_elem *e = &c->el[c->nel];
+    memset(e, 0, sizeof *e);
+    e->patch = patch, e->level = level, e->gi = gi, e->gj = gj;
+    e->vfirst = c->nvp, e->nv = poly.n, e->alive = 1, e->area = area;
+    memcpy(e->B, B, sizeof e->B);
+    memcpy(c->vp + c->nvp, poly.v, sizeof(double) * 3 * (size_t)poly.n);
+    c->nvp += poly.n;
+    c->nel++;
+    ht_insert(c, c->nel - 1);
+    return c->nel - 1;
+}
+
+/* Splits element e into its four children. They inherit its radiosity, so the power
+   B*area it holds is kept exactly (up to rounding: the children tile the parent); the
+   incident power is shared by area. Later shots then resolve the detail. */
+static void split_elem(rad_cell *c, int e)
+{
+    rad_elem par = c->el[e];
+    c->el[e].alive = 0;
+    for (int a = 0; a < 2; a++)
+        for (int b = 0; b < 2; b++) {
+            int k = add_elem(c, par.patch, par.level + 1, 2 * par.gi + a, 2 * par.gj + b, par.B);
+            if (k >= 0)
+                for (int ch = 0; ch < 3; ch++) c->el[k].incident[ch] = par.incident[ch] * c->el[k].area / par.area;
+        }
+}
+
+/* Adaptive subdivision: an element is split when its radiosity differs from a
+   neighbour's (same polygon, same or coarser level, in this cell) by more than rel
+   times their mean and more than floor. Decided for all first, then split. */
+static void subdivide(vw_ctx *ctx, rad_cell *c, double rel, double floor_, int max_level)
+{
+    int n = c->nel, nsplit = 0;
+    char *mark = xrealloc(NULL, (size_t)(n ? n : 1));
+    memset(mark, 0, (size_t)(n ? n : 1));
+    static const int dx[4] = {1, -1, 0, 0}, dy[4] = {0, 0, 1, -1};
+    for (int e = 0; e < n; e++) {
+        rad_elem *x = &c->el[e];
+        if (!x->alive) continue;
+        int32_t poly = c->patches[x->patch].pc.poly;
+        double Ya = rad_sum3(x->B) / 3;
+        for (int k = 0; k < 4; k++) {
+            int o = -1;
+            for (int l = x->level; l >= 0 && o < 0; l--) {
+                int sh = x->level - l;
+                int gi = (x->gi + dx[k]) >> sh, gj = (x->gj + dy[k]) >> sh;
+                o = ht_find(c, poly, -1, l, gi, gj, 0);
+                if (o >= 0 && !c->el[o].alive) o = -2; /* finer ones compare with x */
+            }
+            if (o < 0) continue;
+            double Yb = rad_sum3(c->el[o].B) / 3, diff = fabs(Ya - Yb);
+            if (diff > rel * 0.5 * (Ya + Yb) && diff > floor_) {
+                if (x->level < max_level) mark[e] = 1;
+                if (c->el[o].level < max_level) mark[o] = 1;
+            }
+        }
+    }
+    for (int e = 0; e < n; e++)
+        if (mark[e]) split_elem(c, e), nsplit++;
+    free(mark);
+    vw_count(ctx, RAD_C_SPLITS, nsplit);
+}
+
+/* ---- the wall rule ---- */
+
+/* Is frame point q on the + side of the wall at w on one axis? Exactly the test of
+   vw_decomp_locate, with the shooter normal as direction. */
+static int plus_side(double q, double v, double w) { return q > w || (q == w && v >= 0); }
+
+/* Is the cell across face f upstream (p on its side)? */
+static int upstream(const vw_box *b, int f, const double q[3], const double v[3])
+{
+    int a = VW_FACE_AXIS(f);
+    if (VW_FACE_SIGN(f) > 0) return plus_side(q[a], v[a], b->hi[a]);
+    return !plus_side(q[a], v[a], b->lo[a]);
+}
+
+/* Does box b meet the open half space in front of the shooter (within the
+   neighbourhood cube, if D > 0)? Computed from the message and the decomposition
+   alone, so the sender and the receiver of a bitmap agree on it. */
+static int in_range(const vw_box *b, const double q[3], const double v[3], double D)
+{
+    double s = 0;
+    for (int a = 0; a < 3; a++) {
+        double lo = b->lo[a], hi = b->hi[a];
+        if (D > 0) {
+            lo = fmax(lo, q[a] - D);
+            hi = fmin(hi, q[a] + D);
+            if (lo > hi) return 0;
+        }
+        s += v[a] > 0 ? v[a] * (hi - q[a]) : v[a] * (lo - q[a]);
+    }
+    return s > 0;
+}
+
+/* ---- building ---- */
+
+static vw_status cell_build(vw_ctx *ctx, const void *objects, size_t n, void **state)
+{
+    rad_solver *S = vw_ctx_user(ctx);
+    const vw_decomp *d = vw_ctx_decomp(ctx);
+    rad_cell *c = calloc(1, sizeof *c);
+    if (!c) return VW_E_NOMEM;
+    c->S = S;
+    c->cell = vw_ctx_cell(ctx);
+    const rad_piece *pcs = objects;
+    c->patches = xrealloc(NULL, sizeof *c->patches * (n ? n : 1));
+    for (size_t i = 0; i < n; i++) {
+        /* The runtime hands a piece to every cell its box touches; its owner keeps it. */
+        if (vw_decomp_locate(d, pcs[i].centroid, pcs[i].normal) != c->cell) continue;
+        rad_patch *pt = &c->patches[c->npatches++];
+        memset(pt, 0, sizeof *pt);
+        pt->pc = pcs[i];
+        for (int k = 0; k < 3; k++) pt->unshot[k] = pcs[i].emit[k] * pcs[i].area;
+    }
+    for (int p = 0; p < c->npatches; p++) {
+        int lo[2], hi[2];
+        rad_piece_grid(&c->patches[p].pc, lo, hi);
+        for (int i = lo[0]; i <= hi[0]; i++)
+            for (int j = lo[1]; j <= hi[1]; j++) add_elem(c, p, 0, i, j, c->patches[p].pc.emit);
+    }
+    int maxnb = vw_decomp_max_neighbours(d);
+    for (int f = 0; f < 6; f++) {
+        int *ids = xrealloc(NULL, sizeof(int) * (size_t)(maxnb > 0 ? maxnb : 1));
+        int k = vw_decomp_neighbours(d, c->cell, f, ids, maxnb);
+        c->nnb[f] = k < maxnb ? k : maxnb;
+        c->nb[f] = ids;
+        c->nbbox[f] = xrealloc(NULL, sizeof(vw_box) * (size_t)(c->nnb[f] ? c->nnb[f] : 1));
+        for (int i = 0; i < c->nnb[f]; i++) c->nbbox[f][i] = vw_decomp_cell_box(d, ids[i]);
+    }
+    c->pvis = xrealloc(NULL, (size_t)(c->npatches ? c->npatches : 1));
+    *state = c;
+    return VW_OK;
+}
+
+static void cell_free(void *state, void *user)
+{
+    rad_cell *c = state;
+    (void)user;
+    if (!c) return;
+    for (int f = 0; f < 6; f++) free(c->nb[f]), free(c->nbbox[f]);
+    for (int i = 0; i < c->npend; i++) free(c->pend[i].bits);
+    free(c->pend);
+    free(c->patches), free(c->el), free(c->vp), free(c->ht);
+    free(c->z.depth), free(c->z.owner), free(c->z.stamp), free(c->mask), free(c->touched);
+    free(c->pvis), free(c->hv);
+    free(c);
+}
+
+static double cell_load(vw_ctx *ctx, void *state)
+{
+    rad_cell *c = state;
+    (void)ctx;
+    return (double)c->nel;
+}
+
+/* ---- reporting ---- */
+
+static void report(vw_ctx *ctx, rad_cell *c, int round)
+{
+    rad_report_msg r;
+    memset(&r, 0, sizeof r);
+    r.round = round;
+    r.cell = c->cell;
+    r.nshots = c->nshots;
+    for (int p = 0; p < c->npatches; p++) {
+        double u = rad_sum3(c->patches[p].unshot);
+        if (u > r.max_unshot) r.max_unshot = u;
+        for (int k = 0; k < 3; k++) r.unshot[k] += c->patches[p].unshot[k];
+    }
+    memcpy(r.absorbed, c->absorbed, sizeof r.absorbed);
+    memcpy(r.shot, c->shot, sizeof r.shot);
+    memcpy(r.won, c->won, sizeof r.won);
+    vw_send_output(ctx, RAD_K_REPORT, &r);
+}
+
+/* The first message of a new round reports the state the previous round left: every
+   shot of that round had ended when it did (run() returns at quiescence). */
+static void enter_round(vw_ctx *ctx, rad_cell *c, int round)
+{
+    if (round > c->round) {
+        report(ctx, c, round);
+        c->round = round;
+    }
+}
+
+/* ---- shots ---- */
+
+static void ensure_raster(rad_cell *c)
+{
+    if (c->z.depth) return;
+    size_t np = (size_t)c->S->hc.npix;
+    c->z.depth = xrealloc(NULL, sizeof(double) * np);
+    c->z.owner = xrealloc(NULL, sizeof(int32_t) * np);
+    c->z.stamp = calloc(np, sizeof(uint32_t));
+    if (!c->z.stamp) abort();
+    c->z.cur = 0;
+    c->mask = xrealloc(NULL, c->S->bitmap_bytes);
+}
+
+/* Forwards the shot across every face whose neighbours are downstream and take part. */
+static void forward(vw_ctx *ctx, rad_cell *c, const rad_shot_hdr *h, const double q[3],
+                    const double v[3], const uint8_t *bits, int full)
+{
+    rad_solver *S = c->S;
+    vw_box own = vw_ctx_cell_box(ctx);
+    unsigned char *buf = NULL;
+    if (!full) {
+        buf = xrealloc(NULL, sizeof *h + S->bitmap_bytes);
+        memcpy(buf, h, sizeof *h);
+        memcpy(buf + sizeof *h, bits, S->bitmap_bytes);
+    }
+    for (int f = 0; f < 6; f++) {
+        if (!c->nnb[f] || upstream(&own, f, q, v)) continue;
+        for (int i = 0; i < c->nnb[f]; i++) {
+            if (!in_range(&c->nbbox[f][i], q, v, S->opt.neighbourhood)) continue;
+            if (full) {
+                vw_send_cell(ctx, c->nb[f][i], RAD_K_FULL, h);
+                vw_count(ctx, RAD_C_FULL_MSGS, 1);
+            } else {
+                vw_send_cell(ctx, c->nb[f][i], RAD_K_SHOT, buf);
+                vw_count(ctx, RAD_C_SHOT_MSGS, 1);
+                vw_count(ctx, RAD_C_SHOT_BYTES, (int64_t)(sizeof *h + S->bitmap_bytes));
+            }
+        }
+    }
+    free(buf);
+}
+
+/* Projects this cell's elements onto the pixels still clear in mask (which it updates),
+   deposits the power of the pixels won, and forwards the merged bitmap. */
+static void process_shot(vw_ctx *ctx, rad_cell *c, const rad_shot_hdr *h, uint8_t *mask, int full)
+{
+    rad_solver *S = c->S;
+    const vw_decomp *d = vw_ctx_decomp(ctx);
+    double q[3], v[3];
+    vw_decomp_to_frame(d, h->p, q);
+    vw_decomp_to_frame(d, h->n, v);
+    const rad_hemicube *hc = &S->hc;
+    if (!full && c->nel > 0) {
+        ensure_raster(c);
+        if (++c->z.cur == 0) {
+            memset(c->z.stamp, 0, sizeof(uint32_t) * (size_t)hc->npix);
+            c->z.cur = 1;
+        }
+        double ax[3][3], vv[3];
+        memcpy(ax[0], h->u, sizeof vv);
+        rad_cross(h->n, h->u, ax[1]);
+        memcpy(ax[2], h->n, sizeof vv);
+        const double eps = S->near_eps;
+        /* Patches wholly behind (or in) the shooter plane cannot be seen. */
+        for (int p = 0; p < c->npatches; p++) {
+            const rad_piece *pc = &c->patches[p].pc;
+            c->pvis[p] = 0;
+            if (pc->id == h->piece) continue;
+            for (int i = 0; i < pc->nv && !c->pvis[p]; i++) {
+                double r[3];
+                rad_sub(pc->v[i], h->p, r);
+                c->pvis[p] = rad_dot(r, h->n) > eps;
+            }
+        }
+        if (!c->hv) c->hv = xrealloc(NULL, sizeof(double) * 3 * RAD_MAXV);
+        int64_t nr = 0;
+        for (int e = 0; e < c->nel; e++) {
+            const rad_elem *x = &c->el[e];
+            if (!x->alive || !c->pvis[x->patch]) continue;
+            int front = 0;
+            for (int i = 0; i < x->nv; i++) {
+                double r[3];
+                rad_sub(c->vp[x->vfirst + i], h->p, r);
+                for (int k = 0; k < 3; k++) c->hv[i][k] = rad_dot(r, ax[k]);
+                front |= c->hv[i][2] > eps;
+            }
+            if (!front) continue;
+            rad_hemicube_raster(hc, (const double(*)[3])c->hv, x->nv, mask, &c->z, e, eps);
+            nr++;
+        }
+        vw_count(ctx, RAD_C_RASTER, nr);
+        /* Deposit: every pixel won goes to its nearest element. */
+        if (!c->touched) c->touched = NULL;
+        int ntouched = 0, captouched = 0;
+        for (int px = 0; px < hc->npix; px++) {
+            if (c->z.stamp[px] != c->z.cur) continue;
+            rad_elem *x = &c->el[c->z.owner[px]];
+            if (x->won == 0) {
+                if (ntouched == captouched) {
+                    captouched = captouched ? 2 * captouched : 256;
+                    c->touched = xrealloc(c->touched, sizeof(int) * (size_t)captouched);
+                }
+                c->touched[ntouched++] = c->z.owner[px];
+            }
+            x->won += hc->dff[px];
+            mask[px >> 3] |= (uint8_t)(1u << (px & 7));
+        }
+        int64_t back = 0;
+        for (int t = 0; t < ntouched; t++) {
+            rad_elem *x = &c->el[c->touched[t]];
+            rad_patch *pt = &c->patches[x->patch];
+            double r[3];
+            rad_sub(h->p, c->vp[x->vfirst], r);
+            int facing = rad_dot(r, pt->pc.normal) > 0;
+            for (int k = 0; k < 3; k++) {
+                double P = x->won * h->power[k];
+                c->won[k] += P;
+                if (facing) {
+                    double refl = pt->pc.rho[k] * P;
+                    x->B[k] += refl / x->area;
+                    x->incident[k] += P;
+                    pt->unshot[k] += refl;
+                    c->absorbed[k] += P - refl;
+                } else {
+                    /* The back of a one-sided polygon is black: it absorbs. */
+                    c->absorbed[k] += P;
+                }
+            }
+            back += !facing;
+            x->won = 0;
+        }
+        if (back) vw_count(ctx, RAD_C_BACK_HITS, back);
+        full = 1;
+        for (size_t b = 0; b < S->bitmap_bytes && full; b++) {
+            uint8_t want = 0xff;
+            if (b == S->bitmap_bytes - 1 && (hc->npix & 7)) want = (uint8_t)((1u << (hc->npix & 7)) - 1);
+            full = (mask[b] & want) == want;
+        }
+    }
+    forward(ctx, c, h, q, v, mask, full);
+}
+
+/* A bitmap (or a "full" notice) from an upstream neighbour. */
+static void on_shot_common(vw_ctx *ctx, rad_cell *c, const rad_shot_hdr *h, const uint8_t *bits)
+{
+    rad_solver *S = c->S;
+    enter_round(ctx, c, h->round);
+    int k;
+    for (k = 0; k < c->npend; k++)
+        if (c->pend[k].id == h->id) break;
+    if (k == c->npend) {
+        if (c->npend == c->cappend) {
+            c->cappend = c->cappend ? 2 * c->cappend : 8;
+            c->pend = xrealloc(c->pend, sizeof *c->pend * (size_t)c->cappend);
+            for (int i = c->npend; i < c->cappend; i++) c->pend[i].bits = NULL;
+        }
+        rad_pend *pd = &c->pend[c->npend++];
+        pd->id = h->id;
+        pd->h = *h;
+        pd->received = 0;
+        pd->full = 0;
+        if (!pd->bits) pd->bits = xrealloc(NULL, S->bitmap_bytes);
+        memset(pd->bits, 0, S->bitmap_bytes);
+        /* How many bitmaps to wait for: the participating upstream neighbours. */
+        const vw_decomp *d = vw_ctx_decomp(ctx);
+        double q[3], v[3];
+        vw_decomp_to_frame(d, h->p, q);
+        vw_decomp_to_frame(d, h->n, v);
+        vw_box own = vw_ctx_cell_box(ctx);
+        int expected = 0;
+        for (int f = 0; f < 6; f++) {
+            if (!c->nnb[f] || !upstream(&own, f, q, v)) continue;
+            for (int i = 0; i < c->nnb[f]; i++)
+                expected += c->nb[f][i] == h->src_cell ||
+                            in_range(&c->nbbox[f][i], q, v, S->opt.neighbourhood);
+        }
+        pd->expected = expected > 0 ? expected : 1;
+    }
+    rad_pend *pd = &c->pend[k];
+    if (bits)
+        for (size_t b = 0; b < S->bitmap_bytes; b++) pd->bits[b] |= bits[b];
+    else
+        pd->full = 1;
+    if (++pd->received < pd->expected) return;
+    process_shot(ctx, c, &pd->h, pd->bits, pd->full);
+    /* Swap-remove, keeping the bitmap buffers for reuse. */
+    uint8_t *keep = pd->bits;
+    *pd = c->pend[--c->npend];
+    c->pend[c->npend].bits = keep;
+}
+
+static void on_shot(vw_ctx *ctx, void *state, const void *msg)
+{
+    const rad_shot_hdr *h = msg;
+    on_shot_common(ctx, state, h, (const uint8_t *)msg + sizeof *h);
+}
+
+static void on_full(vw_ctx *ctx, void *state, const void *msg)
+{
+    on_shot_common(ctx, state, msg, NULL);
+}
+
+/* A hemicube orientation turned about the normal by an angle drawn from the shot id:
+   the aliasing of successive shots then does not line up. */
+static void orientation(const double n[3], uint64_t id, double u[3])
+{
+    double t[3] = {1, 0, 0};
+    if (fabs(n[0]) > 0.6) t[0] = 0, t[1] = 1;
+    double a[3], b[3];
+    rad_cross(n, t, a);
+    rad_normalize(a);
+    rad_cross(n, a, b);
+    uint64_t z = id * 0x9e3779b97f4a7c15ull;
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+    z ^= z >> 31;
+    double ang = 2 * M_PI * (double)(z >> 11) * 0x1.0p-53;
+    for (int k = 0; k < 3; k++) u[k] = cos(ang) * a[k] + sin(ang) * b[k];
+}
+
+/* Shoots this cell's patch of largest unshot power, while the round's budget lasts. */
+static int step(vw_ctx *ctx, void *state)
+{
+    rad_cell *c = state;
+    if (c->budget <= 0) return 0;
+    int best = -1;
+    double bu = c->thr;
+    for (int p = 0; p < c->npatches; p++) {
+        double u = rad_sum3(c->patches[p].unshot);
+        if (u > bu) bu = u, best = p;
+    }
+    if (best < 0) {
+        c->budget = 0;
+        return 0;
+    }
+    rad_patch *pt = &c->patches[best];
+    rad_shot_hdr h;
+    memset(&h, 0, sizeof h);
+    memcpy(h.p, pt->pc.centroid, sizeof h.p);
+    memcpy(h.n, pt->pc.normal, sizeof h.n);
+    memcpy(h.power, pt->unshot, sizeof h.power);
+    h.id = ((uint64_t)c->cell << 40) | c->seq++;
+    h.piece = pt->pc.id;
+    h.src_cell = c->cell;
+    h.round = c->round;
+    orientation(h.n, (uint64_t)pt->pc.id * 1000003u + (uint64_t)pt->nshots, h.u);
+    for (int k = 0; k < 3; k++) {
+        c->shot[k] += pt->unshot[k];
+        pt->unshot[k] = 0;
+    }
+    pt->nshots++;
+    c->nshots++;
+    c->budget--;
+    vw_count(ctx, RAD_C_SHOTS, 1);
+    ensure_raster(c);
+    memset(c->mask, 0, c->S->bitmap_bytes);
+    process_shot(ctx, c, &h, c->mask, 0);
+    return 1;
+}
+
+/* ---- control messages ---- */
+
+static void on_go(vw_ctx *ctx, void *state, const void *msg)
+{
+    rad_cell *c = state;
+    const rad_go_msg *g = msg;
+    enter_round(ctx, c, g->round);
+    if (g->sub_rel > 0) subdivide(ctx, c, g->sub_rel, g->sub_floor, g->max_level);
+    c->budget = g->budget;
+    c->thr = g->thr;
+}
+
+static void on_collect(vw_ctx *ctx, void *state, const void *msg)
+{
+    rad_cell *c = state;
+    (void)msg;
+    report(ctx, c, c->round);
+    for (int p = 0; p < c->npatches; p++) {
+        rad_patch_result r;
+        memset(&r, 0, sizeof r);
+        r.piece = c->patches[p].pc.id;
+        r.nshots = c->patches[p].nshots;
+        memcpy(r.unshot, c->patches[p].unshot, sizeof r.unshot);
+        vw_send_output(ctx, RAD_K_PATCH_OUT, &r);
+    }
+    for (int e = 0; e < c->nel; e++) {
+        const rad_elem *x = &c->el[e];
+        if (!x->alive) continue;
+        rad_elem_result r;
+        memset(&r, 0, sizeof r);
+        r.piece = c->patches[x->patch].pc.id;
+        r.poly = c->patches[x->patch].pc.poly;
+        r.level = x->level, r.gi = x->gi, r.gj = x->gj;
+        r.area = x->area;
+        memcpy(r.B, x->B, sizeof r.B);
+        memcpy(r.incident, x->incident, sizeof r.incident);
+        vw_send_output(ctx, RAD_K_ELEM_OUT, &r);
+    }
+}
+
+static int find_patch(const rad_cell *c, int64_t piece)
+{
+    int lo = 0, hi = c->npatches - 1; /* patches are in mesh order, so sorted by id */
+    while (lo <= hi) {
+        int mid = (lo + hi) / 2;
+        if (c->patches[mid].pc.id == piece) return mid;
+        if (c->patches[mid].pc.id < piece) lo = mid + 1;
+        else hi = mid - 1;
+    }
+    return -1;
+}
+
+static void on_restore_patch(vw_ctx *ctx, void *state, const void *msg)
+{
+    rad_cell *c = state;
+    const rad_patch_result *r = msg;
+    (void)ctx;
+    int p = find_patch(c, r->piece);
+    if (p < 0) return;
+    memcpy(c->patches[p].unshot, r->unshot, sizeof r->unshot);
+    c->patches[p].nshots = r->nshots;
+}
+
+static void on_restore_elem(vw_ctx *ctx, void *state, const void *msg)
+{
+    rad_cell *c = state;
+    const rad_elem_result *r = msg;
+    (void)ctx;
+    if (find_patch(c, r->piece) < 0) return;
+    for (;;) {
+        int e = ht_find(c, r->poly, r->piece, r->level, r->gi, r->gj, 1);
+        if (e >= 0) {
+            memcpy(c->el[e].B, r->B, sizeof r->B);
+            memcpy(c->el[e].incident, r->incident, sizeof r->incident);
+            return;
+        }
+        /* Not there yet: split the finest live ancestor, then look again. */
+        int a = -1;
+        for (int l = r->level - 1; l >= 0 && a < 0; l--)
+            a = ht_find(c, r->poly, r->piece, l, r->gi >> (r->level - l), r->gj >> (r->level - l), 1);
+        if (a < 0) return;
+        split_elem(c, a);
+    }
+}
+
+/* ---- output handlers (output process) ---- */
+
+static void out_report(void *user, const void *msg)
+{
+    rad_solver *S = user;
+    const rad_report_msg *r = msg;
+    S->nreports++;
+    S->rep.nshots += r->nshots;
+    if (r->max_unshot > S->rep.max_unshot) S->rep.max_unshot = r->max_unshot;
+    for (int k = 0; k < 3; k++) {
+        S->rep.unshot[k] += r->unshot[k];
+        S->rep.absorbed[k] += r->absorbed[k];
+        S->rep.shot[k] += r->shot[k];
+        S->rep.won[k] += r->won[k];
+    }
+}
+
+static void out_patch(void *user, const void *msg)
+{
+    rad_solver *S = user;
+    if (S->npatches == S->cappatches) {
+        S->cappatches = S->cappatches ? 2 * S->cappatches : 1024;
+        S->patches = xrealloc(S->patches, sizeof *S->patches * S->cappatches);
+    }
+    memcpy(&S->patches[S->npatches++], msg, sizeof *S->patches);
+}
+
+static void out_elem(void *user, const void *msg)
+{
+    rad_solver *S = user;
+    if (S->nelems == S->capelems) {
+        S->capelems = S->capelems ? 2 * S->capelems : 1024;
+        S->elems = xrealloc(S->elems, sizeof *S->elems * S->capelems);
+    }
+    memcpy(&S->elems[S->nelems++], msg, sizeof *S->elems);
+}
+
+void rad_module_setup(rad_solver *s)
+{
+    vw_msg_kind *k = s->kinds;
+    memset(k, 0, sizeof s->kinds);
+    k[RAD_K_GO] = (vw_msg_kind){"go", sizeof(rad_go_msg), on_go, NULL};
+    k[RAD_K_SHOT] = (vw_msg_kind){"shot", sizeof(rad_shot_hdr) + s->bitmap_bytes, on_shot, NULL};
+    k[RAD_K_FULL] = (vw_msg_kind){"shot_full", sizeof(rad_shot_hdr), on_full, NULL};
+    k[RAD_K_COLLECT] = (vw_msg_kind){"collect", sizeof(rad_collect_msg), on_collect, NULL};
+    k[RAD_K_RESTORE_PATCH] = (vw_msg_kind){"restore_patch", sizeof(rad_patch_result), on_restore_patch, NULL};
+    k[RAD_K_RESTORE_ELEM] = (vw_msg_kind){"restore_elem", sizeof(rad_elem_result), on_restore_elem, NULL};
+    k[RAD_K_REPORT] = (vw_msg_kind){"report", sizeof(rad_report_msg), NULL, out_report};
+    k[RAD_K_PATCH_OUT] = (vw_msg_kind){"patch_out", sizeof(rad_patch_result), NULL, out_patch};
+    k[RAD_K_ELEM_OUT] = (vw_msg_kind){"elem_out", sizeof(rad_elem_result), NULL, out_elem};
+    vw_module *m = &s->mod;
+    memset(m, 0, sizeof *m);
+    m->abi = VW_MODULE_ABI;
+    m->name = "radiosity";
+    m->object_size = sizeof(rad_piece);
+    m->object_bounds = NULL; /* set by solve.c */
+    m->kinds = s->kinds;
+    m->nkinds = RAD_NKINDS;
+    m->counters = rad_counter_names;
+    m->ncounters = RAD_NCOUNTERS;
+    m->cell_build = cell_build;
+    m->cell_free = cell_free;
+    m->step = step;
+    m->load = cell_load;
+}

@@ -1,0 +1,358 @@
+/* output.c - what the radiosity solver writes: a vertex-coloured PLY, a per-polygon CSV
+ * and a PNG from a camera (its own small z-buffer rasteriser of the elements, Gouraud
+ * shaded). Every file is written atomically: a temporary file in the same directory,
+ * renamed over the target only once complete.
+ *
+ * Display colours: radiosity plus the ambient term of progressive refinement (the
+ * unshot power spread evenly, Cohen et al. 1988) for display only, scaled so that the
+ * 95th percentile of the non-emitting elements maps to 0.85, gamma 2.2.
+ */
+#include "radiosity/radiosity.h"
+#include "radiosity/vec.h"
+
+#include <errno.h>
+#include <stdarg.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "vwalls/image.h"
+
+vw_status rad_write_atomic(const char *path, const void *buf, size_t len, char *err, size_t errlen)
+{
+    size_t n = strlen(path);
+    char *tmp = malloc(n + 16);
+    if (!tmp) return VW_E_NOMEM;
+    snprintf(tmp, n + 16, "%s.tmp.XXXXXX", path);
+    int fd = mkstemp(tmp);
+    if (fd < 0) {
+        snprintf(err, errlen, "%s: cannot write: %s", path, strerror(errno));
+        free(tmp);
+        return VW_E_IO;
+    }
+    FILE *f = fdopen(fd, "wb");
+    int ok = f && fwrite(buf, 1, len, f) == len;
+    ok = (f ? fclose(f) == 0 : (close(fd), 0)) && ok;
+    if (!ok || rename(tmp, path) != 0) {
+        snprintf(err, errlen, "%s: cannot write: %s", path, strerror(errno));
+        unlink(tmp);
+        free(tmp);
+        return VW_E_IO;
+    }
+    free(tmp);
+    return VW_OK;
+}
+
+/* A growing text buffer. */
+typedef struct sbuf {
+    char *s;
+    size_t n, cap;
+    int oom;
+} sbuf;
+
+static void sb_printf(sbuf *b, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+static void sb_printf(sbuf *b, const char *fmt, ...)
+{
+    for (;;) {
+        va_list ap;
+        va_start(ap, fmt);
+        int k = vsnprintf(b->s ? b->s + b->n : NULL, b->s ? b->cap - b->n : 0, fmt, ap);
+        va_end(ap);
+        if (k < 0) return;
+        if (b->s && b->n + (size_t)k < b->cap) {
+            b->n += (size_t)k;
+            return;
+        }
+        size_t nc = b->cap ? 2 * b->cap : 1 << 16;
+        while (nc < b->n + (size_t)k + 1) nc *= 2;
+        char *ns = realloc(b->s, nc);
+        if (!ns) {
+            b->oom = 1;
+            return;
+        }
+        b->s = ns, b->cap = nc;
+    }
+}
+
+void rad_ambient(const rad_mesh *m, const rad_patch_result *p, size_t np, double out[3])
+{
+    double rho[3] = {0, 0, 0}, un[3] = {0, 0, 0};
+    for (size_t i = 0; i < m->npieces; i++)
+        for (int k = 0; k < 3; k++) rho[k] += m->pieces[i].rho[k] * m->pieces[i].area;
+    for (size_t i = 0; i < np; i++)
+        for (int k = 0; k < 3; k++) un[k] += p[i].unshot[k];
+    for (int k = 0; k < 3; k++) {
+        double r = m->area > 0 ? rho[k] / m->area : 0;
+        out[k] = m->area > 0 ? un[k] / m->area / (1 - fmin(r, 0.999)) : 0;
+    }
+}
+
+/* Per element vertex: display radiosity averaged over the elements of the same polygon
+   meeting at that point (so the PLY and the image are smooth inside a polygon). */
+typedef struct vkey {
+    int32_t poly;
+    int64_t q[3];
+    size_t slot;
+} vkey;
+
+static int cmp_vkey(const void *a, const void *b)
+{
+    const vkey *x = a, *y = b;
+    if (x->poly != y->poly) return x->poly < y->poly ? -1 : 1;
+    for (int k = 0; k < 3; k++)
+        if (x->q[k] != y->q[k]) return x->q[k] < y->q[k] ? -1 : 1;
+    return 0;
+}
+
+typedef struct shaded {
+    size_t n;             /* elements */
+    size_t *first;        /* first vertex slot of element i */
+    int *nv;
+    double (*v)[3];       /* slot positions */
+    float (*col)[3];      /* slot colours, 0..1 after tone mapping */
+} shaded;
+
+static void shaded_free(shaded *s)
+{
+    free(s->first), free(s->nv), free(s->v), free(s->col);
+}
+
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return x < y ? -1 : x > y;
+}
+
+static int shade(const rad_mesh *m, const rad_elem_result *e, size_t n, const double amb[3], shaded *out)
+{
+    memset(out, 0, sizeof *out);
+    out->n = n;
+    out->first = malloc(sizeof(size_t) * (n + 1));
+    out->nv = malloc(sizeof(int) * (n ? n : 1));
+    size_t cap = n * 6 + 16, ns = 0;
+    out->v = malloc(sizeof *out->v * cap);
+    double (*rad)[3] = malloc(sizeof *rad * (n ? n : 1));
+    if (!out->first || !out->nv || !out->v || !rad) goto oom;
+    double ext = 0;
+    for (size_t i = 0; i < m->npieces; i++)
+        for (int k = 0; k < 3; k++) ext = fmax(ext, fabs(m->pieces[i].centroid[k]));
+    double quant = 1e-7 * (ext > 0 ? ext : 1);
+    /* Display radiosity per element, and the exposure from non-emitters. */
+    double *lum = malloc(sizeof(double) * (n ? n : 1));
+    size_t nl = 0;
+    if (!lum) goto oom;
+    for (size_t i = 0; i < n; i++) {
+        const rad_piece *pc = &m->pieces[e[i].piece];
+        for (int k = 0; k < 3; k++) rad[i][k] = e[i].B[k] + pc->rho[k] * amb[k];
+        if (rad_sum3(pc->emit) == 0) lum[nl++] = rad_sum3(rad[i]) / 3;
+    }
+    double expo = 1;
+    if (nl) {
+        qsort(lum, nl, sizeof(double), cmp_double);
+        double p95 = lum[(size_t)(0.95 * (double)(nl - 1))];
+        expo = p95 > 0 ? 0.85 / p95 : 1;
+    }
+    free(lum);
+    for (size_t i = 0; i < n; i++) {
+        rad_poly poly;
+        const rad_piece *pc = &m->pieces[e[i].piece];
+        int k = rad_elem_polygon(pc, e[i].level, e[i].gi, e[i].gj, &poly);
+        if (ns + (size_t)k > cap) {
+            while (ns + (size_t)k > cap) cap *= 2;
+            void *nv = realloc(out->v, sizeof *out->v * cap);
+            if (!nv) goto oom;
+            out->v = nv;
+        }
+        out->first[i] = ns;
+        out->nv[i] = k;
+        memcpy(out->v + ns, poly.v, sizeof(double) * 3 * (size_t)k);
+        ns += (size_t)k;
+    }
+    out->first[n] = ns;
+    vkey *keys = malloc(sizeof *keys * (ns ? ns : 1));
+    size_t *owner = malloc(sizeof(size_t) * (ns ? ns : 1));
+    out->col = malloc(sizeof *out->col * (ns ? ns : 1));
+    if (!keys || !owner || !out->col) {
+        free(keys), free(owner);
+        goto oom;
+    }
+    for (size_t i = 0; i < n; i++)
+        for (size_t s = out->first[i]; s < out->first[i + 1]; s++) {
+            keys[s].poly = e[i].poly;
+            for (int k = 0; k < 3; k++) keys[s].q[k] = (int64_t)llround(out->v[s][k] / quant);
+            keys[s].slot = s;
+            owner[s] = i;
+        }
+    qsort(keys, ns, sizeof *keys, cmp_vkey);
+    for (size_t a = 0; a < ns;) {
+        size_t b = a;
+        double acc[3] = {0, 0, 0}, w = 0;
+        while (b < ns && cmp_vkey(&keys[a], &keys[b]) == 0) {
+            size_t i = owner[keys[b].slot];
+            for (int k = 0; k < 3; k++) acc[k] += rad[i][k] * e[i].area;
+            w += e[i].area;
+            b++;
+        }
+        for (size_t c = a; c < b; c++) {
+            size_t i = owner[keys[c].slot];
+            const rad_piece *pc = &m->pieces[e[i].piece];
+            for (int k = 0; k < 3; k++) {
+                /* Emitters keep their own colour (a light is not blurred into its frame). */
+                double x = rad_sum3(pc->emit) > 0 ? rad[i][k] : acc[k] / w;
+                x = fmin(fmax(x * expo, 0), 1);
+                out->col[keys[c].slot][k] = (float)pow(x, 1 / 2.2);
+            }
+        }
+        a = b;
+    }
+    free(keys), free(owner), free(rad);
+    return 0;
+oom:
+    free(rad);
+    shaded_free(out);
+    return -1;
+}
+
+vw_status rad_write_ply(const char *path, const rad_mesh *m, const rad_elem_result *e, size_t n,
+                        const double ambient[3], char *err, size_t errlen)
+{
+    shaded sh;
+    if (shade(m, e, n, ambient, &sh)) return VW_E_NOMEM;
+    sbuf b = {0};
+    size_t nv = sh.first[n];
+    sb_printf(&b, "ply\nformat ascii 1.0\ncomment vwalls radiosity: %zu elements\n"
+                  "element vertex %zu\nproperty float x\nproperty float y\nproperty float z\n"
+                  "property uchar red\nproperty uchar green\nproperty uchar blue\n"
+                  "element face %zu\nproperty list uchar int vertex_indices\nend_header\n",
+              n, nv, n);
+    for (size_t s = 0; s < nv; s++)
+        sb_printf(&b, "%.9g %.9g %.9g %d %d %d\n", sh.v[s][0], sh.v[s][1], sh.v[s][2],
+                  (int)lround(255 * sh.col[s][0]), (int)lround(255 * sh.col[s][1]),
+                  (int)lround(255 * sh.col[s][2]));
+    for (size_t i = 0; i < n; i++) {
+        sb_printf(&b, "%d", sh.nv[i]);
+        for (int k = 0; k < sh.nv[i]; k++) sb_printf(&b, " %zu", sh.first[i] + (size_t)k);
+        sb_printf(&b, "\n");
+    }
+    shaded_free(&sh);
+    vw_status st = b.oom ? VW_E_NOMEM : rad_write_atomic(path, b.s, b.n, err, errlen);
+    free(b.s);
+    return st;
+}
+
+vw_status rad_write_csv(const char *path, const rad_mesh *m, const vw_scene *sc,
+                        const rad_elem_result *e, size_t n, char *err, size_t errlen)
+{
+    size_t np = m->npolys;
+    double *area = malloc(sizeof(double) * (np ? np : 1));
+    double (*B)[3] = malloc(sizeof *B * (np ? np : 1)), (*inc)[3] = malloc(sizeof *inc * (np ? np : 1));
+    if (!area || !B || !inc) {
+        free(area), free(B), free(inc);
+        return VW_E_NOMEM;
+    }
+    rad_polygon_sums(e, n, np, area, B, inc);
+    sbuf b = {0};
+    sb_printf(&b, "polygon,area,rho_r,rho_g,rho_b,emit_r,emit_g,emit_b,B_r,B_g,B_b\n");
+    for (size_t k = 0; k < sc->npolygons; k++) {
+        const vw_polygon *pg = &sc->polygons[k];
+        if (pg->id < 0 || (size_t)pg->id >= np || area[pg->id] <= 0) continue;
+        const vw_material *mt =
+            pg->material >= 0 && (size_t)pg->material < sc->nmaterials ? &sc->materials[pg->material] : NULL;
+        sb_printf(&b, "%d,%.9g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.9g,%.9g,%.9g\n", pg->id, area[pg->id],
+                  mt ? mt->diffuse[0] : 0.5, mt ? mt->diffuse[1] : 0.5, mt ? mt->diffuse[2] : 0.5,
+                  mt ? mt->emission[0] : 0, mt ? mt->emission[1] : 0, mt ? mt->emission[2] : 0,
+                  B[pg->id][0], B[pg->id][1], B[pg->id][2]);
+        area[pg->id] = 0; /* once per polygon */
+    }
+    free(area), free(B), free(inc);
+    vw_status st = b.oom ? VW_E_NOMEM : rad_write_atomic(path, b.s, b.n, err, errlen);
+    free(b.s);
+    return st;
+}
+
+/* ---- the image: perspective z-buffer over triangles with Gouraud colour ---- */
+
+vw_status rad_write_image(const char *path, const vw_camera *cam, const rad_mesh *m,
+                          const rad_elem_result *e, size_t n, const double ambient[3], char *err,
+                          size_t errlen)
+{
+    int W = cam->width > 0 ? cam->width : 512, H = cam->height > 0 ? cam->height : 512;
+    shaded sh;
+    if (shade(m, e, n, ambient, &sh)) return VW_E_NOMEM;
+    float *zb = malloc(sizeof(float) * (size_t)W * (size_t)H);
+    uint8_t *img = calloc((size_t)W * (size_t)H * 3, 1);
+    if (!zb || !img) {
+        free(zb), free(img), shaded_free(&sh);
+        return VW_E_NOMEM;
+    }
+    for (size_t i = 0; i < (size_t)W * (size_t)H; i++) zb[i] = INFINITY;
+    double fw[3], rt[3], up[3];
+    rad_sub(cam->at, cam->from, fw);
+    rad_normalize(fw);
+    rad_cross(fw, cam->up, rt);
+    if (!rad_normalize(rt)) rt[0] = 1, rt[1] = rt[2] = 0;
+    rad_cross(rt, fw, up);
+    double f = 1 / tan(0.5 * (cam->angle > 0 ? cam->angle : 45) * M_PI / 180);
+    double hither = cam->hither > 0 ? cam->hither : 1e-3;
+    for (size_t i = 0; i < n; i++) {
+        /* Camera space (x right, y up, z forward), clipped at the near plane. */
+        double P[RAD_MAXV + 2][6], Q[RAD_MAXV + 2][6];
+        int nv = sh.nv[i], nq = 0;
+        for (int k = 0; k < nv; k++) {
+            double r[3];
+            rad_sub(sh.v[sh.first[i] + k], cam->from, r);
+            P[k][0] = rad_dot(r, rt), P[k][1] = rad_dot(r, up), P[k][2] = rad_dot(r, fw);
+            for (int c = 0; c < 3; c++) P[k][3 + c] = sh.col[sh.first[i] + k][c];
+        }
+        for (int k = 0; k < nv; k++) {
+            const double *s = P[k], *t = P[(k + 1) % nv];
+            double ds = s[2] - hither, dt = t[2] - hither;
+            if (ds >= 0) memcpy(Q[nq++], s, sizeof Q[0]);
+            if ((ds >= 0) != (dt >= 0)) {
+                double a = ds / (ds - dt);
+                for (int c = 0; c < 6; c++) Q[nq][c] = s[c] + a * (t[c] - s[c]);
+                nq++;
+            }
+        }
+        if (nq < 3) continue;
+        double X[RAD_MAXV + 2], Y[RAD_MAXV + 2], iz[RAD_MAXV + 2];
+        for (int k = 0; k < nq; k++) {
+            iz[k] = 1 / Q[k][2];
+            X[k] = 0.5 * W + 0.5 * H * f * Q[k][0] * iz[k];
+            Y[k] = 0.5 * H - 0.5 * H * f * Q[k][1] * iz[k];
+        }
+        for (int t = 1; t + 1 < nq; t++) {
+            int a = 0, b = t, c = t + 1;
+            double area = (X[b] - X[a]) * (Y[c] - Y[a]) - (X[c] - X[a]) * (Y[b] - Y[a]);
+            if (area == 0) continue;
+            int x0 = (int)fmax(0, floor(fmin(X[a], fmin(X[b], X[c])))),
+                x1 = (int)fmin(W - 1, ceil(fmax(X[a], fmax(X[b], X[c]))));
+            int y0 = (int)fmax(0, floor(fmin(Y[a], fmin(Y[b], Y[c])))),
+                y1 = (int)fmin(H - 1, ceil(fmax(Y[a], fmax(Y[b], Y[c]))));
+            for (int y = y0; y <= y1; y++)
+                for (int x = x0; x <= x1; x++) {
+                    double px = x + 0.5, py = y + 0.5;
+                    double w0 = ((X[b] - px) * (Y[c] - py) - (X[c] - px) * (Y[b] - py)) / area;
+                    double w1 = ((X[c] - px) * (Y[a] - py) - (X[a] - px) * (Y[c] - py)) / area;
+                    double w2 = 1 - w0 - w1;
+                    if (w0 < -1e-9 || w1 < -1e-9 || w2 < -1e-9) continue;
+                    /* Perspective-correct: interpolate attribute/z and 1/z. */
+                    double izp = w0 * iz[a] + w1 * iz[b] + w2 * iz[c];
+                    float depth = (float)(1 / izp);
+                    size_t pix = (size_t)y * (size_t)W + (size_t)x;
+                    if (!(depth < zb[pix])) continue;
+                    zb[pix] = depth;
+                    for (int ch = 0; ch < 3; ch++) {
+                        double v = (w0 * Q[a][3 + ch] * iz[a] + w1 * Q[b][3 + ch] * iz[b] +
+                                    w2 * Q[c][3 + ch] * iz[c]) / izp;
+                        img[3 * pix + (size_t)ch] = (uint8_t)lround(255 * fmin(fmax(v, 0), 1));
+                    }
+                }
+        }
+    }
+    vw_status st = vw_image_write_png(path, W, H, img, err, errlen);
+    free(zb), free(img), shaded_free(&sh);
+    return st;
+}

@@ -1,0 +1,196 @@
+/* radiosity.h - the distributed progressive radiosity solver (DESIGN.md section 7), as an
+ * application of the public vwalls API: meshing, the vwalls module, the solve loop, the
+ * hemicube and the outputs. Every name here is rad_*; nothing outside apps/ and tools/
+ * uses it.
+ *
+ * Invariants the whole application keeps:
+ *  - a piece (a patch clipped at the walls) lies in exactly one cell, its owner, the cell
+ *    vw_decomp_locate() gives for its centroid with its normal as direction; every other
+ *    cell the runtime hands it to drops it;
+ *  - no geometry leaves its cell: a shot travels as a header plus a hemicube coverage
+ *    bitmap, results travel to the output process as numbers;
+ *  - energy ledger (per RGB channel, double): emitted = absorbed + unshot + escaped.
+ */
+#ifndef RAD_RADIOSITY_H
+#define RAD_RADIOSITY_H
+
+#include <stddef.h>
+#include <stdint.h>
+#include "vwalls/vwalls.h"
+
+/* Largest number of vertices of a piece or element after clipping. A convex input
+   polygon of up to RAD_MAXV-10 vertices always fits (a rectangle adds at most 4, a
+   box at most 6). */
+#define RAD_MAXV 24
+/* Hemicube resolution limit: a shot message (header + 3 res^2 bits) must fit into
+   VW_MAX_MSG_BYTES. */
+#define RAD_MAX_RES 100
+
+/* The object handed to the runtime: one patch clipped to one cell (plain data). */
+typedef struct rad_piece {
+    int64_t id;             /* global piece id: index in the mesh */
+    int32_t poly;           /* original polygon id (scene object id) */
+    int32_t nv;
+    int32_t pi, pj;         /* patch grid index in the polygon's (u,v) frame */
+    double v[RAD_MAXV][3];
+    double normal[3], centroid[3], area;
+    double origin[3], uax[3], vax[3];  /* the polygon's frame: elements align to it */
+    double elem;            /* level-0 receiver element size */
+    double rho[3], emit[3]; /* reflectance; emitted radiosity (power per area) */
+} rad_piece;
+
+typedef struct rad_options {
+    double sf;              /* stop when max unshot / emitted < sf */
+    int res;                /* hemicube resolution (even, <= RAD_MAX_RES) */
+    double patch_size;      /* largest patch side; <= 0: from the scene size */
+    int elem_split;         /* receiver elements per patch side */
+    int workers;
+    int dims[3];            /* grid layout of cells */
+    int per_round;          /* shots per cell per round */
+    double neighbourhood;   /* > 0: a shot reaches only cells within this distance */
+    double subdivide;       /* > 0: adaptive subdivision threshold (relative) */
+    int max_level;          /* deepest subdivision level */
+    int64_t max_shots;      /* > 0: stop after this many shots (not converged) */
+    int max_rounds;         /* > 0: stop after this many rounds (testing a kill) */
+    const char *checkpoint; /* file to write checkpoints to, or NULL */
+    double checkpoint_every;/* seconds between checkpoints (0: every round) */
+    const char *resume;     /* checkpoint to resume from, or NULL */
+    int quiet;
+} rad_options;
+
+void rad_options_init(rad_options *o);
+
+/* ---- meshing (mesh.c) ---- */
+
+typedef struct rad_mesh {
+    rad_piece *pieces;
+    size_t npieces;
+    int *owner;             /* owner cell of each piece */
+    size_t npolys;          /* scene polygons (ids are scene ids, may be sparse) */
+    double emitted[3];      /* total emitted power */
+    double area;            /* total area */
+} rad_mesh;
+
+/* Splits every polygon into patches and clips them at the cells of d. Bad geometry is
+   reported as "file:line: message" in err (VW_E_INPUT); zero-area polygons are skipped
+   with a warning on stderr (unless quiet). A scene without emitter is an error. */
+vw_status rad_mesh_build(const vw_scene *s, const char *path, const vw_decomp *d,
+                         const rad_options *o, rad_mesh *m, char *err, size_t errlen);
+void rad_mesh_free(rad_mesh *m);
+/* The world box for a scene: its bounds, padded so that no axis is flat. */
+vw_box rad_world_box(const vw_scene *s);
+/* The default patch size for a scene (a tenth of the largest extent). */
+double rad_default_patch_size(const vw_scene *s);
+
+/* Geometry helpers shared with the module and the outputs. */
+typedef struct rad_poly {
+    int n;
+    double v[RAD_MAXV][3];
+} rad_poly;
+/* Element (level, gi, gj) of piece pc: the piece clipped to the grid square. Returns the
+   number of vertices (0 when empty). */
+int rad_elem_polygon(const rad_piece *pc, int level, int gi, int gj, rad_poly *out);
+/* The range of level-0 element grid indices a piece covers. */
+void rad_piece_grid(const rad_piece *pc, int lo[2], int hi[2]);
+double rad_poly_area(const rad_poly *p, double normal[3], double centroid[3]);
+
+/* ---- hemicube (hemicube.c) ---- */
+
+typedef struct rad_hemicube {
+    int res;                /* top face res x res; four half sides res x res/2 */
+    int npix;               /* 3 res^2: pixel layout in hemicube.c */
+    double *dff;            /* delta form factor per pixel, normalised to sum 1 */
+    double raw_sum;         /* their sum before normalising (about 1) */
+} rad_hemicube;
+
+vw_status rad_hemicube_init(rad_hemicube *h, int res);
+void rad_hemicube_free(rad_hemicube *h);
+/* Bytes of a coverage bitmap. */
+size_t rad_hemicube_bitmap_bytes(int res);
+
+/* Rasterises a polygon given in hemicube coordinates (x, y along the orientation, z
+   along the shooter normal; origin at the shooter) into a z-buffer: pixels whose bit in
+   mask is clear and whose stored depth is larger take depth and id. stamp/cur mark the
+   pixels written in this shot (depth is valid only where stamp == cur). */
+typedef struct rad_zbuf {
+    double *depth;
+    int32_t *owner;
+    uint32_t *stamp;
+    uint32_t cur;
+} rad_zbuf;
+void rad_hemicube_raster(const rad_hemicube *h, const double (*hv)[3], int nv, const uint8_t *mask,
+                         rad_zbuf *z, int32_t id, double near_eps);
+
+/* ---- the solver (module.c, solve.c) ---- */
+
+/* One receiver element's result, gathered on the output process. */
+typedef struct rad_elem_result {
+    int64_t piece;
+    int32_t poly, level, gi, gj;
+    double area;
+    double B[3];            /* radiosity */
+    double incident[3];     /* power that arrived (front side) */
+} rad_elem_result;
+
+typedef struct rad_patch_result {
+    int64_t piece;
+    int64_t nshots;
+    double unshot[3];
+} rad_patch_result;
+
+typedef struct rad_ledger {
+    double emitted[3], absorbed[3], unshot[3], escaped[3];
+    double error;           /* max over channels of |emitted - rest| / emitted */
+} rad_ledger;
+
+typedef struct rad_solver rad_solver;
+
+typedef void (*rad_progress_fn)(void *user, double unshot_ratio, int64_t shots);
+
+/* Creates the world over a mesh (the mesh must outlive the solver). */
+vw_status rad_solver_create(const rad_mesh *m, const vw_decomp *d, const rad_options *o,
+                            rad_solver **out, char *err, size_t errlen);
+void rad_solver_free(rad_solver *s);
+/* Runs rounds until converged (or a limit of the options). *converged tells which. */
+vw_status rad_solver_run(rad_solver *s, rad_progress_fn progress, void *user, int *converged,
+                         char *err, size_t errlen);
+/* Gathers the results on the output process (elements sorted by piece, level, gi, gj). */
+vw_status rad_solver_collect(rad_solver *s, char *err, size_t errlen);
+const rad_elem_result *rad_solver_elements(const rad_solver *s, size_t *n);
+const rad_patch_result *rad_solver_patches(const rad_solver *s, size_t *n);
+rad_ledger rad_solver_ledger(const rad_solver *s);
+int64_t rad_solver_shots(const rad_solver *s);
+double rad_solver_unshot_ratio(const rad_solver *s);
+vw_world *rad_solver_world(rad_solver *s);
+/* Writes a checkpoint (collects first); atomic. */
+vw_status rad_solver_checkpoint(rad_solver *s, const char *path, char *err, size_t errlen);
+/* Snapshot hook: called after every round on every process (it may collect). */
+typedef void (*rad_round_fn)(void *user, rad_solver *s, int round);
+void rad_solver_on_round(rad_solver *s, rad_round_fn fn, void *user);
+/* Messages and bytes of shots (for the bench). */
+void rad_solver_traffic(const rad_solver *s, int64_t *shot_msgs, int64_t *shot_bytes,
+                        int64_t *full_msgs);
+
+/* Per original polygon: area-weighted radiosity and total incident power, indexed by
+   polygon id (arrays of npoly entries, zero where a polygon has no element). */
+void rad_polygon_sums(const rad_elem_result *e, size_t n, size_t npoly, double *area,
+                      double (*B)[3], double (*incident)[3]);
+
+/* ---- outputs (output.c) ---- */
+
+/* PLY with vertex colours (radiosity averaged at shared vertices of a polygon, plus the
+   display ambient term), atomic. */
+vw_status rad_write_ply(const char *path, const rad_mesh *m, const rad_elem_result *e, size_t n,
+                        const double ambient[3], char *err, size_t errlen);
+vw_status rad_write_csv(const char *path, const rad_mesh *m, const vw_scene *sc,
+                        const rad_elem_result *e, size_t n, char *err, size_t errlen);
+vw_status rad_write_image(const char *path, const vw_camera *cam, const rad_mesh *m,
+                          const rad_elem_result *e, size_t n, const double ambient[3], char *err,
+                          size_t errlen);
+/* The display-only ambient term of progressive refinement (Cohen et al. 1988). */
+void rad_ambient(const rad_mesh *m, const rad_patch_result *p, size_t np, double out[3]);
+/* Writes buf[0..len) to path atomically (temp file in the same directory + rename). */
+vw_status rad_write_atomic(const char *path, const void *buf, size_t len, char *err,
+                           size_t errlen);
+
+#endif

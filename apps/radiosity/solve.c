@@ -1,0 +1,358 @@
+/* solve.c - the solve loop of the radiosity solver: rounds of vw_world_run, the energy
+ * ledger, gathering results on the output process, checkpoints and resuming.
+ *
+ * A round posts GO(round, budget) to every cell and runs to quiescence: each cell
+ * shoots up to `budget` patches above the threshold, and every shot ends within the
+ * run. The first message of a round a cell handles makes it report the state the last
+ * round left, so after run r the output process knows the exact quiescent state at the
+ * start of round r. A round in which no cell shot (a global counter, the same on every
+ * process) means every patch is below the threshold: converged, and the reports of
+ * that round describe the final state.
+ */
+#include "radiosity/solver_internal.h"
+#include "radiosity/vec.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+static double now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static void piece_bounds(const void *obj, vw_box *out, void *user)
+{
+    const rad_piece *pc = obj;
+    (void)user;
+    for (int a = 0; a < 3; a++) out->lo[a] = INFINITY, out->hi[a] = -INFINITY;
+    for (int i = 0; i < pc->nv; i++)
+        for (int a = 0; a < 3; a++) {
+            out->lo[a] = fmin(out->lo[a], pc->v[i][a]);
+            out->hi[a] = fmax(out->hi[a], pc->v[i][a]);
+        }
+}
+
+static vw_status run_world(rad_solver *s, char *err, size_t errlen)
+{
+    memset(&s->rep, 0, sizeof s->rep);
+    s->nreports = 0;
+    vw_status st = vw_world_run(s->w);
+    if (st != VW_OK) snprintf(err, errlen, "radiosity run failed: %s", vw_world_errmsg(s->w));
+    return st;
+}
+
+/* The ledger from the last run's reports (output process). */
+static void update_ledger(rad_solver *s)
+{
+    rad_ledger *L = &s->ledger;
+    L->error = 0;
+    for (int k = 0; k < 3; k++) {
+        L->emitted[k] = s->mesh->emitted[k];
+        L->absorbed[k] = s->base_absorbed[k] + s->rep.absorbed[k];
+        L->unshot[k] = s->rep.unshot[k];
+        L->escaped[k] = s->base_escaped[k] + s->rep.shot[k] - s->rep.won[k];
+        double scale = fmax(L->emitted[k], 1e-300 + 1e-12 * s->emitted_sum);
+        double e = fabs(L->emitted[k] - (L->absorbed[k] + L->unshot[k] + L->escaped[k])) / scale;
+        if (e > L->error) L->error = e;
+    }
+    s->ratio = s->rep.max_unshot / s->emitted_sum;
+}
+
+vw_status rad_solver_create(const rad_mesh *m, const vw_decomp *d, const rad_options *o,
+                            rad_solver **out, char *err, size_t errlen)
+{
+    *out = NULL;
+    if (errlen) err[0] = 0;
+    rad_solver *s = calloc(1, sizeof *s);
+    if (!s) return VW_E_NOMEM;
+    s->mesh = m;
+    s->d = d;
+    s->opt = *o;
+    vw_status st = rad_hemicube_init(&s->hc, o->res);
+    if (st != VW_OK) {
+        snprintf(err, errlen, "--hemicube %d: must be even and between 2 and %d", o->res, RAD_MAX_RES);
+        free(s);
+        return st;
+    }
+    s->bitmap_bytes = rad_hemicube_bitmap_bytes(o->res);
+    rad_module_setup(s);
+    s->mod.object_bounds = piece_bounds;
+    s->emitted_sum = rad_sum3(m->emitted);
+    s->thr = o->sf * s->emitted_sum;
+    vw_box wb = vw_decomp_world(d);
+    double ext = 0;
+    for (int a = 0; a < 3; a++) ext = fmax(ext, wb.hi[a] - wb.lo[a]);
+    s->near_eps = 1e-9 * ext;
+    vw_config cfg;
+    vw_config_init(&cfg);
+    cfg.workers = o->workers;
+    st = vw_world_create(&s->mod, s, d, &cfg, &s->w);
+    if (st == VW_OK) st = vw_world_add_objects(s->w, m->pieces, m->npieces);
+    if (st == VW_OK) st = vw_world_commit(s->w);
+    if (st != VW_OK) {
+        snprintf(err, errlen, "cannot set up the radiosity world: %s",
+                 s->w ? vw_world_errmsg(s->w) : vw_status_message(st));
+        rad_solver_free(s);
+        return st;
+    }
+    if (o->checkpoint && vw_world_processes(s->w) > 1 && o->checkpoint_every > 0) {
+        /* A time-based decision would differ between processes. */
+        snprintf(err, errlen, "--checkpoint-every with several processes is not supported; use 0 (every round)");
+        rad_solver_free(s);
+        return VW_E_UNSUPPORTED;
+    }
+    if (o->resume) {
+        st = VW_OK;
+        FILE *f = fopen(o->resume, "rb");
+        char magic[8];
+        uint64_t npieces = 0, fp = 0, np = 0, ne = 0;
+        int32_t round = 0;
+        int64_t shots = 0;
+        double ba[3], be[3];
+        if (!f) {
+            snprintf(err, errlen, "%s: cannot open checkpoint: %s", o->resume, strerror(errno));
+            rad_solver_free(s);
+            return VW_E_IO;
+        }
+        uint64_t want = 1469598103934665603ull;
+        for (size_t i = 0; i < m->npieces; i++) {
+            uint64_t bits;
+            memcpy(&bits, &m->pieces[i].area, sizeof bits);
+            want = (want ^ bits) * 1099511628211ull;
+            memcpy(&bits, &m->pieces[i].centroid[0], sizeof bits);
+            want = (want ^ bits) * 1099511628211ull;
+        }
+        if (fread(magic, 1, 8, f) != 8 || memcmp(magic, "VWRADCK1", 8) || fread(&npieces, 8, 1, f) != 1 ||
+            fread(&fp, 8, 1, f) != 1 || fread(&round, 4, 1, f) != 1 || fread(&shots, 8, 1, f) != 1 ||
+            fread(ba, 8, 3, f) != 3 || fread(be, 8, 3, f) != 3 || fread(&np, 8, 1, f) != 1) {
+            snprintf(err, errlen, "%s: not a radiosity checkpoint (or truncated)", o->resume);
+            st = VW_E_INPUT;
+        } else if (npieces != m->npieces || fp != want) {
+            snprintf(err, errlen,
+                     "%s: checkpoint of a different scene or meshing (use the same scene, --cells, "
+                     "--patch-size and --elements as the run that wrote it)", o->resume);
+            st = VW_E_INPUT;
+        }
+        for (uint64_t i = 0; st == VW_OK && i < np; i++) {
+            rad_patch_result r;
+            if (fread(&r, sizeof r, 1, f) != 1 || r.piece < 0 || (size_t)r.piece >= m->npieces) {
+                snprintf(err, errlen, "%s: truncated or corrupt checkpoint", o->resume);
+                st = VW_E_INPUT;
+                break;
+            }
+            vw_world_post(s->w, m->owner[r.piece], RAD_K_RESTORE_PATCH, &r);
+        }
+        if (st == VW_OK && fread(&ne, 8, 1, f) != 1) st = VW_E_INPUT;
+        for (uint64_t i = 0; st == VW_OK && i < ne; i++) {
+            rad_elem_result r;
+            if (fread(&r, sizeof r, 1, f) != 1 || r.piece < 0 || (size_t)r.piece >= m->npieces) {
+                st = VW_E_INPUT;
+                break;
+            }
+            vw_world_post(s->w, m->owner[r.piece], RAD_K_RESTORE_ELEM, &r);
+        }
+        if (st == VW_E_INPUT && !err[0]) snprintf(err, errlen, "%s: truncated or corrupt checkpoint", o->resume);
+        fclose(f);
+        if (st == VW_OK) {
+            s->round = round;
+            s->base_shots = shots;
+            memcpy(s->base_absorbed, ba, sizeof ba);
+            memcpy(s->base_escaped, be, sizeof be);
+            st = run_world(s, err, errlen);
+        }
+        if (st != VW_OK) {
+            rad_solver_free(s);
+            return st;
+        }
+    }
+    s->shots = s->base_shots;
+    *out = s;
+    return VW_OK;
+}
+
+void rad_solver_free(rad_solver *s)
+{
+    if (!s) return;
+    vw_world_free(s->w);
+    rad_hemicube_free(&s->hc);
+    free(s->elems);
+    free(s->patches);
+    free(s);
+}
+
+void rad_solver_on_round(rad_solver *s, rad_round_fn fn, void *user)
+{
+    s->on_round = fn;
+    s->on_round_user = user;
+}
+
+vw_status rad_solver_run(rad_solver *s, rad_progress_fn progress, void *user, int *converged,
+                         char *err, size_t errlen)
+{
+    *converged = 0;
+    int ncells = vw_decomp_cell_count(s->d);
+    double last_ck = now();
+    int rounds = 0;
+    for (;;) {
+        rad_go_msg g;
+        memset(&g, 0, sizeof g);
+        g.round = ++s->round;
+        g.budget = s->opt.per_round > 0 ? s->opt.per_round : 1;
+        g.thr = s->thr;
+        if (s->opt.subdivide > 0) {
+            g.sub_rel = s->opt.subdivide;
+            g.sub_floor = 0.01 * s->opt.subdivide * s->emitted_sum / 3 / s->mesh->area;
+            g.max_level = s->opt.max_level;
+        }
+        for (int c = 0; c < ncells; c++) vw_world_post(s->w, c, RAD_K_GO, &g);
+        int64_t before = vw_world_counter(s->w, RAD_C_SHOTS);
+        vw_status st = run_world(s, err, errlen);
+        if (st != VW_OK) return st;
+        int64_t after = vw_world_counter(s->w, RAD_C_SHOTS);
+        s->shots = s->base_shots + after;
+        rounds++;
+        if (vw_world_is_output(s->w)) {
+            update_ledger(s);
+            if (progress) progress(user, s->ratio, s->shots);
+        }
+        /* On every process: the hook may collect, which is a run everybody joins. */
+        if (s->on_round) s->on_round(s->on_round_user, s, s->round);
+        if (after == before) {
+            *converged = 1;
+            break;
+        }
+        if (s->opt.max_shots > 0 && s->shots >= s->opt.max_shots) break;
+        if (s->opt.checkpoint && now() - last_ck >= s->opt.checkpoint_every) {
+            st = rad_solver_checkpoint(s, s->opt.checkpoint, err, errlen);
+            if (st != VW_OK) return st;
+            last_ck = now();
+        }
+        if (s->opt.max_rounds > 0 && rounds >= s->opt.max_rounds) break;
+    }
+    return VW_OK;
+}
+
+static int cmp_elem(const void *a, const void *b)
+{
+    const rad_elem_result *x = a, *y = b;
+    if (x->piece != y->piece) return x->piece < y->piece ? -1 : 1;
+    if (x->level != y->level) return x->level < y->level ? -1 : 1;
+    if (x->gi != y->gi) return x->gi < y->gi ? -1 : 1;
+    if (x->gj != y->gj) return x->gj < y->gj ? -1 : 1;
+    return 0;
+}
+
+static int cmp_patch(const void *a, const void *b)
+{
+    const rad_patch_result *x = a, *y = b;
+    return x->piece < y->piece ? -1 : x->piece > y->piece;
+}
+
+vw_status rad_solver_collect(rad_solver *s, char *err, size_t errlen)
+{
+    s->nelems = s->npatches = 0;
+    rad_collect_msg m = {0, 0};
+    int ncells = vw_decomp_cell_count(s->d);
+    for (int c = 0; c < ncells; c++) vw_world_post(s->w, c, RAD_K_COLLECT, &m);
+    vw_status st = run_world(s, err, errlen);
+    if (st != VW_OK) return st;
+    if (vw_world_is_output(s->w)) {
+        qsort(s->elems, s->nelems, sizeof *s->elems, cmp_elem);
+        qsort(s->patches, s->npatches, sizeof *s->patches, cmp_patch);
+        update_ledger(s);
+    }
+    return VW_OK;
+}
+
+const rad_elem_result *rad_solver_elements(const rad_solver *s, size_t *n)
+{
+    *n = s->nelems;
+    return s->elems;
+}
+
+const rad_patch_result *rad_solver_patches(const rad_solver *s, size_t *n)
+{
+    *n = s->npatches;
+    return s->patches;
+}
+
+rad_ledger rad_solver_ledger(const rad_solver *s) { return s->ledger; }
+int64_t rad_solver_shots(const rad_solver *s) { return s->shots; }
+double rad_solver_unshot_ratio(const rad_solver *s) { return s->ratio; }
+vw_world *rad_solver_world(rad_solver *s) { return s->w; }
+
+void rad_solver_traffic(const rad_solver *s, int64_t *shot_msgs, int64_t *shot_bytes, int64_t *full_msgs)
+{
+    *shot_msgs = vw_world_counter(s->w, RAD_C_SHOT_MSGS);
+    *shot_bytes = vw_world_counter(s->w, RAD_C_SHOT_BYTES);
+    *full_msgs = vw_world_counter(s->w, RAD_C_FULL_MSGS);
+}
+
+/* Checkpoint: "VWRADCK1", pieces, mesh fingerprint, round, shots, absorbed[3],
+   escaped[3], patches, elements (native byte order: resume on the same kind of
+   machine). Written atomically: a kill while writing leaves the previous one. */
+vw_status rad_solver_checkpoint(rad_solver *s, const char *path, char *err, size_t errlen)
+{
+    vw_status st = rad_solver_collect(s, err, errlen);
+    if (st != VW_OK || !vw_world_is_output(s->w)) return st;
+    const rad_mesh *m = s->mesh;
+    uint64_t fp = 1469598103934665603ull;
+    for (size_t i = 0; i < m->npieces; i++) {
+        uint64_t bits;
+        memcpy(&bits, &m->pieces[i].area, sizeof bits);
+        fp = (fp ^ bits) * 1099511628211ull;
+        memcpy(&bits, &m->pieces[i].centroid[0], sizeof bits);
+        fp = (fp ^ bits) * 1099511628211ull;
+    }
+    size_t len = 8 + 8 + 8 + 4 + 8 + 48 + 8 + s->npatches * sizeof(rad_patch_result) + 8 +
+                 s->nelems * sizeof(rad_elem_result);
+    unsigned char *buf = malloc(len), *p = buf;
+    if (!buf) return VW_E_NOMEM;
+    uint64_t npieces = m->npieces, np = s->npatches, ne = s->nelems;
+    int32_t round = s->round;
+    int64_t shots = s->shots;
+    double ab[3], es[3];
+    for (int k = 0; k < 3; k++) ab[k] = s->ledger.absorbed[k], es[k] = s->ledger.escaped[k];
+#define PUT(x, n) (memcpy(p, (x), (n)), p += (n))
+    PUT("VWRADCK1", 8);
+    PUT(&npieces, 8);
+    PUT(&fp, 8);
+    PUT(&round, 4);
+    PUT(&shots, 8);
+    PUT(ab, 24);
+    PUT(es, 24);
+    PUT(&np, 8);
+    PUT(s->patches, s->npatches * sizeof(rad_patch_result));
+    PUT(&ne, 8);
+    PUT(s->elems, s->nelems * sizeof(rad_elem_result));
+#undef PUT
+    st = rad_write_atomic(path, buf, len, err, errlen);
+    free(buf);
+    return st;
+}
+
+void rad_polygon_sums(const rad_elem_result *e, size_t n, size_t npoly, double *area,
+                      double (*B)[3], double (*incident)[3])
+{
+    for (size_t i = 0; i < npoly; i++) {
+        area[i] = 0;
+        for (int k = 0; k < 3; k++) B[i][k] = incident[i][k] = 0;
+    }
+    for (size_t i = 0; i < n; i++) {
+        if (e[i].poly < 0 || (size_t)e[i].poly >= npoly) continue;
+        area[e[i].poly] += e[i].area;
+        for (int k = 0; k < 3; k++) {
+            B[e[i].poly][k] += e[i].B[k] * e[i].area;
+            incident[e[i].poly][k] += e[i].incident[k];
+        }
+    }
+    for (size_t i = 0; i < npoly; i++)
+        if (area[i] > 0)
+            for (int k = 0; k < 3; k++) B[i][k] /= area[i];
+}

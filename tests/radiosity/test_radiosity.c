@@ -1,0 +1,340 @@
+/* test_radiosity.c - tests of the radiosity application: delta form factors, analytic
+ * form factors, a closed box, decomposition independence, the energy ledger and
+ * checkpoint/resume. One executable; the first argument names the test.
+ * Scenes are built in code (squares, a box) or by the generators (cornell).
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "radiosity/radiosity.h"
+#include "vw_test.h"
+#include "vwalls/gen.h"
+
+/* ---- scenes in code ---- */
+
+typedef struct quad {
+    double v[4][3];
+    float rho, emit;
+} quad;
+
+static vw_scene *scene_of(const quad *q, int n)
+{
+    vw_scene *s = calloc(1, sizeof *s);
+    s->materials = calloc((size_t)n, sizeof *s->materials);
+    s->polygons = calloc((size_t)n, sizeof *s->polygons);
+    s->vertices = calloc((size_t)n * 4, sizeof *s->vertices);
+    s->indices = calloc((size_t)n * 4, sizeof *s->indices);
+    s->nmaterials = s->npolygons = (size_t)n;
+    s->nvertices = s->nindices = (size_t)n * 4;
+    for (int i = 0; i < n; i++) {
+        for (int k = 0; k < 3; k++) {
+            s->materials[i].diffuse[k] = q[i].rho;
+            s->materials[i].emission[k] = q[i].emit;
+        }
+        s->materials[i].ior = 1;
+        s->polygons[i] = (vw_polygon){.id = i, .material = i, .first = 4 * i, .count = 4};
+        for (int k = 0; k < 4; k++) {
+            memcpy(s->vertices[4 * i + k], q[i].v[k], sizeof(double) * 3);
+            s->indices[4 * i + k] = 4 * i + k;
+        }
+    }
+    return s;
+}
+
+/* The six inward faces of the unit cube; face 0 (the floor) emits when emit > 0. */
+static vw_scene *box_scene(float rho, float emit)
+{
+    quad q[6] = {
+        {{{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}}, rho, emit},   /* z=0, normal +z */
+        {{{0, 0, 1}, {0, 1, 1}, {1, 1, 1}, {1, 0, 1}}, rho, 0},      /* z=1, normal -z */
+        {{{0, 0, 0}, {0, 1, 0}, {0, 1, 1}, {0, 0, 1}}, rho, 0},      /* x=0, normal +x */
+        {{{1, 0, 0}, {1, 0, 1}, {1, 1, 1}, {1, 1, 0}}, rho, 0},      /* x=1, normal -x */
+        {{{0, 0, 0}, {0, 0, 1}, {1, 0, 1}, {1, 0, 0}}, rho, 0},      /* y=0, normal +y */
+        {{{0, 1, 0}, {1, 1, 0}, {1, 1, 1}, {0, 1, 1}}, rho, 0},      /* y=1, normal -y */
+    };
+    return scene_of(q, 6);
+}
+
+static vw_scene *cornell(void)
+{
+    vw_scene *s = NULL;
+    char err[256];
+    vw_status st = vw_gen("cornell", NULL, &s, err, sizeof err);
+    if (st != VW_OK) {
+        fprintf(stderr, "cornell: %s\n", err);
+        exit(1);
+    }
+    return s;
+}
+
+/* ---- solving ---- */
+
+typedef struct result {
+    size_t npoly;
+    double *area;
+    double (*B)[3], (*inc)[3];
+    rad_ledger ledger;
+    int64_t shots;
+    double ratio;
+} result;
+
+static void result_free(result *r)
+{
+    free(r->area), free(r->B), free(r->inc);
+}
+
+static result solve(const vw_scene *sc, rad_options o)
+{
+    result r;
+    memset(&r, 0, sizeof r);
+    o.quiet = 1;
+    vw_box wb = rad_world_box(sc);
+    vw_decomp *d;
+    CHECK(vw_decomp_create_grid(&wb, o.dims, &d) == VW_OK);
+    rad_mesh m;
+    char err[512] = "";
+    vw_status st = rad_mesh_build(sc, "test", d, &o, &m, err, sizeof err);
+    if (st != VW_OK) fprintf(stderr, "%s\n", err);
+    CHECK(st == VW_OK);
+    rad_solver *s;
+    st = rad_solver_create(&m, d, &o, &s, err, sizeof err);
+    if (st != VW_OK) fprintf(stderr, "%s\n", err);
+    CHECK(st == VW_OK);
+    int conv = 0;
+    CHECK(rad_solver_run(s, NULL, NULL, &conv, err, sizeof err) == VW_OK);
+    CHECK(rad_solver_collect(s, err, sizeof err) == VW_OK);
+    size_t ne;
+    const rad_elem_result *e = rad_solver_elements(s, &ne);
+    r.npoly = m.npolys;
+    r.area = calloc(r.npoly, sizeof *r.area);
+    r.B = calloc(r.npoly, sizeof *r.B);
+    r.inc = calloc(r.npoly, sizeof *r.inc);
+    rad_polygon_sums(e, ne, r.npoly, r.area, r.B, r.inc);
+    r.ledger = rad_solver_ledger(s);
+    r.shots = rad_solver_shots(s);
+    r.ratio = rad_solver_unshot_ratio(s);
+    if (o.max_rounds == 0 && o.max_shots == 0) CHECK(conv);
+    rad_solver_free(s);
+    rad_mesh_free(&m);
+    vw_decomp_free(d);
+    return r;
+}
+
+/* Area-weighted relative RMS difference of polygon radiosities. */
+static double rel_rms(const result *a, const result *b)
+{
+    double num = 0, den = 0;
+    for (size_t i = 0; i < a->npoly; i++)
+        for (int k = 0; k < 3; k++) {
+            double d = a->B[i][k] - b->B[i][k];
+            num += a->area[i] * d * d;
+            den += a->area[i] * b->B[i][k] * b->B[i][k];
+        }
+    return sqrt(num / den);
+}
+
+/* ---- tests ---- */
+
+static int t_ffsum(void)
+{
+    int res[] = {8, 32, 64, 100};
+    for (int i = 0; i < 4; i++) {
+        rad_hemicube h;
+        CHECK(rad_hemicube_init(&h, res[i]) == VW_OK);
+        printf("res %3d: sum of delta form factors %.6f\n", res[i], h.raw_sum);
+        if (res[i] >= 32) CHECK_NEAR(h.raw_sum, 1.0, 1e-3);
+        double s = 0;
+        for (int p = 0; p < h.npix; p++) s += h.dff[p];
+        CHECK_NEAR(s, 1.0, 1e-12);
+        rad_hemicube_free(&h);
+    }
+    CHECK(rad_hemicube_bitmap_bytes(RAD_MAX_RES) + 128 <= VW_MAX_MSG_BYTES);
+    return 0;
+}
+
+/* F from unit square 0 (emitting, black) to square 1 (black): incident / emitted. */
+static double ff(const quad *q, const char *layout, int *ok)
+{
+    vw_scene *sc = scene_of(q, 2);
+    rad_options o;
+    rad_options_init(&o);
+    o.patch_size = 1.0 / 16;
+    o.elem_split = 1;
+    o.res = 100;
+    o.sf = 1e-9;
+    o.workers = 2;
+    if (layout) vw_layout_parse(layout, o.dims, NULL, 0);
+    result r = solve(sc, o);
+    double F = r.inc[1][0] / 1.0;
+    printf("F = %.5f  (%s, ledger error %.2e, escaped %.4f)\n", F, layout ? layout : "1",
+           r.ledger.error, r.ledger.escaped[0]);
+    *ok = r.ledger.error < 1e-9;
+    result_free(&r);
+    vw_scene_free(sc);
+    return F;
+}
+
+static int t_parallel(void)
+{
+    quad q[2] = {{{{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}}, 0, 1},
+                 {{{0, 0, 1}, {0, 1, 1}, {1, 1, 1}, {1, 0, 1}}, 0, 0}};
+    /* Parallel unit squares at distance 1 (Howell's catalogue, C-11). */
+    double X = 1, Y = 1, x = sqrt(1 + X * X), y = sqrt(1 + Y * Y);
+    double ref = 2 / (M_PI * X * Y) *
+                 (0.5 * log(x * x * y * y / (x * x + y * y - 1)) + X * y * atan(X / y) + Y * x * atan(Y / x) -
+                  X * atan(X) - Y * atan(Y));
+    int ok;
+    double F = ff(q, NULL, &ok);
+    printf("analytic %.5f, relative error %.3f%%\n", ref, 100 * fabs(F - ref) / ref);
+    CHECK(ok);
+    CHECK_NEAR(F, ref, 0.02 * ref);
+    F = ff(q, "2x2x2", &ok);
+    CHECK(ok);
+    CHECK_NEAR(F, ref, 0.02 * ref);
+    return 0;
+}
+
+static int t_perpendicular(void)
+{
+    quad q[2] = {{{{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}}, 0, 1},   /* z=0, normal +z */
+                 {{{0, 0, 0}, {0, 0, 1}, {1, 0, 1}, {1, 0, 0}}, 0, 0}};  /* y=0, normal +y */
+    /* Perpendicular unit squares sharing an edge (Howell C-14, W = H = 1). */
+    double W = 1, H = 1, W2 = W * W, H2 = H * H, R = W2 + H2;
+    double ref = 1 / (M_PI * W) *
+                 (W * atan(1 / W) + H * atan(1 / H) - sqrt(R) * atan(1 / sqrt(R)) +
+                  0.25 * log((1 + W2) * (1 + H2) / (1 + R) *
+                             pow(W2 * (1 + R) / ((1 + W2) * R), W2) *
+                             pow(H2 * (1 + R) / ((1 + H2) * R), H2)));
+    int ok;
+    double F = ff(q, NULL, &ok);
+    printf("analytic %.5f, relative error %.3f%%\n", ref, 100 * fabs(F - ref) / ref);
+    CHECK(ok);
+    CHECK_NEAR(F, ref, 0.02 * ref);
+    F = ff(q, "2x2x2", &ok);
+    CHECK(ok);
+    CHECK_NEAR(F, ref, 0.02 * ref);
+    return 0;
+}
+
+static int t_box(void)
+{
+    const float rho = 0.5f;
+    vw_scene *sc = box_scene(rho, 1);
+    rad_options o;
+    rad_options_init(&o);
+    o.patch_size = 0.25;
+    o.sf = 1e-5;
+    o.workers = 2;
+    const char *layouts[] = {"1", "2x2x2"};
+    for (int l = 0; l < 2; l++) {
+        vw_layout_parse(layouts[l], o.dims, NULL, 0);
+        result r = solve(sc, o);
+        double total = 0, emitted = 1; /* the floor: area 1, Ke 1 */
+        for (size_t i = 0; i < r.npoly; i++) total += r.B[i][0] * r.area[i];
+        double want = emitted / (1 - rho);
+        printf("%s: sum B*A = %.6f, want %.6f (rel %.2e), %lld shots, ledger %.2e, escaped %.2e\n",
+               layouts[l], total, want, fabs(total - want) / want, (long long)r.shots, r.ledger.error,
+               r.ledger.escaped[0]);
+        CHECK_NEAR(total, want, 0.01 * want);
+        CHECK(r.ledger.error < 1e-9);
+        result_free(&r);
+    }
+    vw_scene_free(sc);
+    return 0;
+}
+
+static int t_layouts(void)
+{
+    vw_scene *sc = cornell();
+    rad_options o;
+    rad_options_init(&o);
+    o.sf = 2e-4;
+    o.workers = 1;
+    result ref = solve(sc, o);
+    printf("1 cell, 1 worker: %lld shots, ledger %.2e\n", (long long)ref.shots, ref.ledger.error);
+    CHECK(ref.ledger.error < 1e-9);
+    struct { const char *layout; int workers; } v[] = {
+        {"1", 2}, {"1", 4}, {"2x2x2", 1}, {"2x2x2", 2}, {"2x2x2", 4}, {"4x4x4", 2},
+    };
+    for (size_t i = 0; i < sizeof v / sizeof v[0]; i++) {
+        vw_layout_parse(v[i].layout, o.dims, NULL, 0);
+        o.workers = v[i].workers;
+        result r = solve(sc, o);
+        double e = rel_rms(&r, &ref);
+        printf("%-6s %d workers: %lld shots, relative RMS vs one cell %.3f%%, ledger %.2e\n", v[i].layout,
+               v[i].workers, (long long)r.shots, 100 * e, r.ledger.error);
+        CHECK(e <= 0.01);
+        CHECK(r.ledger.error < 1e-9);
+        result_free(&r);
+    }
+    result_free(&ref);
+    vw_scene_free(sc);
+    return 0;
+}
+
+static int t_checkpoint(void)
+{
+    vw_scene *sc = cornell();
+    rad_options o;
+    rad_options_init(&o);
+    o.sf = 2e-4;
+    o.workers = 2;
+    vw_layout_parse("2x2x2", o.dims, NULL, 0);
+    result full = solve(sc, o);
+    char path[] = "/tmp/vw_rad_ckXXXXXX";
+    int fd = mkstemp(path);
+    CHECK(fd >= 0);
+    close(fd);
+    rad_options a = o;
+    a.checkpoint = path;
+    a.checkpoint_every = 0;
+    a.max_rounds = 3;
+    result part = solve(sc, a); /* stops mid-run; the checkpoint of round 3 stays */
+    printf("interrupted after %lld shots (unshot ratio %.3g)\n", (long long)part.shots, part.ratio);
+    CHECK(part.ratio > o.sf);
+    rad_options b = o;
+    b.resume = path;
+    result res = solve(sc, b);
+    double e = rel_rms(&res, &full);
+    printf("resumed: %lld shots in all, relative RMS vs uninterrupted %.3f%%, ledger %.2e\n",
+           (long long)res.shots, 100 * e, res.ledger.error);
+    CHECK(res.shots > part.shots);
+    CHECK(e <= 0.01);
+    CHECK(res.ledger.error < 1e-9);
+    unlink(path);
+    result_free(&full), result_free(&part), result_free(&res);
+    vw_scene_free(sc);
+    return 0;
+}
+
+/* Writes a generated scene as NFF (the CLI tests read it). */
+static int t_gen(const char *name, const char *path)
+{
+    vw_scene *s = NULL;
+    char err[256];
+    CHECK(vw_gen(name, NULL, &s, err, sizeof err) == VW_OK);
+    CHECK(vw_scene_write_nff_file(s, path, err, sizeof err) == VW_OK);
+    vw_scene_free(s);
+    return 0;
+}
+
+int main(int argc, char **argv)
+{
+    if (argc < 2) {
+        fprintf(stderr, "usage: test_radiosity ffsum|parallel|perpendicular|box|layouts|checkpoint|gen NAME FILE\n");
+        return 2;
+    }
+    const char *t = argv[1];
+    if (!strcmp(t, "ffsum")) return t_ffsum();
+    if (!strcmp(t, "parallel")) return t_parallel();
+    if (!strcmp(t, "perpendicular")) return t_perpendicular();
+    if (!strcmp(t, "box")) return t_box();
+    if (!strcmp(t, "layouts")) return t_layouts();
+    if (!strcmp(t, "checkpoint")) return t_checkpoint();
+    if (!strcmp(t, "gen") && argc == 4) return t_gen(argv[2], argv[3]);
+    fprintf(stderr, "unknown test '%s'\n", t);
+    return 2;
+}

@@ -1,0 +1,370 @@
+/* cmd_radiosity.c - vwalls radiosity: the distributed progressive radiosity solver on an
+ * OBJ+MTL or NFF scene, writing a vertex-coloured PLY, a per-polygon CSV, a PNG, stats
+ * and checkpoints (apps/radiosity does the work; this file is options and files).
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "cli.h"
+#include "commands.h"
+#include "radiosity/radiosity.h"
+
+static const char *const CMD = "radiosity";
+
+static void help(void)
+{
+    printf("usage: vwalls radiosity SCENE.(obj|nff) -o OUT.ply [options]\n"
+           "\n"
+           "Progressive refinement radiosity, distributed over cells: every cell shoots its\n"
+           "patch of largest unshot power; a shot travels from cell to cell as a hemicube\n"
+           "coverage bitmap, front to back from the shooter, never as geometry.\n"
+           "Emission comes from MTL 'Ke' (NFF: '#vw Ke r g b' after an 'f'), reflectance\n"
+           "from 'Kd' (NFF: colour * Kd).\n"
+           "  -o FILE.ply          vertex-coloured mesh of the solution\n"
+           "  --cells L            layout of cells, like 2x2x2 (default 1)\n"
+           "  --workers W          worker threads per process (default: number of cores)\n"
+           "  --sf X               stop when max unshot power / emitted < X (default 1e-3)\n"
+           "  --hemicube RES       hemicube resolution, even, <= %d (default 64)\n"
+           "  --patch-size S       largest patch side (default: scene extent / 10)\n"
+           "  --elements K         receiver elements per patch side (default 2)\n"
+           "  --per-round K        shots per cell between convergence checks (default 4)\n"
+           "  --neighbourhood D    a shot reaches only cells within D of the shooter\n"
+           "  --subdivide T        split elements whose radiosity differs from a neighbour's\n"
+           "                       by more than T (relative to their mean)\n"
+           "  --max-level N        deepest subdivision (default 3)\n"
+           "  --max-shots N        stop after about N shots (not converged)\n"
+           "  --csv FILE           per polygon: id, area, reflectance, emission, radiosity\n"
+           "  --image FILE.png     picture from the scene's camera (or --view)\n"
+           "  --view F,A[,FOV]     camera: from x,y,z, at x,y,z, vertical angle (degrees)\n"
+           "  --size WxH           picture size (default: the camera's, or 512x512)\n"
+           "  --snapshot-every N   rewrite the outputs every N shots while solving\n"
+           "  --stats FILE.json    stats JSON (radiosity: shots, unshot_ratio, energy_error)\n"
+           "  --checkpoint FILE    write checkpoints here (atomically)\n"
+           "  --checkpoint-every S seconds between checkpoints (default 60; 0: every round)\n"
+           "  --resume FILE        continue from a checkpoint (same scene and meshing options)\n"
+           "  --max-rounds N       stop after N rounds without writing outputs (tests: a kill)\n"
+           "  --quiet              no progress bar and no summary\n",
+           RAD_MAX_RES);
+}
+
+typedef struct run_ctx {
+    const char *out, *csv, *image, *stats;
+    const vw_scene *scene;
+    const rad_mesh *mesh;
+    vw_camera cam;
+    int64_t snapshot_every, last_snapshot;
+    vw_progress bar;
+    double sf;
+    int failed;
+} run_ctx;
+
+static void on_progress(void *user, double ratio, int64_t shots)
+{
+    run_ctx *r = user;
+    char note[96];
+    snprintf(note, sizeof note, "unshot %.2e / sf %.0e, %lld shots", ratio, r->sf, (long long)shots);
+    double frac = ratio <= r->sf ? 1 : ratio >= 1 ? 0 : log(ratio) / log(r->sf);
+    vw_progress_update(&r->bar, frac, note);
+}
+
+static int write_outputs(run_ctx *r, rad_solver *s)
+{
+    char err[512];
+    size_t ne, np;
+    const rad_elem_result *e = rad_solver_elements(s, &ne);
+    const rad_patch_result *p = rad_solver_patches(s, &np);
+    double amb[3];
+    rad_ambient(r->mesh, p, np, amb);
+    vw_status st = VW_OK;
+    if (r->out) st = rad_write_ply(r->out, r->mesh, e, ne, amb, err, sizeof err);
+    if (st == VW_OK && r->csv) st = rad_write_csv(r->csv, r->mesh, r->scene, e, ne, err, sizeof err);
+    if (st == VW_OK && r->image) st = rad_write_image(r->image, &r->cam, r->mesh, e, ne, amb, err, sizeof err);
+    if (st != VW_OK) {
+        vw_cli_error(CMD, "%s", st == VW_E_NOMEM ? "out of memory writing the outputs" : err);
+        return -1;
+    }
+    return 0;
+}
+
+static void on_round(void *user, rad_solver *s, int round)
+{
+    run_ctx *r = user;
+    (void)round;
+    if (r->snapshot_every <= 0 || r->failed) return;
+    if (rad_solver_shots(s) - r->last_snapshot < r->snapshot_every) return;
+    r->last_snapshot = rad_solver_shots(s);
+    char err[512];
+    if (rad_solver_collect(s, err, sizeof err) != VW_OK) {
+        vw_cli_error(CMD, "%s", err);
+        r->failed = 1;
+        return;
+    }
+    if (vw_world_is_output(rad_solver_world(s)) && write_outputs(r, s)) r->failed = 1;
+}
+
+static int parse_view(const char *v, vw_camera *cam)
+{
+    double x[7];
+    int n = sscanf(v, "%lf,%lf,%lf,%lf,%lf,%lf,%lf", &x[0], &x[1], &x[2], &x[3], &x[4], &x[5], &x[6]);
+    if (n < 6) return -1;
+    for (int k = 0; k < 3; k++) cam->from[k] = x[k], cam->at[k] = x[3 + k];
+    cam->up[0] = 0, cam->up[1] = 1, cam->up[2] = 0;
+    if (n == 7) cam->angle = x[6];
+    if (!(cam->angle > 0 && cam->angle < 180)) cam->angle = 45;
+    cam->hither = 1e-3;
+    return 0;
+}
+
+int vw_cmd_radiosity(int argc, char **argv)
+{
+    rad_options o;
+    rad_options_init(&o);
+    run_ctx r;
+    memset(&r, 0, sizeof r);
+    const char *scene_path = NULL, *view = NULL;
+    int W = 0, H = 0;
+    long lv;
+    for (int i = 1; i < argc; i++) {
+        const char *a = argv[i], *v;
+#define VALUE() if (!(v = vw_cli_value(CMD, argc, argv, &i))) return VW_EXIT_USAGE
+        if (!strcmp(a, "--help") || !strcmp(a, "-h")) {
+            help();
+            return VW_EXIT_OK;
+        } else if (!strcmp(a, "--quiet")) {
+            o.quiet = 1;
+        } else if (!strcmp(a, "-o")) {
+            VALUE();
+            r.out = v;
+        } else if (!strcmp(a, "--cells")) {
+            VALUE();
+            if (vw_cli_layout(CMD, a, v, o.dims)) return VW_EXIT_USAGE;
+        } else if (!strcmp(a, "--workers")) {
+            VALUE();
+            if (vw_cli_int(CMD, a, v, 1, 1024, &lv)) return VW_EXIT_USAGE;
+            o.workers = (int)lv;
+        } else if (!strcmp(a, "--sf")) {
+            VALUE();
+            if (vw_cli_double(CMD, a, v, 1e-12, 1, &o.sf)) return VW_EXIT_USAGE;
+        } else if (!strcmp(a, "--hemicube")) {
+            VALUE();
+            if (vw_cli_int(CMD, a, v, 2, RAD_MAX_RES, &lv)) return VW_EXIT_USAGE;
+            if (lv & 1) {
+                vw_cli_error(CMD, "--hemicube: bad value '%s' (expected an even number)", v);
+                return VW_EXIT_USAGE;
+            }
+            o.res = (int)lv;
+        } else if (!strcmp(a, "--patch-size")) {
+            VALUE();
+            if (vw_cli_double(CMD, a, v, 1e-9, 1e30, &o.patch_size)) return VW_EXIT_USAGE;
+        } else if (!strcmp(a, "--elements")) {
+            VALUE();
+            if (vw_cli_int(CMD, a, v, 1, 64, &lv)) return VW_EXIT_USAGE;
+            o.elem_split = (int)lv;
+        } else if (!strcmp(a, "--per-round")) {
+            VALUE();
+            if (vw_cli_int(CMD, a, v, 1, 1000000, &lv)) return VW_EXIT_USAGE;
+            o.per_round = (int)lv;
+        } else if (!strcmp(a, "--neighbourhood")) {
+            VALUE();
+            if (vw_cli_double(CMD, a, v, 1e-12, 1e30, &o.neighbourhood)) return VW_EXIT_USAGE;
+        } else if (!strcmp(a, "--subdivide")) {
+            VALUE();
+            if (vw_cli_double(CMD, a, v, 1e-6, 100, &o.subdivide)) return VW_EXIT_USAGE;
+        } else if (!strcmp(a, "--max-level")) {
+            VALUE();
+            if (vw_cli_int(CMD, a, v, 0, 12, &lv)) return VW_EXIT_USAGE;
+            o.max_level = (int)lv;
+        } else if (!strcmp(a, "--max-shots")) {
+            VALUE();
+            if (vw_cli_int(CMD, a, v, 1, 0x7fffffffL, &lv)) return VW_EXIT_USAGE;
+            o.max_shots = lv;
+        } else if (!strcmp(a, "--max-rounds")) {
+            VALUE();
+            if (vw_cli_int(CMD, a, v, 1, 0x7fffffffL, &lv)) return VW_EXIT_USAGE;
+            o.max_rounds = (int)lv;
+        } else if (!strcmp(a, "--csv")) {
+            VALUE();
+            r.csv = v;
+        } else if (!strcmp(a, "--image")) {
+            VALUE();
+            r.image = v;
+        } else if (!strcmp(a, "--view")) {
+            VALUE();
+            view = v;
+        } else if (!strcmp(a, "--size")) {
+            VALUE();
+            if (vw_cli_size(CMD, a, v, &W, &H)) return VW_EXIT_USAGE;
+        } else if (!strcmp(a, "--snapshot-every")) {
+            VALUE();
+            if (vw_cli_int(CMD, a, v, 1, 0x7fffffffL, &lv)) return VW_EXIT_USAGE;
+            r.snapshot_every = lv;
+        } else if (!strcmp(a, "--stats")) {
+            VALUE();
+            r.stats = v;
+        } else if (!strcmp(a, "--checkpoint")) {
+            VALUE();
+            o.checkpoint = v;
+        } else if (!strcmp(a, "--checkpoint-every")) {
+            VALUE();
+            if (vw_cli_double(CMD, a, v, 0, 1e9, &o.checkpoint_every)) return VW_EXIT_USAGE;
+        } else if (!strcmp(a, "--resume")) {
+            VALUE();
+            o.resume = v;
+        } else if (a[0] == '-' && a[1]) {
+            vw_cli_error(CMD, "unknown option '%s' (try --help)", a);
+            return VW_EXIT_USAGE;
+        } else if (!scene_path) {
+            scene_path = a;
+        } else {
+            vw_cli_error(CMD, "more than one scene ('%s' and '%s')", scene_path, a);
+            return VW_EXIT_USAGE;
+        }
+#undef VALUE
+    }
+    if (!scene_path) {
+        vw_cli_error(CMD, "no scene given (try --help)");
+        return VW_EXIT_USAGE;
+    }
+    if (!r.out && !r.csv && !r.image && !r.stats && !o.checkpoint) {
+        vw_cli_error(CMD, "no output: give -o OUT.ply (or --csv, --image, --stats)");
+        return VW_EXIT_USAGE;
+    }
+    vw_camera cam_view;
+    memset(&cam_view, 0, sizeof cam_view);
+    if (view && parse_view(view, &cam_view)) {
+        vw_cli_error(CMD, "--view: bad value '%s' (expected fx,fy,fz,ax,ay,az[,fov])", view);
+        return VW_EXIT_USAGE;
+    }
+
+    double t0 = vw_cli_now();
+    char err[1024] = "";
+    vw_scene *sc = NULL;
+    if (vw_scene_read_file(scene_path, &sc, err, sizeof err) != VW_OK) {
+        fprintf(stderr, "%s\n", err);
+        return VW_EXIT_USAGE;
+    }
+    vw_box world = rad_world_box(sc);
+    vw_decomp *d = NULL;
+    vw_status st = vw_decomp_create_grid(&world, o.dims, &d);
+    if (st != VW_OK) {
+        vw_cli_error(CMD, "cannot make the decomposition: %s", vw_status_message(st));
+        vw_scene_free(sc);
+        return VW_EXIT_FAIL;
+    }
+    rad_mesh mesh;
+    double t1 = vw_cli_now();
+    st = rad_mesh_build(sc, scene_path, d, &o, &mesh, err, sizeof err);
+    if (st != VW_OK) {
+        if (vw_cli_is_output()) fprintf(stderr, "%s\n", err);
+        vw_decomp_free(d);
+        vw_scene_free(sc);
+        return st == VW_E_INPUT ? VW_EXIT_USAGE : VW_EXIT_FAIL;
+    }
+    r.scene = sc;
+    r.mesh = &mesh;
+    r.sf = o.sf;
+    if (view)
+        r.cam = cam_view;
+    else if (sc->camera.valid)
+        r.cam = sc->camera;
+    else
+        vw_scene_default_camera(sc, &r.cam);
+    if (W > 0) r.cam.width = W, r.cam.height = H;
+    if (r.cam.width <= 0) r.cam.width = 512, r.cam.height = 512;
+
+    rad_solver *s = NULL;
+    double t2 = vw_cli_now();
+    st = rad_solver_create(&mesh, d, &o, &s, err, sizeof err);
+    int rc = VW_EXIT_OK;
+    if (st != VW_OK) {
+        vw_cli_error(CMD, "%s", err);
+        rc = st == VW_E_INPUT || st == VW_E_INVAL || st == VW_E_IO ? VW_EXIT_USAGE : VW_EXIT_FAIL;
+        goto done;
+    }
+    double t3 = vw_cli_now();
+    rad_solver_on_round(s, on_round, &r);
+    vw_progress_begin(&r.bar, "radiosity", o.quiet || !vw_world_is_output(rad_solver_world(s)));
+    int converged = 0;
+    st = rad_solver_run(s, on_progress, &r, &converged, err, sizeof err);
+    vw_progress_end(&r.bar);
+    if (st != VW_OK || r.failed) {
+        if (st != VW_OK) vw_cli_error(CMD, "%s", err);
+        rc = VW_EXIT_FAIL;
+        goto done;
+    }
+    if (o.max_rounds > 0 && !converged) {
+        /* Stopped on purpose, as if killed: the checkpoint is the only output. */
+        if (o.checkpoint && rad_solver_checkpoint(s, o.checkpoint, err, sizeof err) != VW_OK) {
+            vw_cli_error(CMD, "%s", err);
+            rc = VW_EXIT_FAIL;
+        }
+        goto done;
+    }
+    if (rad_solver_collect(s, err, sizeof err) != VW_OK) {
+        vw_cli_error(CMD, "%s", err);
+        rc = VW_EXIT_FAIL;
+        goto done;
+    }
+    double t4 = vw_cli_now();
+    vw_world *w = rad_solver_world(s);
+    if (vw_world_is_output(w)) {
+        rad_ledger L = rad_solver_ledger(s);
+        if (write_outputs(&r, s)) {
+            rc = VW_EXIT_FAIL;
+            goto done;
+        }
+        if (o.checkpoint && rad_solver_checkpoint(s, o.checkpoint, err, sizeof err) != VW_OK) {
+            vw_cli_error(CMD, "%s", err);
+            rc = VW_EXIT_FAIL;
+            goto done;
+        }
+        int64_t sm, sb, fm;
+        rad_solver_traffic(s, &sm, &sb, &fm);
+        size_t ne;
+        rad_solver_elements(s, &ne);
+        if (r.stats) {
+            char extra[768];
+            snprintf(extra, sizeof extra,
+                     "\"radiosity\": {\"shots\": %lld, \"unshot_ratio\": %.17g, \"energy_error\": %.17g, "
+                     "\"converged\": %s, \"sf\": %.17g, \"hemicube\": %d, \"pieces\": %zu, \"elements\": %zu, "
+                     "\"emitted\": %.17g, \"absorbed\": %.17g, \"unshot\": %.17g, \"escaped\": %.17g, "
+                     "\"shot_messages\": %lld, \"shot_bytes\": %lld, \"full_messages\": %lld}",
+                     (long long)rad_solver_shots(s), rad_solver_unshot_ratio(s), L.error,
+                     converged ? "true" : "false", o.sf, o.res, mesh.npieces, ne,
+                     L.emitted[0] + L.emitted[1] + L.emitted[2], L.absorbed[0] + L.absorbed[1] + L.absorbed[2],
+                     L.unshot[0] + L.unshot[1] + L.unshot[2], L.escaped[0] + L.escaped[1] + L.escaped[2],
+                     (long long)sm, (long long)sb, (long long)fm);
+            vw_world_add_time(w, "load", t1 - t0);
+            vw_world_add_time(w, "build", (t2 - t1) + (t3 - t2));
+            vw_world_add_time(w, "compute", t4 - t3);
+            if (vw_world_write_stats(w, r.stats, CMD, extra) != VW_OK) {
+                vw_cli_error(CMD, "%s", vw_world_errmsg(w));
+                rc = VW_EXIT_FAIL;
+                goto done;
+            }
+        }
+        if (!o.quiet) {
+            char layout[64];
+            vw_decomp_layout_string(d, layout, sizeof layout);
+            printf("radiosity: %s, %zu pieces, %zu elements, cells %s, %d workers x %d processes\n",
+                   converged ? "converged" : "stopped", mesh.npieces, ne, layout, vw_world_workers(w),
+                   vw_world_processes(w));
+            printf("shots %lld, unshot ratio %.3g (sf %.3g), energy error %.2e, time %.3f s\n",
+                   (long long)rad_solver_shots(s), rad_solver_unshot_ratio(s), o.sf, L.error, t4 - t3);
+            printf("shot messages %lld (%lld bytes), full notices %lld\n", (long long)sm, (long long)sb,
+                   (long long)fm);
+        }
+        if (L.error > 1e-6) {
+            vw_cli_error(CMD, "energy ledger off by %.3g (relative)", L.error);
+            rc = VW_EXIT_FAIL;
+        }
+    }
+done:
+    rad_solver_free(s);
+    rad_mesh_free(&mesh);
+    vw_decomp_free(d);
+    vw_scene_free(sc);
+    return rc;
+}

@@ -2,7 +2,9 @@
 # bench/mpi.sh - the MPI engine against the threads engine on the example module (a
 # bigger problem): 1 process x 1 worker, 1 process x 2 workers, 2 processes x 1 worker,
 # side by side, best of REPEAT runs each; prints compute time, ratios against 1x1, the
-# imbalance, and the messages and bytes that crossed processes.
+# busiest worker's time in the module (the rest of compute is placing every object and
+# building cells, which every process does for the whole scene), the imbalance, and the
+# messages and bytes that crossed processes.
 # usage: bench/mpi.sh [BUILD_DIR] [SPHERES] [CELLS] [REPEAT]
 set -eu
 repo=$(cd "$(dirname "$0")/.." && pwd)
@@ -45,12 +47,13 @@ run p1w2 1 2
 run p2w1 2 1
 t11=$(cat "$tmp/p1w1.t")
 echo "example module: $n spheres, cells $cells, best of $repeat ($(nproc) cores)"
-printf '%-22s %10s %8s %9s %10s %14s %14s\n' engine compute_s vs_1x1 imbalance pairs remote_msgs remote_bytes
+printf '%-22s %10s %8s %11s %9s %10s %12s %13s\n' engine compute_s vs_1x1 busy_max_s imbalance pairs remote_msgs remote_bytes
 for c in p1w1:"1 process x 1 worker" p1w2:"1 process x 2 workers" p2w1:"2 processes x 1 worker"; do
     k=${c%%:*} name=${c#*:}
     t=$(cat "$tmp/$k.t")
     j=$tmp/$k.best.json
-    printf '%-22s %10.3f %8.2f %9.3f %10s %14s %14s\n' "$name" "$t" "$(awk "BEGIN{print $t11/$t}")" \
+    busy=$(grep -o '"process": [0-9]*, "busy_s": [0-9.]*' "$j" | awk '{if ($4 > m) m = $4} END {print m}')
+    printf '%-22s %10.3f %8.2f %11.4f %9.3f %10s %12s %13s\n' "$name" "$t" "$(awk "BEGIN{print $t11/$t}")" "$busy" \
         "$(field "$j" balance imbalance)" "$(cat "$tmp/$k.out")" \
         "$(field "$j" messages remote_count)" "$(field "$j" messages remote_bytes)"
 done

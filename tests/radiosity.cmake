@@ -9,3 +9,11 @@ foreach(t ffsum parallel perpendicular box layouts checkpoint)
   add_test(NAME radiosity_${t} COMMAND test_radiosity ${t})
   set_tests_properties(radiosity_${t} PROPERTIES LABELS "radiosity;threads" TIMEOUT 60)
 endforeach()
+
+# The command line: bad input (exit 2, file:line, no output) and kill -9 after a
+# checkpoint, then --resume, against the uninterrupted run.
+add_test(NAME radiosity_cli
+         COMMAND sh ${PROJECT_SOURCE_DIR}/tests/radiosity/cli.sh $<TARGET_FILE:vwalls_tool>
+                 ${PROJECT_SOURCE_DIR}/tests/radiosity ${CMAKE_CURRENT_BINARY_DIR}/radiosity_cli
+                 $<TARGET_FILE:test_radiosity>)
+set_tests_properties(radiosity_cli PROPERTIES LABELS "radiosity;threads" TIMEOUT 60)

@@ -321,6 +321,38 @@ static int t_gen(const char *name, const char *path)
     return 0;
 }
 
+/* Area-weighted relative RMS between the radiosities of two --csv files. */
+static int t_csvcmp(const char *a, const char *b, double tol)
+{
+    FILE *fa = fopen(a, "r"), *fb = fopen(b, "r");
+    CHECK(fa && fb);
+    char la[1024], lb[1024];
+    double num = 0, den = 0;
+    int rows = 0;
+    CHECK(fgets(la, sizeof la, fa) && fgets(lb, sizeof lb, fb));
+    while (fgets(la, sizeof la, fa)) {
+        CHECK(fgets(lb, sizeof lb, fb));
+        int ida, idb;
+        double x[10], y[10];
+        CHECK(sscanf(la, "%d,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf", &ida, &x[0], &x[1], &x[2], &x[3], &x[4],
+                     &x[5], &x[6], &x[7], &x[8], &x[9]) == 11);
+        CHECK(sscanf(lb, "%d,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf", &idb, &y[0], &y[1], &y[2], &y[3], &y[4],
+                     &y[5], &y[6], &y[7], &y[8], &y[9]) == 11);
+        CHECK_EQ_INT(ida, idb);
+        for (int k = 7; k < 10; k++) {
+            num += x[0] * (x[k] - y[k]) * (x[k] - y[k]);
+            den += x[0] * x[k] * x[k];
+        }
+        rows++;
+    }
+    fclose(fa), fclose(fb);
+    double e = sqrt(num / den);
+    printf("%d polygons, relative RMS %.4f%%\n", rows, 100 * e);
+    CHECK(rows > 0);
+    CHECK(e <= tol);
+    return 0;
+}
+
 int main(int argc, char **argv)
 {
     if (argc < 2) {
@@ -335,6 +367,7 @@ int main(int argc, char **argv)
     if (!strcmp(t, "layouts")) return t_layouts();
     if (!strcmp(t, "checkpoint")) return t_checkpoint();
     if (!strcmp(t, "gen") && argc == 4) return t_gen(argv[2], argv[3]);
+    if (!strcmp(t, "csvcmp") && argc == 5) return t_csvcmp(argv[2], argv[3], atof(argv[4]));
     fprintf(stderr, "unknown test '%s'\n", t);
     return 2;
 }

@@ -54,7 +54,7 @@ int vw_cmd_example_pairs(int argc, char **argv)
             if (!(v = vw_cli_value(CMD, argc, argv, &i)) || vw_cli_int(CMD, a, v, 1, 1024, &workers))
                 return VW_EXIT_USAGE;
         } else if (!strcmp(a, "--radius")) {
-            if (!(v = vw_cli_value(CMD, argc, argv, &i)) || vw_cli_double(CMD, a, v, 1e-9, 1, &rmax))
+            if (!(v = vw_cli_value(CMD, argc, argv, &i)) || vw_cli_double(CMD, a, v, 1e-6, 0.25, &rmax))
                 return VW_EXIT_USAGE;
         } else if (!strcmp(a, "--cells")) {
             if (!(v = vw_cli_value(CMD, argc, argv, &i)) || vw_cli_layout(CMD, a, v, dims))
@@ -96,7 +96,6 @@ int vw_cmd_example_pairs(int argc, char **argv)
     }
     if (rc == VW_EXIT_OK && vw_world_is_output(w)) {
         vw_world_add_time(w, "load", t1 - t0);
-        vw_world_add_time(w, "compute", t2 - t1);
         if (quiet) {
             printf("%lld\n", (long long)pairs);
         } else {
@@ -107,6 +106,8 @@ int vw_cmd_example_pairs(int argc, char **argv)
                    vw_decomp_cell_count(d), vw_world_workers(w), vw_world_processes(w));
             printf("ghosts sent %lld, time %.3f s, imbalance %.3f\n", (long long)vw_world_counter(w, 1),
                    t2 - t1, vw_world_imbalance(w));
+            printf("phases: generate %.3f s, place %.3f s, build %.3f s, compute %.3f s\n", t1 - t0,
+                   vw_world_time(w, "place"), vw_world_time(w, "build"), vw_world_time(w, "compute"));
         }
         if (stats && vw_world_write_stats(w, stats, CMD, NULL) != VW_OK) {
             vw_cli_error(CMD, "%s", vw_world_errmsg(w));

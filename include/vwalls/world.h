@@ -94,6 +94,8 @@ VW_API void vw_world_reset_stats(vw_world *w);
 /* Times of phases the application measured itself, for the stats JSON
    ("load", "build", "compute", "balance", ...). Accumulates. */
 VW_API void vw_world_add_time(vw_world *w, const char *phase, double seconds);
+/* The time accumulated for a phase (0 if none). */
+VW_API double vw_world_time(const vw_world *w, const char *phase);
 
 /* What the balancer did, for the stats JSON "balance" member. */
 VW_API void vw_world_set_balance_info(vw_world *w, const char *strategy, double imbalance_before,

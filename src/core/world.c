@@ -476,6 +476,13 @@ void vw_world_add_time(vw_world *w, const char *phase, double seconds)
     w->time_phase[w->nphases++] = seconds;
 }
 
+double vw_world_time(const vw_world *w, const char *phase)
+{
+    for (int i = 0; i < w->nphases; i++)
+        if (strcmp(w->phase_name[i], phase) == 0) return w->time_phase[i];
+    return 0;
+}
+
 void vw_world_set_balance_info(vw_world *w, const char *strategy, double before, double after,
                                uint64_t migrated)
 {

@@ -14,6 +14,8 @@ typedef struct vw_command {
 } vw_command;
 
 static const vw_command commands[] = {
+    {"gen", vw_cmd_gen, "write a generated scene (balls, rings, tree, spheres, cornell, room) as NFF"},
+    {"info", vw_cmd_info, "describe a scene: counts, bounds, camera, lights (--objects: every object)"},
     {"example-pairs", vw_cmd_example_pairs, "count touching sphere pairs (the example module)"},
     {"render", vw_cmd_render, "ray trace an NFF or OBJ scene, distributed over cells"},
     {"radiosity", vw_cmd_radiosity, "progressive radiosity of an OBJ or NFF scene, distributed over cells"},

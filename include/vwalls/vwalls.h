@@ -2,7 +2,8 @@
  *
  * What is not declared in these headers is not the API. The topic headers:
  * common.h (status, boxes), decomp.h (cells and walls), module.h (writing a module),
- * world.h (the runtime), scene.h and image.h (reading scenes, writing images).
+ * world.h (the runtime), engine.h (MPI set-up and agreement between processes),
+ * scene.h, image.h and gen.h (reading and generating scenes, writing images).
  */
 #ifndef VWALLS_VWALLS_H
 #define VWALLS_VWALLS_H
@@ -11,6 +12,9 @@
 #include "vwalls/decomp.h"
 #include "vwalls/module.h"
 #include "vwalls/world.h"
+#include "vwalls/engine.h"
 #include "vwalls/scene.h"
+#include "vwalls/image.h"
+#include "vwalls/gen.h"
 
 #endif

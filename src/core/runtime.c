@@ -302,12 +302,14 @@ static void handle_packet(vw__worker *wk, vw_ctx *ctx, vw__packet *p)
         atomic_fetch_sub(&w->workers[p->src - w->rank * w->nworkers].outstanding, p->used);
 }
 
-/* Calls step() on the worker's cells round-robin; returns 1 if one of them worked. */
+/* Calls step() on the worker's cells round-robin; returns 1 if one of them worked,
+   0 if none has step work, -1 if the worker is over its message cap: then step() is
+   not called at all (the cells may still have work), and the worker must stay busy. */
 static int run_step(vw__worker *wk, vw_ctx *ctx)
 {
     vw_world *w = wk->w;
     if (!w->m->step || wk->ncells == 0) return 0;
-    if (atomic_load(&wk->outstanding) > w->cfg.cap_bytes) return 0;
+    if (atomic_load(&wk->outstanding) > w->cfg.cap_bytes) return -1;
     for (int tries = 0; tries < wk->ncells; tries++) {
         int cell = wk->cells[wk->step_cursor];
         wk->step_cursor = (wk->step_cursor + 1) % wk->ncells;
@@ -358,7 +360,22 @@ static void *worker_main(void *arg)
             continue;
         }
         if (flush_all(wk)) continue;
-        if (run_step(wk, &ctx)) continue;
+        int stepped = run_step(wk, &ctx);
+        if (stepped > 0) continue;
+        if (stepped < 0) {
+            /* Over the cap: what this worker sent is being handled by counted workers of
+               this process, so the cap falls; wait for that (or a packet), still busy. */
+            pthread_mutex_lock(&wk->mu);
+            if (!wk->head) {
+                struct timespec until;
+                clock_gettime(CLOCK_REALTIME, &until);
+                until.tv_nsec += 200000;
+                if (until.tv_nsec >= 1000000000L) until.tv_sec++, until.tv_nsec -= 1000000000L;
+                pthread_cond_timedwait(&wk->cv, &wk->mu, &until);
+            }
+            pthread_mutex_unlock(&wk->mu);
+            continue;
+        }
         /* Nothing to do: go idle until a packet arrives or the run ends. */
         pthread_mutex_lock(&wk->mu);
         if (wk->head) {

@@ -41,6 +41,7 @@ static void help(void)
            "  --size WxH           picture size (default: the camera's, or 512x512)\n"
            "  --snapshot-every N   rewrite the outputs every N shots while solving\n"
            "  --stats FILE.json    stats JSON (radiosity: shots, unshot_ratio, energy_error)\n"
+           "  --trace FILE         per round: seconds, shots, unshot ratio (for plots)\n"
            "  --checkpoint FILE    write checkpoints here (atomically)\n"
            "  --checkpoint-every S seconds between checkpoints (default 60; 0: every round)\n"
            "  --resume FILE        continue from a checkpoint (same scene and meshing options)\n"
@@ -56,7 +57,9 @@ typedef struct run_ctx {
     vw_camera cam;
     int64_t snapshot_every, last_snapshot;
     vw_progress bar;
-    double sf;
+    double sf, t_start;
+    char *trace;          /* --trace: "seconds shots unshot_ratio" per round */
+    size_t ntrace, captrace;
     int failed;
 } run_ctx;
 
@@ -65,6 +68,17 @@ static void on_progress(void *user, double ratio, int64_t shots)
     run_ctx *r = user;
     char note[96];
     snprintf(note, sizeof note, "unshot %.2e / sf %.0e, %lld shots", ratio, r->sf, (long long)shots);
+    char line[96];
+    int k = snprintf(line, sizeof line, "%.6f %lld %.9g\n", vw_cli_now() - r->t_start, (long long)shots, ratio);
+    if (k > 0 && r->ntrace + (size_t)k + 1 > r->captrace) {
+        size_t nc = r->captrace ? 2 * r->captrace : 4096;
+        char *nt = realloc(r->trace, nc);
+        if (nt) r->trace = nt, r->captrace = nc;
+    }
+    if (k > 0 && r->ntrace + (size_t)k + 1 <= r->captrace) {
+        memcpy(r->trace + r->ntrace, line, (size_t)k);
+        r->ntrace += (size_t)k;
+    }
     double frac = ratio <= r->sf ? 1 : ratio >= 1 ? 0 : log(ratio) / log(r->sf);
     vw_progress_update(&r->bar, frac, note);
 }
@@ -123,7 +137,7 @@ int vw_cmd_radiosity(int argc, char **argv)
     rad_options_init(&o);
     run_ctx r;
     memset(&r, 0, sizeof r);
-    const char *scene_path = NULL, *view = NULL;
+    const char *scene_path = NULL, *view = NULL, *trace = NULL;
     int W = 0, H = 0;
     long lv;
     for (int i = 1; i < argc; i++) {
@@ -203,6 +217,9 @@ int vw_cmd_radiosity(int argc, char **argv)
         } else if (!strcmp(a, "--stats")) {
             VALUE();
             r.stats = v;
+        } else if (!strcmp(a, "--trace")) {
+            VALUE();
+            trace = v;
         } else if (!strcmp(a, "--checkpoint")) {
             VALUE();
             o.checkpoint = v;
@@ -284,6 +301,7 @@ int vw_cmd_radiosity(int argc, char **argv)
         goto done;
     }
     double t3 = vw_cli_now();
+    r.t_start = t3;
     rad_solver_on_round(s, on_round, &r);
     vw_progress_begin(&r.bar, "radiosity", o.quiet || !vw_world_is_output(rad_solver_world(s)));
     int converged = 0;
@@ -324,6 +342,11 @@ int vw_cmd_radiosity(int argc, char **argv)
         rad_solver_traffic(s, &sm, &sb, &fm);
         size_t ne;
         rad_solver_elements(s, &ne);
+        if (trace && rad_write_atomic(trace, r.trace ? r.trace : "", r.ntrace, err, sizeof err) != VW_OK) {
+            vw_cli_error(CMD, "%s", err);
+            rc = VW_EXIT_FAIL;
+            goto done;
+        }
         if (r.stats) {
             char extra[768];
             snprintf(extra, sizeof extra,
@@ -362,6 +385,7 @@ int vw_cmd_radiosity(int argc, char **argv)
         }
     }
 done:
+    free(r.trace);
     rad_solver_free(s);
     rad_mesh_free(&mesh);
     vw_decomp_free(d);

@@ -298,7 +298,7 @@ static void cell_free(void *state, void *user)
     (void)user;
     if (!c) return;
     for (int f = 0; f < 6; f++) free(c->nb[f]), free(c->nbbox[f]);
-    for (int i = 0; i < c->npend; i++) free(c->pend[i].bits);
+    for (int i = 0; i < c->cappend; i++) free(c->pend[i].bits); /* spare buffers too */
     free(c->pend);
     free(c->patches), free(c->el), free(c->vp), free(c->ht);
     free(c->z.depth), free(c->z.owner), free(c->z.stamp), free(c->mask), free(c->touched);

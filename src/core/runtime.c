@@ -256,24 +256,21 @@ void vw_count(vw_ctx *ctx, int idx, int64_t n)
 
 /* ---- the worker loop ---------------------------------------------------------------- */
 
-/* Emulates a slower machine: spin for (k-1) times the time just spent. */
-static void slow_down(vw__worker *wk, double spent)
+/* Charges the time from t0 to t1 to a cell and its worker, and returns when the
+   charge ends. With a slow-down factor k (an emulated slower machine) the worker first
+   spins for (k-1) times the time spent, and that is charged too. One clock read per
+   switch of cell is all the hot path pays. */
+static double account(vw__worker *wk, int cell, double t0, double t1)
 {
     const double *s = wk->w->cfg.worker_slowdown;
-    if (!s || s[wk->global] <= 1.0) return;
-    double until = vw__now() + spent * (s[wk->global] - 1.0);
-    while (vw__now() < until) {
+    if (s && s[wk->global] > 1.0) {
+        double until = t1 + (t1 - t0) * (s[wk->global] - 1.0);
+        while ((t1 = vw__now()) < until) {
+        }
     }
-}
-
-static void account(vw__worker *wk, int cell, double t0, double t1)
-{
-    double spent = t1 - t0;
-    slow_down(wk, spent);
-    double t2 = vw__now();
-    spent = t2 - t0;
-    wk->busy_s += spent;
-    if (cell >= 0) wk->w->cells[cell].busy_s += spent;
+    wk->busy_s += t1 - t0;
+    if (cell >= 0) wk->w->cells[cell].busy_s += t1 - t0;
+    return t1;
 }
 
 static void handle_packet(vw__worker *wk, vw_ctx *ctx, vw__packet *p)
@@ -285,9 +282,7 @@ static void handle_packet(vw__worker *wk, vw_ctx *ctx, vw__packet *p)
     for (uint32_t i = 0; i < p->nmsgs; i++) {
         const vw__msg_header *h = (const vw__msg_header *)(p->data + off);
         if (h->cell != cur) {
-            double t1 = vw__now();
-            account(wk, cur, t0, t1);
-            t0 = vw__now();
+            t0 = account(wk, cur, t0, vw__now());
             cur = h->cell;
         }
         vw__cell *c = &w->cells[h->cell];

@@ -9,7 +9,7 @@ for what in "${@:-build}"; do
   case "$what" in
     build) want+=(gcc libc6-dev make cmake pkg-config libembree-dev libpng-dev
                   libopenmpi-dev openmpi-bin openssh-client iproute2) ;;
-    bench) want+=(povray gnuplot-nox time) ;;
+    bench) want+=(povray gnuplot-nox time python3) ;;
     fuzz)  want+=(clang libclang-rt-14-dev) ;;
     mpich) want+=(libmpich-dev mpich) ;;
     docs)  want+=(doxygen) ;;

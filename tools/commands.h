@@ -6,6 +6,7 @@
 #define VW_TOOLS_COMMANDS_H
 
 int vw_cmd_example_pairs(int argc, char **argv);
+int vw_cmd_example_components(int argc, char **argv);
 int vw_cmd_render(int argc, char **argv);
 
 int vw_cmd_gen(int argc, char **argv);

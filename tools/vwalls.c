@@ -17,6 +17,8 @@ static const vw_command commands[] = {
     {"gen", vw_cmd_gen, "write a generated scene (balls, rings, tree, spheres, cornell, room) as NFF"},
     {"info", vw_cmd_info, "describe a scene: counts, bounds, camera, lights (--objects: every object)"},
     {"example-pairs", vw_cmd_example_pairs, "count touching sphere pairs (the example module)"},
+    {"example-components", vw_cmd_example_components,
+     "connected components of touching spheres (the second example module)"},
     {"render", vw_cmd_render, "ray trace an NFF or OBJ scene, distributed over cells"},
     {"radiosity", vw_cmd_radiosity, "progressive radiosity of an OBJ or NFF scene, distributed over cells"},
 };
@@ -31,7 +33,7 @@ static void usage(FILE *f)
             "Runs on worker threads; the same command runs under mpirun on several machines.\n"
             "\ncommands:\n");
     for (size_t i = 0; i < sizeof commands / sizeof commands[0]; i++)
-        fprintf(f, "  %-14s %s\n", commands[i].name, commands[i].summary);
+        fprintf(f, "  %-19s %s\n", commands[i].name, commands[i].summary);
     fprintf(f, "\nexit status: 0 success, 2 bad input or usage, 1 any other failure\n");
 }
 

@@ -1,0 +1,390 @@
+/* components.c - the second example module: connected components of touching spheres.
+ *
+ * Each sphere is owned by the cell holding its centre (as in pairs.c). A cell joins its
+ * own touching spheres with union-find once, at build; those local components never
+ * change again. Only their *labels* do: a label is the smallest sphere id known to be
+ * connected, and it only ever goes down. A boundary sphere (one within reach of another
+ * cell) is sent with its component's label to every cell in reach; a cell that finds
+ * one of its spheres touching it lowers that component's label and, if it went down,
+ * resends its own boundary spheres. Labels are bounded below, so the exchange stops by
+ * itself, and the runtime's quiescence is the end of the algorithm: no convergence test.
+ * A second run collects every sphere's label on the output process.
+ */
+#include "components.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <time.h>
+
+enum { MSG_LABEL, MSG_REPORT, MSG_RESULT, NKINDS };   /* message kinds */
+
+/* "Sphere s belongs to a component whose smallest known id is label." Carrying the whole
+   sphere (not just its id) means the receiver needs no earlier ghost: messages may
+   arrive in any order. */
+typedef struct ex_label_msg {
+    ex_sphere s;
+    int64_t label;
+} ex_label_msg;
+
+typedef struct ex_result_msg {
+    int64_t id, label;
+} ex_result_msg;
+
+typedef struct ex_params {
+    double rmax;          /* reach of a boundary sphere beyond its own radius */
+    int64_t *labels;      /* the result, written by the output handler */
+    size_t n;
+} ex_params;
+
+typedef struct ex_cell {
+    ex_sphere *own;       /* spheres whose centre lies in this cell, sorted by bin key */
+    uint64_t *key;
+    size_t nown;
+    size_t *parent;       /* union-find over own spheres, fully compressed after build */
+    int64_t *label;       /* meaningful at roots: smallest id known to be connected */
+    /* Boundary spheres grouped by root: bsph[bstart[r] .. bstart[r+1]) are the own
+       spheres of root r that other cells can touch; dest[dstart[i] .. dstart[i+1]) are
+       the other cells within reach of own sphere i. */
+    size_t *bstart, *bsph, *dstart;
+    int *dest;
+    /* Roots whose label went down since their boundary spheres were last sent. Each
+       root is on the stack at most once (dirty flag), so the stack needs nown slots. */
+    unsigned char *dirty;
+    size_t *stack, nstack;
+    int started;
+} ex_cell;
+
+/* ---- neighbour search: the same sorted bins as pairs.c ---- */
+
+/* Bins of spacing h = 2*rmax: two touching spheres lie in adjacent bins. Sorted by key,
+   z fastest, the bins (x+dx, y+dy, z-1..z+1) are one run of the array. */
+static uint64_t bin_key(const double c[3], double h, int dx, int dy, int dz)
+{
+    uint64_t k = 0;
+    for (int a = 0; a < 3; a++) {
+        int64_t i = (int64_t)floor(c[a] / h) + 1 + (a == 0 ? dx : a == 1 ? dy : dz);
+        k = (k << 21) | (uint64_t)(i < 0 ? 0 : i);
+    }
+    return k;
+}
+
+static size_t lower_bound(const ex_cell *ec, uint64_t key)
+{
+    size_t lo = 0, hi = ec->nown;
+    while (lo < hi) {
+        size_t mid = (lo + hi) / 2;
+        if (ec->key[mid] < key) lo = mid + 1; else hi = mid;
+    }
+    return lo;
+}
+
+static int touching(const ex_sphere *a, const ex_sphere *b)
+{
+    double d2 = 0;
+    for (int k = 0; k < 3; k++) d2 += (a->c[k] - b->c[k]) * (a->c[k] - b->c[k]);
+    return d2 <= (a->r + b->r) * (a->r + b->r);
+}
+
+/* Calls fn(ec, j, arg) for every own sphere j that touches q. */
+static void for_touching(ex_cell *ec, const ex_sphere *q, double h,
+                         void (*fn)(ex_cell *ec, size_t j, void *arg), void *arg)
+{
+    for (int dx = -1; dx <= 1; dx++)
+        for (int dy = -1; dy <= 1; dy++) {
+            uint64_t last = bin_key(q->c, h, dx, dy, 1);
+            for (size_t j = lower_bound(ec, bin_key(q->c, h, dx, dy, -1));
+                 j < ec->nown && ec->key[j] <= last; j++)
+                if (touching(&ec->own[j], q)) fn(ec, j, arg);
+        }
+}
+
+/* ---- union-find over the own spheres (built once) ---- */
+
+static size_t find(size_t *parent, size_t i)
+{
+    while (parent[i] != i) i = parent[i] = parent[parent[i]];
+    return i;
+}
+
+static void join(ex_cell *ec, size_t j, void *arg)
+{
+    size_t a = find(ec->parent, *(const size_t *)arg), b = find(ec->parent, j);
+    if (a != b) ec->parent[a > b ? a : b] = a < b ? a : b;
+}
+
+/* ---- the module ---- */
+
+static void sphere_bounds(const void *obj, vw_box *out, void *user)
+{
+    const ex_sphere *s = obj;
+    (void)user;
+    for (int k = 0; k < 3; k++) out->lo[k] = out->hi[k] = s->c[k]; /* placed by its centre */
+}
+
+static void cell_free(void *state, void *user)
+{
+    ex_cell *ec = state;
+    (void)user;
+    if (!ec) return;
+    free(ec->own), free(ec->key), free(ec->parent), free(ec->label), free(ec->bstart);
+    free(ec->bsph), free(ec->dstart), free(ec->dest), free(ec->dirty), free(ec->stack);
+    free(ec);
+}
+
+static int cmp_u64(const void *a, const void *b)
+{
+    uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
+    return (x > y) - (x < y);
+}
+
+/* Own spheres, local components, and who must hear about each boundary sphere. */
+static vw_status cell_build(vw_ctx *ctx, const void *objects, size_t n, void **state)
+{
+    const ex_params *pp = vw_ctx_user(ctx);
+    const vw_decomp *d = vw_ctx_decomp(ctx);
+    const double h = 2 * pp->rmax;
+    const int self = vw_ctx_cell(ctx), ncells = vw_decomp_cell_count(d);
+    const size_t m1 = n ? n : 1;
+    ex_cell *ec = calloc(1, sizeof *ec);
+    uint64_t (*tmp)[2] = malloc(sizeof *tmp * m1);   /* (key, index) to sort */
+    int *cells = malloc(sizeof(int) * (size_t)ncells);
+    if (!ec || !tmp || !cells) goto nomem;
+    ec->own = malloc(sizeof *ec->own * m1);
+    ec->key = malloc(sizeof *ec->key * m1);
+    ec->parent = malloc(sizeof *ec->parent * m1);
+    ec->label = malloc(sizeof *ec->label * m1);
+    ec->bstart = calloc(m1 + 1, sizeof *ec->bstart);
+    ec->bsph = malloc(sizeof *ec->bsph * m1);
+    ec->dstart = calloc(m1 + 1, sizeof *ec->dstart);
+    ec->dirty = calloc(m1, 1);
+    ec->stack = malloc(sizeof *ec->stack * m1);
+    if (!ec->own || !ec->key || !ec->parent || !ec->label || !ec->bstart || !ec->bsph ||
+        !ec->dstart || !ec->dirty || !ec->stack)
+        goto nomem;
+
+    const ex_sphere *s = objects;
+    static const double dir[3] = {1, 1, 1};     /* a centre on a wall goes to the + side */
+    size_t m = 0;
+    for (size_t i = 0; i < n; i++)
+        if (vw_decomp_locate(d, s[i].c, dir) == self)
+            tmp[m][0] = bin_key(s[i].c, h, 0, 0, 0), tmp[m++][1] = i;
+    qsort(tmp, m, sizeof *tmp, cmp_u64);
+    for (size_t i = 0; i < m; i++) ec->key[i] = tmp[i][0], ec->own[i] = s[tmp[i][1]];
+    ec->nown = m;
+
+    /* Local components. */
+    for (size_t i = 0; i < m; i++) ec->parent[i] = i;
+    for (size_t i = 0; i < m; i++) for_touching(ec, &ec->own[i], h, join, &i);
+    for (size_t i = 0; i < m; i++) ec->label[i] = INT64_MAX;
+    int64_t local = 0;
+    for (size_t i = 0; i < m; i++) {
+        size_t r = ec->parent[i] = find(ec->parent, i);
+        local += r == i;
+        if (ec->own[i].id < ec->label[r]) ec->label[r] = ec->own[i].id;
+    }
+    vw_count(ctx, EX_COMPONENTS_CNT_LOCAL, local);
+
+    /* Destinations of every own sphere: the other cells its reach (its box widened by
+       its radius and the largest radius) overlaps. Touching is symmetric and so is
+       reach, so a cell hears about every foreign sphere touching one of its own. */
+    size_t ndest = 0, cap = 0;
+    for (size_t i = 0; i < m; i++) {
+        vw_box reach;
+        for (int k = 0; k < 3; k++) {
+            reach.lo[k] = ec->own[i].c[k] - ec->own[i].r - pp->rmax;
+            reach.hi[k] = ec->own[i].c[k] + ec->own[i].r + pp->rmax;
+        }
+        int nc = vw_decomp_cells_overlapping(d, &reach, 0, cells, ncells);
+        for (int k = 0; k < nc; k++) {
+            if (cells[k] == self) continue;
+            if (ndest == cap) {
+                cap = cap ? 2 * cap : 64;
+                int *grown = realloc(ec->dest, sizeof *grown * cap);
+                if (!grown) goto nomem;
+                ec->dest = grown;
+            }
+            ec->dest[ndest++] = cells[k];
+        }
+        ec->dstart[i + 1] = ndest;
+        if (ec->dstart[i + 1] > ec->dstart[i]) ec->bstart[ec->parent[i] + 1]++;
+    }
+    /* Group the boundary spheres by root (a counting sort). The dirty stack is unused
+       until the first step, so it holds the fill positions meanwhile. */
+    for (size_t r = 0; r < m; r++) ec->bstart[r + 1] += ec->bstart[r];
+    for (size_t r = 0; r < m; r++) ec->stack[r] = ec->bstart[r];
+    for (size_t i = 0; i < m; i++)
+        if (ec->dstart[i + 1] > ec->dstart[i]) ec->bsph[ec->stack[ec->parent[i]]++] = i;
+
+    free(tmp), free(cells);
+    *state = ec;
+    return VW_OK;
+nomem:
+    free(tmp), free(cells);
+    cell_free(ec, NULL);
+    return VW_E_NOMEM;
+}
+
+static void mark_dirty(ex_cell *ec, size_t r)
+{
+    if (!ec->dirty[r]) ec->dirty[r] = 1, ec->stack[ec->nstack++] = r;
+}
+
+/* Sends the boundary spheres of every root whose label went down. The runtime calls step
+   only when the worker's inbox is empty, so many label drops cost one resend. */
+static int step(vw_ctx *ctx, void *state)
+{
+    ex_cell *ec = state;
+    if (!ec->started) {     /* first call: every boundary sphere's initial label goes out */
+        ec->started = 1;
+        for (size_t r = 0; r < ec->nown; r++)
+            if (ec->bstart[r + 1] > ec->bstart[r]) mark_dirty(ec, r);
+    }
+    if (!ec->nstack) return 0;
+    while (ec->nstack) {
+        size_t r = ec->stack[--ec->nstack];
+        ec->dirty[r] = 0;
+        for (size_t b = ec->bstart[r]; b < ec->bstart[r + 1]; b++) {
+            size_t i = ec->bsph[b];
+            ex_label_msg msg = {ec->own[i], ec->label[r]};
+            for (size_t k = ec->dstart[i]; k < ec->dstart[i + 1]; k++)
+                vw_send_cell(ctx, ec->dest[k], MSG_LABEL, &msg);
+            vw_count(ctx, EX_COMPONENTS_CNT_LABEL_MSGS, (int64_t)(ec->dstart[i + 1] - ec->dstart[i]));
+        }
+    }
+    return 1;
+}
+
+typedef struct ex_lower {
+    vw_ctx *ctx;
+    int64_t label;
+} ex_lower;
+
+static void lower(ex_cell *ec, size_t j, void *arg)
+{
+    const ex_lower *lw = arg;
+    size_t r = ec->parent[j];
+    if (lw->label < ec->label[r]) {
+        ec->label[r] = lw->label;
+        mark_dirty(ec, r);
+        vw_count(lw->ctx, EX_COMPONENTS_CNT_RELABELS, 1);
+    }
+}
+
+/* A foreign sphere and its label: every local component it touches takes the label if
+   it is smaller. */
+static void on_label(vw_ctx *ctx, void *state, const void *msg)
+{
+    const ex_label_msg *lm = msg;
+    const ex_params *pp = vw_ctx_user(ctx);
+    ex_lower lw = {ctx, lm->label};
+    for_touching(state, &lm->s, 2 * pp->rmax, lower, &lw);
+}
+
+/* Second run: labels are final; every cell reports its spheres to the output process. */
+static void on_report(vw_ctx *ctx, void *state, const void *msg)
+{
+    const ex_cell *ec = state;
+    (void)msg;
+    for (size_t i = 0; i < ec->nown; i++) {
+        ex_result_msg res = {ec->own[i].id, ec->label[ec->parent[i]]};
+        vw_send_output(ctx, MSG_RESULT, &res);
+        if (res.label == res.id) vw_count(ctx, EX_COMPONENTS_CNT_COMPONENTS, 1);
+    }
+}
+
+/* Runs on the output process, one call at a time. */
+static void on_result(void *user, const void *msg)
+{
+    const ex_params *pp = user;
+    const ex_result_msg *res = msg;
+    if (pp->labels && res->id >= 0 && (size_t)res->id < pp->n) pp->labels[res->id] = res->label;
+}
+
+static const vw_msg_kind kinds[NKINDS] = {
+    [MSG_LABEL] = {"label", sizeof(ex_label_msg), on_label, NULL},
+    [MSG_REPORT] = {"report", sizeof(int), on_report, NULL},
+    [MSG_RESULT] = {"result", sizeof(ex_result_msg), NULL, on_result},
+};
+static const char *const counters[EX_COMPONENTS_NCOUNTERS] = {
+    [EX_COMPONENTS_CNT_COMPONENTS] = "components",
+    [EX_COMPONENTS_CNT_LOCAL] = "local_components",
+    [EX_COMPONENTS_CNT_LABEL_MSGS] = "label_messages",
+    [EX_COMPONENTS_CNT_RELABELS] = "relabels",
+};
+
+static const vw_module components_module = {
+    .abi = VW_MODULE_ABI,
+    .name = "components",
+    .object_size = sizeof(ex_sphere),
+    .object_bounds = sphere_bounds,
+    .kinds = kinds,
+    .nkinds = NKINDS,
+    .counters = counters,
+    .ncounters = EX_COMPONENTS_NCOUNTERS,
+    .cell_build = cell_build,
+    .cell_free = cell_free,
+    .step = step,
+};
+
+static double seconds_between(const struct timespec *a, const struct timespec *b)
+{
+    return (double)(b->tv_sec - a->tv_sec) + 1e-9 * (double)(b->tv_nsec - a->tv_nsec);
+}
+
+vw_status ex_components_label(const ex_sphere *s, size_t n, double rmax, const vw_decomp *d,
+                              const vw_config *cfg, int64_t *labels, int64_t *ncomponents,
+                              vw_world **out_world)
+{
+    /* The world keeps a pointer to params: a world handed back is for reading stats,
+       not for running again. */
+    ex_params params = {rmax, labels, n};
+    vw_world *w;
+    vw_status st = vw_world_create(&components_module, &params, d, cfg, &w);
+    if (st != VW_OK) return st;
+    struct timespec t[5];
+    clock_gettime(CLOCK_MONOTONIC, &t[0]);
+    st = vw_world_add_objects(w, s, n);          /* placement into cells */
+    clock_gettime(CLOCK_MONOTONIC, &t[1]);
+    if (st == VW_OK) st = vw_world_commit(w);    /* local union-find in every cell */
+    clock_gettime(CLOCK_MONOTONIC, &t[2]);
+    if (st == VW_OK) st = vw_world_run(w);       /* labels travel until none goes down */
+    clock_gettime(CLOCK_MONOTONIC, &t[3]);
+    const int dummy = 0;
+    for (int c = 0; st == VW_OK && c < vw_decomp_cell_count(d); c++)
+        st = vw_world_post(w, c, MSG_REPORT, &dummy);
+    if (st == VW_OK) st = vw_world_run(w);       /* final labels to the output process */
+    clock_gettime(CLOCK_MONOTONIC, &t[4]);
+    const char *phase[4] = {"place", "build", "compute", "report"};
+    for (int i = 0; i < 4; i++) vw_world_add_time(w, phase[i], seconds_between(&t[i], &t[i + 1]));
+    *ncomponents = vw_world_counter(w, EX_COMPONENTS_CNT_COMPONENTS);
+    if (out_world)
+        *out_world = w;
+    else
+        vw_world_free(w);
+    return st;
+}
+
+/* ---- the sequential reference ---- */
+
+int64_t ex_components_reference(const ex_sphere *s, size_t n, int64_t *labels)
+{
+    size_t *parent = malloc(sizeof *parent * (n ? n : 1));
+    if (!parent) return -1;
+    for (size_t i = 0; i < n; i++) parent[i] = i;
+    for (size_t i = 0; i < n; i++)
+        for (size_t j = i + 1; j < n; j++)
+            if (touching(&s[i], &s[j])) {
+                size_t a = find(parent, i), b = find(parent, j);
+                if (a != b) parent[a > b ? a : b] = a < b ? a : b;
+            }
+    /* Linking the larger index under the smaller makes every root its component's
+       smallest index, which is the smallest id when ids are indices. */
+    int64_t ncomp = 0;
+    for (size_t i = 0; i < n; i++) {
+        size_t r = find(parent, i);
+        labels[i] = s[r].id;
+        ncomp += r == i;
+    }
+    free(parent);
+    return ncomp;
+}

@@ -1,0 +1,63 @@
+# examples.cmake - tests of the second example module (examples/components.c): the
+# distributed components equal the sequential reference, label for label, for every
+# layout and worker count, under the stress switches, and under mpirun when MPI is found.
+# (The first example, pairs, is tested in core.cmake and mpi.cmake.)
+
+set(VW_EX_ARGS --spheres 3000 --radius 0.05 --seed 5 --check --quiet)
+foreach(layout 1 2x4 2x2x2 4x4x4)
+  foreach(workers 1 2 4)
+    add_test(NAME example_components_${layout}_w${workers}
+             COMMAND vwalls_tool example-components ${VW_EX_ARGS} --cells ${layout} --workers ${workers})
+    set_tests_properties(example_components_${layout}_w${workers} PROPERTIES LABELS "examples;threads")
+  endforeach()
+endforeach()
+# Delayed and reordered delivery, one message per packet: labels may arrive in any order.
+add_test(NAME example_components_stress
+         COMMAND vwalls_tool example-components ${VW_EX_ARGS} --cells 4x4x4 --workers 4)
+set_tests_properties(example_components_stress PROPERTIES LABELS "examples;threads"
+                     ENVIRONMENT "VW_STRESS=99")
+add_test(NAME example_components_stress_split
+         COMMAND vwalls_tool example-components ${VW_EX_ARGS} --cells 2x2x2 --workers 2)
+set_tests_properties(example_components_stress_split PROPERTIES LABELS "examples;threads"
+                     ENVIRONMENT "VW_STRESS=7;VW_STRESS_SPLIT=1")
+# Sparse (almost no touching) and dense (one component) scenes, and no spheres at all.
+add_test(NAME example_components_sparse
+         COMMAND vwalls_tool example-components --spheres 2000 --radius 0.005 --cells 2x2x2 --check --quiet)
+add_test(NAME example_components_dense
+         COMMAND vwalls_tool example-components --spheres 2000 --radius 0.2 --cells 4x4x4 --check --quiet)
+set_tests_properties(example_components_dense PROPERTIES PASS_REGULAR_EXPRESSION "^1\n")
+add_test(NAME example_components_empty
+         COMMAND vwalls_tool example-components --spheres 0 --cells 2x2x2 --check --quiet)
+set_tests_properties(example_components_empty PROPERTIES PASS_REGULAR_EXPRESSION "^0\n")
+set_tests_properties(example_components_sparse example_components_dense example_components_empty
+                     PROPERTIES LABELS "examples;threads")
+
+# Bad usage: exit status 2 (WILL_FAIL only knows non-zero, so check the 2 by script).
+foreach(bad "--cells;2x" "--radius;0" "--radius;1" "--workers;0" "--bogus")
+  string(REPLACE ";" "_" tname "${bad}")
+  string(REGEX REPLACE "[^A-Za-z0-9_]" "" tname "${tname}")
+  add_test(NAME example_components_bad_${tname}
+           COMMAND sh -c "\"$0\" example-components \"$@\"; test $? -eq 2" $<TARGET_FILE:vwalls_tool> ${bad})
+  set_tests_properties(example_components_bad_${tname} PROPERTIES LABELS "examples")
+endforeach()
+
+# Under mpirun: cells spread over processes, labels cross process boundaries.
+if(VW_HAVE_MPI)
+  set(_vw_ex_env "OMPI_ALLOW_RUN_AS_ROOT=1;OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1;OMPI_MCA_rmaps_base_oversubscribe=1")
+  foreach(np 2 3)
+    foreach(w 1 2)
+      add_test(NAME example_components_mpi_np${np}_w${w}
+               COMMAND ${MPIEXEC_EXECUTABLE} ${MPIEXEC_NUMPROC_FLAG} ${np} ${MPIEXEC_PREFLAGS}
+                       $<TARGET_FILE:vwalls_tool> example-components ${VW_EX_ARGS} --cells 4x4x2
+                       --workers ${w} ${MPIEXEC_POSTFLAGS})
+      set_tests_properties(example_components_mpi_np${np}_w${w} PROPERTIES LABELS "examples;mpi"
+                           TIMEOUT 120 PROCESSORS 2 ENVIRONMENT "${_vw_ex_env}")
+    endforeach()
+  endforeach()
+  add_test(NAME example_components_mpi_stress_np2
+           COMMAND ${MPIEXEC_EXECUTABLE} ${MPIEXEC_NUMPROC_FLAG} 2 ${MPIEXEC_PREFLAGS}
+                   $<TARGET_FILE:vwalls_tool> example-components ${VW_EX_ARGS} --cells 4x4x4
+                   --workers 2 ${MPIEXEC_POSTFLAGS})
+  set_tests_properties(example_components_mpi_stress_np2 PROPERTIES LABELS "examples;mpi"
+                       TIMEOUT 120 PROCESSORS 2 ENVIRONMENT "${_vw_ex_env};VW_STRESS=5")
+endif()

@@ -1,0 +1,167 @@
+/* cmd_example_components.c - vwalls example-components: the second example module on
+ * random spheres, printing the connected components of touching spheres found by labels
+ * travelling across walls (and, with --check, comparing every label with the sequential one).
+ */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "cli.h"
+#include "commands.h"
+#include "components.h"
+
+static const char *const CMD = "example-components";
+
+static void help(void)
+{
+    printf("usage: vwalls example-components [--spheres N] [--radius R] [--seed S] [--cells LAYOUT]\n"
+           "                                 [--workers W] [--stats FILE.json] [--check] [--quiet]\n"
+           "\n"
+           "Finds the connected components of touching spheres among N random spheres in the\n"
+           "unit cube, distributed over cells: each cell joins its own spheres with union-find,\n"
+           "then the smallest id of every component travels across walls until no label goes\n"
+           "down; the runtime's quiescence ends the run.\n"
+           "  --spheres N    number of spheres (default 10000)\n"
+           "  --radius R     largest radius (default 0.035, near percolation for 10000 spheres)\n"
+           "  --seed S       random seed (default 1)\n"
+           "  --cells L      layout of cells, like 4, 2x4, 2x2x2 (default 2x2x2)\n"
+           "  --workers W    worker threads per process (default: number of cores)\n"
+           "  --stats FILE   write the stats JSON (counters under \"components\")\n"
+           "  --check        also label sequentially (O(N^2)) and fail if any label differs\n"
+           "  --quiet        print only the number of components\n");
+}
+
+/* Size of the largest component, from labels (smallest id of each sphere's component). */
+static int64_t largest(const int64_t *labels, size_t n)
+{
+    int64_t *size = calloc(n ? n : 1, sizeof *size), best = 0;
+    if (!size) return -1;
+    for (size_t i = 0; i < n; i++)
+        if (++size[labels[i]] > best) best = size[labels[i]];
+    free(size);
+    return best;
+}
+
+int vw_cmd_example_components(int argc, char **argv)
+{
+    long n = 10000, seed = 1, workers = 0;
+    double rmax = 0.035;
+    int dims[3] = {2, 2, 2}, check = 0, quiet = 0;
+    const char *stats = NULL;
+    for (int i = 1; i < argc; i++) {
+        const char *a = argv[i], *v;
+        if (!strcmp(a, "--help") || !strcmp(a, "-h")) {
+            help();
+            return VW_EXIT_OK;
+        } else if (!strcmp(a, "--check")) {
+            check = 1;
+        } else if (!strcmp(a, "--quiet")) {
+            quiet = 1;
+        } else if (!strcmp(a, "--spheres")) {
+            if (!(v = vw_cli_value(CMD, argc, argv, &i)) || vw_cli_int(CMD, a, v, 0, 100000000, &n))
+                return VW_EXIT_USAGE;
+        } else if (!strcmp(a, "--seed")) {
+            if (!(v = vw_cli_value(CMD, argc, argv, &i)) || vw_cli_int(CMD, a, v, 0, 0x7fffffffL, &seed))
+                return VW_EXIT_USAGE;
+        } else if (!strcmp(a, "--workers")) {
+            if (!(v = vw_cli_value(CMD, argc, argv, &i)) || vw_cli_int(CMD, a, v, 1, 1024, &workers))
+                return VW_EXIT_USAGE;
+        } else if (!strcmp(a, "--radius")) {
+            if (!(v = vw_cli_value(CMD, argc, argv, &i)) || vw_cli_double(CMD, a, v, 1e-6, 0.25, &rmax))
+                return VW_EXIT_USAGE;
+        } else if (!strcmp(a, "--cells")) {
+            if (!(v = vw_cli_value(CMD, argc, argv, &i)) || vw_cli_layout(CMD, a, v, dims))
+                return VW_EXIT_USAGE;
+        } else if (!strcmp(a, "--stats")) {
+            if (!(stats = vw_cli_value(CMD, argc, argv, &i))) return VW_EXIT_USAGE;
+        } else {
+            vw_cli_error(CMD, "unknown option '%s' (try --help)", a);
+            return VW_EXIT_USAGE;
+        }
+    }
+    size_t ns = (size_t)(n ? n : 1);
+    ex_sphere *s = malloc(sizeof *s * ns);
+    int64_t *labels = malloc(sizeof *labels * ns), *ref = check ? malloc(sizeof *ref * ns) : NULL;
+    if (!s || !labels || (check && !ref)) {
+        vw_cli_error(CMD, "out of memory for %ld spheres", n);
+        free(s), free(labels), free(ref);
+        return VW_EXIT_FAIL;
+    }
+    double t0 = vw_cli_now();
+    ex_pairs_generate(s, (size_t)n, rmax, (uint64_t)seed);
+    vw_box unit = {{0, 0, 0}, {1, 1, 1}};
+    vw_decomp *d;
+    vw_status st = vw_decomp_create_grid(&unit, dims, &d);
+    if (st != VW_OK) {
+        vw_cli_error(CMD, "cannot make the decomposition: %s", vw_status_message(st));
+        free(s), free(labels), free(ref);
+        return VW_EXIT_FAIL;
+    }
+    vw_config cfg;
+    vw_config_init(&cfg);
+    cfg.workers = (int)workers;
+    int64_t ncomp = 0;
+    vw_world *w = NULL;
+    double t1 = vw_cli_now();
+    st = ex_components_label(s, (size_t)n, rmax, d, &cfg, labels, &ncomp, &w);
+    double t2 = vw_cli_now();
+    int rc = VW_EXIT_OK;
+    if (st != VW_OK) {
+        vw_cli_error(CMD, "run failed: %s", w ? vw_world_errmsg(w) : vw_status_message(st));
+        rc = VW_EXIT_FAIL;
+    }
+    if (rc == VW_EXIT_OK && vw_world_is_output(w)) {
+        vw_world_add_time(w, "load", t1 - t0);
+        if (quiet) {
+            printf("%lld\n", (long long)ncomp);
+        } else {
+            char layout[64];
+            vw_decomp_layout_string(d, layout, sizeof layout);
+            printf("components: %lld (largest %lld spheres)\n", (long long)ncomp,
+                   (long long)largest(labels, (size_t)n));
+            printf("spheres %ld, cells %s (%d), workers %d x %d processes\n", n, layout,
+                   vw_decomp_cell_count(d), vw_world_workers(w), vw_world_processes(w));
+            printf("local components %lld, label messages %lld, relabels %lld\n",
+                   (long long)vw_world_counter(w, EX_COMPONENTS_CNT_LOCAL),
+                   (long long)vw_world_counter(w, EX_COMPONENTS_CNT_LABEL_MSGS),
+                   (long long)vw_world_counter(w, EX_COMPONENTS_CNT_RELABELS));
+            printf("time %.3f s, imbalance %.3f\n", t2 - t1, vw_world_imbalance(w));
+            printf("phases: generate %.3f s, place %.3f s, build %.3f s, compute %.3f s, "
+                   "report %.3f s\n", t1 - t0, vw_world_time(w, "place"), vw_world_time(w, "build"),
+                   vw_world_time(w, "compute"), vw_world_time(w, "report"));
+        }
+        if (stats) {
+            char extra[256];
+            snprintf(extra, sizeof extra,
+                     "\"components\": {\"count\": %lld, \"local\": %lld, \"label_messages\": %lld, "
+                     "\"relabels\": %lld}",
+                     (long long)ncomp, (long long)vw_world_counter(w, EX_COMPONENTS_CNT_LOCAL),
+                     (long long)vw_world_counter(w, EX_COMPONENTS_CNT_LABEL_MSGS),
+                     (long long)vw_world_counter(w, EX_COMPONENTS_CNT_RELABELS));
+            if (vw_world_write_stats(w, stats, CMD, extra) != VW_OK) {
+                vw_cli_error(CMD, "%s", vw_world_errmsg(w));
+                rc = VW_EXIT_FAIL;
+            }
+        }
+        if (check) {
+            int64_t nref = ex_components_reference(s, (size_t)n, ref);
+            if (!quiet) printf("sequential: %lld components\n", (long long)nref);
+            size_t bad = 0, first = 0;
+            for (size_t i = 0; i < (size_t)n; i++)
+                if (labels[i] != ref[i] && !bad++) first = i;
+            if (nref != ncomp || bad) {
+                vw_cli_error(CMD, "distributed result differs from the sequential one: %lld vs %lld "
+                             "components, %zu labels differ%s", (long long)ncomp, (long long)nref, bad,
+                             bad ? "" : " (none)");
+                if (bad)
+                    vw_cli_error(CMD, "first: sphere %zu has label %lld, expected %lld", first,
+                                 (long long)labels[first], (long long)ref[first]);
+                rc = VW_EXIT_FAIL;
+            }
+        }
+    }
+    vw_world_free(w);
+    vw_decomp_free(d);
+    free(s), free(labels), free(ref);
+    return rc;
+}

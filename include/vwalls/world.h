@@ -65,6 +65,11 @@ VW_API vw_status vw_world_redecompose(vw_world *w, const vw_decomp *d, const int
 /* Replace object `id` (dynamic scenes): it leaves cells it no longer overlaps, joins
    the new ones; only the touched cells are rebuilt at the next commit/run. */
 VW_API vw_status vw_world_update_object(vw_world *w, size_t id, const void *object);
+/* The cells that hold object `id` now, ascending: writes at most max ids to out (may be
+   NULL with max 0) and returns how many there are. The placement is known to every
+   process, so this answers the same everywhere. O(objects held by all cells): for
+   tests and tools that check the placement rule, not for inner loops. */
+VW_API int vw_world_cells_of_object(const vw_world *w, size_t id, int *out, int max);
 
 /* Engine facts. */
 VW_API int vw_world_process(const vw_world *w);       /* this process's rank */

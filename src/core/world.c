@@ -304,6 +304,20 @@ vw_status vw_world_update_object(vw_world *w, size_t id, const void *object)
     return st;
 }
 
+int vw_world_cells_of_object(const vw_world *w, size_t id, int *out, int max)
+{
+    if (!w || id >= w->nobjects) return 0;
+    int n = 0;
+    for (int c = 0; c < w->ncells; c++)
+        for (size_t k = 0; k < w->cells[c].nobjs; k++)
+            if (w->cells[c].objs[k] == id) {
+                if (out && n < max) out[n] = c;
+                n++;
+                break;
+            }
+    return n;
+}
+
 vw_status vw_world_commit(vw_world *w)
 {
     if (!w) return VW_E_INVAL;

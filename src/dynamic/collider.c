@@ -1,0 +1,285 @@
+/* collider.c - the distributed collision test: a vwalls module whose objects are
+ * collision shapes and whose messages are probes (a moving object, sent to the cells
+ * its destination or swept bounds overlap) and contacts (a hit, sent to every process).
+ *
+ * Why contacts go to every process and not only to the output process: under MPI every
+ * process must apply the same accepted edits to its copy of the placement, so every
+ * process must see every contact. Each process names one of its cells as its mailbox;
+ * a cell that finds a hit sends the contact to every mailbox.
+ */
+#include <math.h>
+#include <pthread.h>
+#include <stdlib.h>
+#include <string.h>
+#include "dynamic/dynamic_internal.h"
+
+enum { K_PROBE = 0, K_CONTACT = 1 };
+enum { C_PROBES = 0, C_TESTS, C_CONTACTS, C_NCOUNTERS };
+
+struct vw_collider {
+    vw_world *world;
+    double tol;
+    int *mailbox;          /* per process: the cell receiving contacts */
+    int nprocs;
+    pthread_mutex_t mu;    /* guards the contact list */
+    vw_contact *contacts;
+    size_t ncontacts, capcontacts;
+};
+
+typedef struct cell {
+    vw_shape *s;
+    size_t n;
+    vw_collider *c;
+} cell;
+
+static void shape_bounds(const void *object, vw_box *out, void *user)
+{
+    (void)user;
+    vw_shape_bounds(object, NULL, out);
+}
+
+static vw_status cell_build(vw_ctx *ctx, const void *objects, size_t n, void **state)
+{
+    cell *c = calloc(1, sizeof *c);
+    if (!c) return VW_E_NOMEM;
+    c->c = vw_ctx_user(ctx);
+    if (n) {
+        c->s = malloc(n * sizeof *c->s);
+        if (!c->s) {
+            free(c);
+            return VW_E_NOMEM;
+        }
+        memcpy(c->s, objects, n * sizeof *c->s);
+    }
+    c->n = n;
+    *state = c;
+    return VW_OK;
+}
+
+static void cell_free(void *state, void *user)
+{
+    (void)user;
+    cell *c = state;
+    if (!c) return;
+    free(c->s);
+    free(c);
+}
+
+static int boxes_overlap(const vw_box *a, const vw_box *b)
+{
+    for (int k = 0; k < 3; k++)
+        if (a->hi[k] < b->lo[k] || b->hi[k] < a->lo[k]) return 0;
+    return 1;
+}
+
+/* The test of one probe against one obstacle shape; shared with the brute-force
+   reference (vw__probe_test) so both decide by the same rule. */
+int vw__probe_test(const vw_probe *p, const vw_shape *o, double tol)
+{
+    if (o->kind == VW_SHAPE_NONE || o->id == p->start.id) return 0;
+    int how = 0;
+    if ((p->flags & VW_PROBE_END) && vw_shape_collide(&p->end, NULL, o, tol)) how |= VW_PROBE_END;
+    if ((p->flags & VW_PROBE_SWEEP) && vw_shape_collide(&p->start, p->d, o, tol) &&
+        !vw_shape_collide(&p->start, NULL, o, tol))
+        how |= VW_PROBE_SWEEP;
+    return how;
+}
+
+static void handle_probe(vw_ctx *ctx, void *state, const void *msg)
+{
+    cell *c = state;
+    const vw_probe *p = msg;
+    vw_box pb;
+    vw_shape_bounds(&p->end, NULL, &pb);
+    if (p->flags & VW_PROBE_SWEEP) {
+        vw_box sb;
+        vw_shape_bounds(&p->start, p->d, &sb);
+        for (int k = 0; k < 3; k++) {
+            pb.lo[k] = fmin(pb.lo[k], sb.lo[k]);
+            pb.hi[k] = fmax(pb.hi[k], sb.hi[k]);
+        }
+    }
+    for (int k = 0; k < 3; k++) {
+        pb.lo[k] -= c->c->tol;
+        pb.hi[k] += c->c->tol;
+    }
+    vw_count(ctx, C_PROBES, 1);
+    int64_t tests = 0;
+    for (size_t i = 0; i < c->n; i++) {
+        vw_box ob;
+        vw_shape_bounds(&c->s[i], NULL, &ob);
+        if (!boxes_overlap(&pb, &ob)) continue;
+        tests++;
+        int how = vw__probe_test(p, &c->s[i], c->c->tol);
+        if (!how) continue;
+        vw_contact ct = {p->tag, c->s[i].id, how, 0};
+        vw_count(ctx, C_CONTACTS, 1);
+        for (int q = 0; q < c->c->nprocs; q++) vw_send_cell(ctx, c->c->mailbox[q], K_CONTACT, &ct);
+    }
+    vw_count(ctx, C_TESTS, tests);
+}
+
+static void handle_contact(vw_ctx *ctx, void *state, const void *msg)
+{
+    (void)state;
+    vw_collider *c = vw_ctx_user(ctx);
+    pthread_mutex_lock(&c->mu);
+    if (c->ncontacts == c->capcontacts) {
+        size_t cap = c->capcontacts ? 2 * c->capcontacts : 64;
+        vw_contact *n = realloc(c->contacts, cap * sizeof *n);
+        if (!n) { /* a lost contact would accept a colliding move: fail loudly */
+            pthread_mutex_unlock(&c->mu);
+            abort();
+        }
+        c->contacts = n;
+        c->capcontacts = cap;
+    }
+    c->contacts[c->ncontacts++] = *(const vw_contact *)msg;
+    pthread_mutex_unlock(&c->mu);
+}
+
+static const vw_msg_kind kinds[] = {
+    {"probe", sizeof(vw_probe), handle_probe, NULL},
+    {"contact", sizeof(vw_contact), handle_contact, NULL},
+};
+static const char *const counters[C_NCOUNTERS] = {"probes", "tests", "contacts"};
+
+static const vw_module collider_module = {
+    .abi = VW_MODULE_ABI,
+    .name = "collider",
+    .object_size = sizeof(vw_shape),
+    .object_bounds = shape_bounds,
+    .kinds = kinds,
+    .nkinds = 2,
+    .counters = counters,
+    .ncounters = C_NCOUNTERS,
+    .cell_build = cell_build,
+    .cell_free = cell_free,
+};
+
+/* One mailbox per process: the lowest cell it hosts. */
+static vw_status find_mailboxes(vw_collider *c)
+{
+    int np = vw_world_processes(c->world), nw = vw_world_workers(c->world);
+    int nc = vw_decomp_cell_count(vw_world_decomp(c->world));
+    free(c->mailbox);
+    c->mailbox = malloc(sizeof(int) * (size_t)np);
+    if (!c->mailbox) return VW_E_NOMEM;
+    c->nprocs = np;
+    for (int p = 0; p < np; p++) c->mailbox[p] = -1;
+    for (int cl = nc - 1; cl >= 0; cl--) c->mailbox[vw_world_cell_worker(c->world, cl) / nw] = cl;
+    for (int p = 0; p < np; p++)
+        if (c->mailbox[p] < 0) return VW_E_INVAL; /* a process without cells */
+    return VW_OK;
+}
+
+vw_status vw_collider_create(const vw_decomp *d, const vw_config *cfg, double tol,
+                             vw_collider **out)
+{
+    if (!out || !d) return VW_E_INVAL;
+    *out = NULL;
+    vw_collider *c = calloc(1, sizeof *c);
+    if (!c) return VW_E_NOMEM;
+    c->tol = tol > 0 ? tol : 0;
+    pthread_mutex_init(&c->mu, NULL);
+    vw_status st = vw_world_create(&collider_module, c, d, cfg, &c->world);
+    if (st == VW_OK) st = find_mailboxes(c);
+    if (st != VW_OK) {
+        vw_collider_free(c);
+        return st;
+    }
+    *out = c;
+    return VW_OK;
+}
+
+void vw_collider_free(vw_collider *c)
+{
+    if (!c) return;
+    vw_world_free(c->world);
+    pthread_mutex_destroy(&c->mu);
+    free(c->mailbox);
+    free(c->contacts);
+    free(c);
+}
+
+vw_status vw_collider_add(vw_collider *c, const vw_shape *s, size_t n)
+{
+    if (!c) return VW_E_INVAL;
+    return vw_world_add_objects(c->world, s, n);
+}
+
+vw_status vw_collider_update(vw_collider *c, size_t slot, const vw_shape *s)
+{
+    if (!c) return VW_E_INVAL;
+    return vw_world_update_object(c->world, slot, s);
+}
+
+vw_status vw_collider_redecompose(vw_collider *c, const vw_decomp *d, const int *cell_worker)
+{
+    if (!c || !d) return VW_E_INVAL;
+    vw_status st = vw_world_redecompose(c->world, d, cell_worker);
+    return st == VW_OK ? find_mailboxes(c) : st;
+}
+
+vw_world *vw_collider_world(vw_collider *c) { return c ? c->world : NULL; }
+
+static int contact_cmp(const void *a, const void *b)
+{
+    const vw_contact *x = a, *y = b;
+    if (x->tag != y->tag) return x->tag < y->tag ? -1 : 1;
+    if (x->obstacle != y->obstacle) return x->obstacle < y->obstacle ? -1 : 1;
+    return 0;
+}
+
+vw_status vw_collider_query(vw_collider *c, const vw_probe *probes, size_t n, vw_contact **out,
+                            size_t *nout)
+{
+    if (!c || !out || !nout || (n && !probes)) return VW_E_INVAL;
+    *out = NULL;
+    *nout = 0;
+    const vw_decomp *d = vw_world_decomp(c->world);
+    int nc = vw_decomp_cell_count(d);
+    int *cells = malloc(sizeof(int) * (size_t)nc);
+    if (!cells) return VW_E_NOMEM;
+    vw_status st = VW_OK;
+    for (size_t i = 0; i < n && st == VW_OK; i++) {
+        const vw_probe *p = &probes[i];
+        vw_box b;
+        vw_shape_bounds(&p->end, NULL, &b);
+        if (p->flags & VW_PROBE_SWEEP) {
+            vw_box sb;
+            vw_shape_bounds(&p->start, p->d, &sb);
+            for (int k = 0; k < 3; k++) {
+                b.lo[k] = fmin(b.lo[k], sb.lo[k]);
+                b.hi[k] = fmax(b.hi[k], sb.hi[k]);
+            }
+        }
+        /* The cells widened by tol: an obstacle held only by a cell the probe misses by
+           less than tol cannot be hit deeper than tol, but the pad keeps the reached set
+           a superset of the cells holding any shape the probe's box touches. */
+        int k = vw_decomp_cells_overlapping(d, &b, 2 * c->tol + 1e-12, cells, nc);
+        for (int j = 0; j < k && j < nc && st == VW_OK; j++)
+            st = vw_world_post(c->world, cells[j], K_PROBE, p);
+    }
+    free(cells);
+    c->ncontacts = 0;
+    if (st == VW_OK) st = vw_world_run(c->world);
+    if (st != VW_OK) return st;
+    qsort(c->contacts, c->ncontacts, sizeof *c->contacts, contact_cmp);
+    /* One contact per (tag, obstacle): the same obstacle is held by every cell it
+       overlaps, and a polygon is several shapes. */
+    size_t m = 0;
+    for (size_t i = 0; i < c->ncontacts; i++) {
+        if (m && c->contacts[m - 1].tag == c->contacts[i].tag &&
+            c->contacts[m - 1].obstacle == c->contacts[i].obstacle)
+            c->contacts[m - 1].how |= c->contacts[i].how;
+        else
+            c->contacts[m++] = c->contacts[i];
+    }
+    vw_contact *r = malloc((m ? m : 1) * sizeof *r);
+    if (!r) return VW_E_NOMEM;
+    memcpy(r, c->contacts, m * sizeof *r);
+    *out = r;
+    *nout = m;
+    return VW_OK;
+}

@@ -1,0 +1,13 @@
+/* dynamic_internal.h - what the files of the dynamic-scene handler share.
+ */
+#ifndef VW_DYNAMIC_INTERNAL_H
+#define VW_DYNAMIC_INTERNAL_H
+
+#include "vwalls/dynamic.h"
+
+/* The test of one probe against one obstacle shape, as a cell runs it: VW_PROBE_END
+   and/or VW_PROBE_SWEEP bits, 0 for no hit. The brute-force reference uses it too, so
+   both decide by one rule. */
+int vw__probe_test(const vw_probe *p, const vw_shape *o, double tol);
+
+#endif

@@ -17,3 +17,18 @@ add_test(NAME radiosity_cli
                  ${PROJECT_SOURCE_DIR}/tests/radiosity ${CMAKE_CURRENT_BINARY_DIR}/radiosity_cli
                  $<TARGET_FILE:test_radiosity>)
 set_tests_properties(radiosity_cli PROPERTIES LABELS "radiosity;threads" TIMEOUT 60)
+
+# Under mpirun -np 2 and 4 (tests/mpi.cmake, included before this file, sets the
+# launcher flags): 2x2x2 and 4x4x4 with 1 and 2 workers per process against the one-cell
+# threads solution (<= 1 % RMS, ledger <= 1e-9), outputs from rank 0 only, and
+# --checkpoint-every / --resume under MPI.
+if(VW_HAVE_MPI)
+  foreach(np 2 4)
+    add_test(NAME radiosity_mpi_np${np}
+             COMMAND sh ${PROJECT_SOURCE_DIR}/tests/radiosity/mpi.sh ${np} $<TARGET_FILE:vwalls_tool>
+                     $<TARGET_FILE:test_radiosity> ${CMAKE_CURRENT_BINARY_DIR}/radiosity_mpi_np${np}
+                     ${MPIEXEC_EXECUTABLE} ${MPIEXEC_NUMPROC_FLAG} ${np} ${VW_MPI_PREFLAGS})
+    set_tests_properties(radiosity_mpi_np${np} PROPERTIES LABELS "radiosity;mpi" TIMEOUT 240
+                         ENVIRONMENT "${VW_MPI_ENV}" PROCESSORS 2)
+  endforeach()
+endif()

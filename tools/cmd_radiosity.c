@@ -43,7 +43,8 @@ static void help(void)
            "  --stats FILE.json    stats JSON (radiosity: shots, unshot_ratio, energy_error)\n"
            "  --trace FILE         per round: seconds, shots, unshot ratio (for plots)\n"
            "  --checkpoint FILE    write checkpoints here (atomically)\n"
-           "  --checkpoint-every S seconds between checkpoints (default 60; 0: every round)\n"
+           "  --checkpoint-every S seconds between checkpoints (default 60; 0: every round;\n"
+           "                       under MPI the output process's clock decides for all)\n"
            "  --resume FILE        continue from a checkpoint (same scene and meshing options)\n"
            "  --max-rounds N       stop after N rounds without writing outputs (tests: a kill)\n"
            "  --quiet              no progress bar and no summary\n",
@@ -258,9 +259,13 @@ int vw_cmd_radiosity(int argc, char **argv)
     double t0 = vw_cli_now();
     char err[1024] = "";
     vw_scene *sc = NULL;
-    if (vw_scene_read_file(scene_path, &sc, err, sizeof err) != VW_OK) {
-        fprintf(stderr, "%s\n", err);
-        return VW_EXIT_USAGE;
+    /* Under MPI every process reads the scene; all stop if one cannot (a file missing on
+       one host), and only the output process says why. */
+    vw_status rst = vw_engine_agree(vw_scene_read_file(scene_path, &sc, err, sizeof err), err, sizeof err);
+    if (rst != VW_OK) {
+        if (vw_cli_is_output()) fprintf(stderr, "%s\n", err);
+        vw_scene_free(sc);
+        return rst == VW_E_NOMEM ? VW_EXIT_FAIL : VW_EXIT_USAGE;
     }
     vw_box world = rad_world_box(sc);
     vw_decomp *d = NULL;
@@ -272,7 +277,10 @@ int vw_cmd_radiosity(int argc, char **argv)
     }
     rad_mesh mesh;
     double t1 = vw_cli_now();
-    st = rad_mesh_build(sc, scene_path, d, &o, &mesh, err, sizeof err);
+    /* Every process meshes the whole scene; only the output process warns. */
+    rad_options mo = o;
+    if (!vw_cli_is_output()) mo.quiet = 1;
+    st = rad_mesh_build(sc, scene_path, d, &mo, &mesh, err, sizeof err);
     if (st != VW_OK) {
         if (vw_cli_is_output()) fprintf(stderr, "%s\n", err);
         vw_decomp_free(d);
@@ -333,7 +341,9 @@ int vw_cmd_radiosity(int argc, char **argv)
             rc = VW_EXIT_FAIL;
             goto done;
         }
-        if (o.checkpoint && rad_solver_checkpoint(s, o.checkpoint, err, sizeof err) != VW_OK) {
+        /* Just collected: write, do not collect again (a collect is a run every process
+           joins, and the others are past it). */
+        if (o.checkpoint && rad_solver_write_checkpoint(s, o.checkpoint, err, sizeof err) != VW_OK) {
             vw_cli_error(CMD, "%s", err);
             rc = VW_EXIT_FAIL;
             goto done;

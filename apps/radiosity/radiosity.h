@@ -154,7 +154,9 @@ void rad_solver_free(rad_solver *s);
 /* Runs rounds until converged (or a limit of the options). *converged tells which. */
 vw_status rad_solver_run(rad_solver *s, rad_progress_fn progress, void *user, int *converged,
                          char *err, size_t errlen);
-/* Gathers the results on the output process (elements sorted by piece, level, gi, gj). */
+/* Gathers the results on the output process (elements sorted by piece, level, gi, gj).
+   Collective under MPI, like run: every process calls it; the results, the ledger and
+   the unshot ratio below are valid on the output process only. */
 vw_status rad_solver_collect(rad_solver *s, char *err, size_t errlen);
 const rad_elem_result *rad_solver_elements(const rad_solver *s, size_t *n);
 const rad_patch_result *rad_solver_patches(const rad_solver *s, size_t *n);
@@ -162,8 +164,12 @@ rad_ledger rad_solver_ledger(const rad_solver *s);
 int64_t rad_solver_shots(const rad_solver *s);
 double rad_solver_unshot_ratio(const rad_solver *s);
 vw_world *rad_solver_world(rad_solver *s);
-/* Writes a checkpoint (collects first); atomic. */
+/* Writes a checkpoint (collects first); atomic. Collective: every process calls it, the
+   output process writes, and every process returns the write's status. */
 vw_status rad_solver_checkpoint(rad_solver *s, const char *path, char *err, size_t errlen);
+/* Writes the results of the last collect as a checkpoint (output process only; a no-op
+   elsewhere): for a caller that has just collected. */
+vw_status rad_solver_write_checkpoint(const rad_solver *s, const char *path, char *err, size_t errlen);
 /* Snapshot hook: called after every round on every process (it may collect). */
 typedef void (*rad_round_fn)(void *user, rad_solver *s, int round);
 void rad_solver_on_round(rad_solver *s, rad_round_fn fn, void *user);

@@ -101,12 +101,6 @@ vw_status rad_solver_create(const rad_mesh *m, const vw_decomp *d, const rad_opt
         rad_solver_free(s);
         return st;
     }
-    if (o->checkpoint && vw_world_processes(s->w) > 1 && o->checkpoint_every > 0) {
-        /* A time-based decision would differ between processes. */
-        snprintf(err, errlen, "--checkpoint-every with several processes is not supported; use 0 (every round)");
-        rad_solver_free(s);
-        return VW_E_UNSUPPORTED;
-    }
     if (o->resume) {
         st = VW_OK;
         FILE *f = fopen(o->resume, "rb");
@@ -117,6 +111,7 @@ vw_status rad_solver_create(const rad_mesh *m, const vw_decomp *d, const rad_opt
         double ba[3], be[3];
         if (!f) {
             snprintf(err, errlen, "%s: cannot open checkpoint: %s", o->resume, strerror(errno));
+            vw_world_agree(s->w, VW_E_IO, err, errlen);
             rad_solver_free(s);
             return VW_E_IO;
         }
@@ -159,6 +154,9 @@ vw_status rad_solver_create(const rad_mesh *m, const vw_decomp *d, const rad_opt
         }
         if (st == VW_E_INPUT && !err[0]) snprintf(err, errlen, "%s: truncated or corrupt checkpoint", o->resume);
         fclose(f);
+        /* Every process reads the file; one that cannot must not leave the others
+           waiting in the run below. */
+        st = vw_world_agree(s->w, st, err, errlen);
         if (st == VW_OK) {
             s->round = round;
             s->base_shots = shots;
@@ -190,6 +188,17 @@ void rad_solver_on_round(rad_solver *s, rad_round_fn fn, void *user)
 {
     s->on_round = fn;
     s->on_round_user = user;
+}
+
+/* Collective: every process learns the output process's yes or no. A decision taken on
+   a clock (is a checkpoint due?) would differ between processes, and a checkpoint is a
+   collect every process must join; agreement carries rank 0's answer to all (an
+   Allreduce when the answer is no, plus a Bcast when it is yes, once per round). */
+static int output_says_yes(rad_solver *s, int yes)
+{
+    char msg[16] = "";
+    vw_status mine = vw_world_is_output(s->w) && yes ? VW_E_STATE : VW_OK;
+    return vw_world_agree(s->w, mine, msg, sizeof msg) != VW_OK;
 }
 
 vw_status rad_solver_run(rad_solver *s, rad_progress_fn progress, void *user, int *converged,
@@ -228,7 +237,7 @@ vw_status rad_solver_run(rad_solver *s, rad_progress_fn progress, void *user, in
             break;
         }
         if (s->opt.max_shots > 0 && s->shots >= s->opt.max_shots) break;
-        if (s->opt.checkpoint && now() - last_ck >= s->opt.checkpoint_every) {
+        if (s->opt.checkpoint && output_says_yes(s, now() - last_ck >= s->opt.checkpoint_every)) {
             st = rad_solver_checkpoint(s, s->opt.checkpoint, err, errlen);
             if (st != VW_OK) return st;
             last_ck = now();
@@ -294,13 +303,22 @@ void rad_solver_traffic(const rad_solver *s, int64_t *shot_msgs, int64_t *shot_b
     *full_msgs = vw_world_counter(s->w, RAD_C_FULL_MSGS);
 }
 
-/* Checkpoint: "VWRADCK1", pieces, mesh fingerprint, round, shots, absorbed[3],
-   escaped[3], patches, elements (native byte order: resume on the same kind of
-   machine). Written atomically: a kill while writing leaves the previous one. */
 vw_status rad_solver_checkpoint(rad_solver *s, const char *path, char *err, size_t errlen)
 {
     vw_status st = rad_solver_collect(s, err, errlen);
-    if (st != VW_OK || !vw_world_is_output(s->w)) return st;
+    if (st != VW_OK) return st;
+    if (vw_world_is_output(s->w)) st = rad_solver_write_checkpoint(s, path, err, errlen);
+    /* A failed write fails every process, so none waits for the others' next round. */
+    return vw_world_agree(s->w, st, err, errlen);
+}
+
+/* Checkpoint: "VWRADCK1", pieces, mesh fingerprint, round, shots, absorbed[3],
+   escaped[3], patches, elements (native byte order: resume on the same kind of
+   machine). Written atomically: a kill while writing leaves the previous one. */
+vw_status rad_solver_write_checkpoint(const rad_solver *s, const char *path, char *err, size_t errlen)
+{
+    vw_status st;
+    if (!vw_world_is_output(s->w)) return VW_OK;
     const rad_mesh *m = s->mesh;
     uint64_t fp = 1469598103934665603ull;
     for (size_t i = 0; i < m->npieces; i++) {

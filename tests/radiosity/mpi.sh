@@ -1,0 +1,73 @@
+#!/bin/sh
+# mpi.sh NP VWALLS TEST_RADIOSITY TMPDIR LAUNCH... - `vwalls radiosity` under mpirun -np NP
+# against the one-cell solution of the threads engine (Cornell box, sf 2e-4):
+#  - layouts 2x2x2 and 4x4x4, 1 and 2 workers per process: area-weighted relative RMS
+#    over the original polygons <= 1 %, energy ledger <= 1e-9 relative, the stats name
+#    NP processes, and the outputs come from rank 0 alone (one warning line, not NP);
+#  - --checkpoint-every under MPI (rank 0's clock decides for all): a job stopped after a
+#    checkpoint resumes under MPI to the solution; a missing checkpoint fails every rank.
+set -u
+NP=$1 V=$2 TR=$3 T=$4
+shift 4
+LAUNCH="$*"
+rm -rf "$T" && mkdir -p "$T" || exit 1
+fail() { echo "FAIL: $*"; exit 1; }
+
+"$TR" gen cornell "$T/cornell.nff" || fail "gen"
+common="--sf 2e-4 --quiet"
+loud="--sf 2e-4"  # summary and warnings: they must come from rank 0 alone
+"$V" radiosity "$T/cornell.nff" --cells 1 --workers 1 $common --csv "$T/ref.csv" 2>/dev/null ||
+  fail "one-cell threads run"
+
+# ledger JSON NP: energy_error <= 1e-9 and engine.processes == NP
+ledger() {
+  python3 - "$1" "$2" <<'PY' || exit 1
+import json, sys
+d = json.load(open(sys.argv[1]))
+e, p = d["radiosity"]["energy_error"], d["engine"]["processes"]
+print(f"  energy error {e:.2e}, processes {p}, shots {d['radiosity']['shots']}, "
+      f"converged {d['radiosity']['converged']}")
+sys.exit(0 if e <= 1e-9 and p == int(sys.argv[2]) and d["radiosity"]["converged"] else 1)
+PY
+}
+
+for cells in 2x2x2 4x4x4; do
+  for w in 1 2; do
+    tag="np${NP}_${cells}_w$w"
+    echo "$tag:"
+    $LAUNCH "$V" radiosity "$T/cornell.nff" --cells $cells --workers $w $loud \
+      --csv "$T/$tag.csv" --stats "$T/$tag.json" -o "$T/$tag.ply" >"$T/$tag.out" 2>"$T/$tag.err" ||
+      fail "$tag: exit $? ($(cat "$T/$tag.err"))"
+    n=$(grep -c "^radiosity: converged" "$T/$tag.out")
+    [ "$n" -eq 1 ] || fail "$tag: $n summaries (want 1, from rank 0)"
+    "$TR" csvcmp "$T/ref.csv" "$T/$tag.csv" 0.01 || fail "$tag: differs from one cell"
+    ledger "$T/$tag.json" "$NP" || fail "$tag: ledger or process count"
+    n=$(grep -c "warning: polygon (id 8)" "$T/$tag.err")
+    [ "$n" -eq 1 ] || fail "$tag: $n copies of the meshing warning (want 1, from rank 0)"
+  done
+done
+
+# Checkpoints under MPI every 0.2 s (rank 0's clock decides for all): stop the job
+# with SIGTERM once one exists (mpirun forwards it to every rank), resume under MPI.
+tag="np${NP}_ck"
+$LAUNCH "$V" radiosity "$T/cornell.nff" --cells 2x2x2 --workers 1 $common --csv "$T/never.csv" \
+  --checkpoint "$T/ck" --checkpoint-every 0.2 2>"$T/$tag.err" &
+pid=$!
+i=0
+while [ ! -s "$T/ck" ] && [ $i -lt 1000 ]; do sleep 0.02; i=$((i+1)); done
+kill -TERM $pid 2>/dev/null
+wait $pid 2>/dev/null
+[ -s "$T/ck" ] || fail "$tag: no checkpoint written ($(cat "$T/$tag.err"))"
+[ ! -e "$T/never.csv" ] || echo "note: the run ended before the kill"
+ls "$T" | grep -q "tmp\." && fail "$tag: temporary file left behind"
+$LAUNCH "$V" radiosity "$T/cornell.nff" --cells 2x2x2 --workers 1 $common --csv "$T/resumed.csv" \
+  --resume "$T/ck" --stats "$T/resumed.json" 2>"$T/$tag.err" || fail "$tag: resume ($(cat "$T/$tag.err"))"
+"$TR" csvcmp "$T/ref.csv" "$T/resumed.csv" 0.01 || fail "$tag: resumed differs from one cell"
+ledger "$T/resumed.json" "$NP" || fail "$tag: resumed ledger"
+# A checkpoint that is not there: exit 2 on every rank, no hang.
+$LAUNCH "$V" radiosity "$T/cornell.nff" --cells 2x2x2 --workers 1 $common --csv "$T/x.csv" \
+  --resume "$T/missing" 2>"$T/missing.err"; rc=$?
+[ $rc -ne 0 ] || fail "missing checkpoint: exit 0"
+grep -q "cannot open checkpoint" "$T/missing.err" || fail "missing checkpoint: $(cat "$T/missing.err")"
+[ ! -e "$T/x.csv" ] || fail "missing checkpoint: output written"
+echo "ok"

@@ -47,7 +47,8 @@ VW_API void vw_shape_bounds(const vw_shape *s, const double d[3], vw_box *out);
 /* Do shapes a and b interpenetrate by more than tol? With d non-NULL, a is swept along
    the translation d (t in [0,1]) and the swept volume is tested.
    Touching (penetration <= tol) is not a collision, so objects that rest on each other
-   may move apart. Exactness:
+   may move apart; two coplanar triangles that overlap in their plane do collide.
+   Exactness:
      sphere-sphere, sphere-triangle, triangle-triangle: exact (closed-form distance;
        triangle pairs by the separating axis theorem over face normals, edge-edge
        cross products and in-plane edge normals, which is complete for convex polytopes);

@@ -211,7 +211,7 @@ static void poly_of(const vw_shape *s, const double *d, poly *P)
 }
 
 /* Does axis u (any length) separate A and B, i.e. do their projections overlap by at
-   most tol? Axes too short to carry a direction are skipped (they prove nothing). */
+   most tol (the penetration along u)? Axes too short to carry a direction are skipped (they prove nothing). */
 static int separates(const poly *A, const poly *B, const double u[3], double tol)
 {
     double len2 = dot(u, u);
@@ -226,6 +226,9 @@ static int separates(const poly *A, const poly *B, const double u[3], double tol
         double x = dot(B->pt[i], u) * inv;
         bmin = fmin(bmin, x), bmax = fmax(bmax, x);
     }
+    /* Both flat across u (coplanar faces): overlapping in their plane is a collision of
+       two surfaces, not a touch, so only a real gap separates here. */
+    if (amax - amin <= tol && bmax - bmin <= tol) return amin > bmax + tol || bmin > amax + tol;
     return amax - bmin <= tol || bmax - amin <= tol;
 }
 

@@ -61,3 +61,36 @@ if(VW_HAVE_MPI)
   set_tests_properties(example_components_mpi_stress_np2 PROPERTIES LABELS "examples;mpi"
                        TIMEOUT 120 PROCESSORS 2 ENVIRONMENT "${_vw_ex_env};VW_STRESS=5")
 endif()
+
+# The tutorial's code (docs/tutorial/): built against the shared library, as a user's
+# program would be, and run alone, with stress, and under mpirun.
+add_executable(tutorial_hello_cells ${PROJECT_SOURCE_DIR}/docs/tutorial/hello_cells.c
+                                    ${PROJECT_SOURCE_DIR}/docs/tutorial/hello_module.c)
+target_link_libraries(tutorial_hello_cells PRIVATE vwalls::vwalls)
+foreach(layout 1 2x2x2 4x4x2)
+  foreach(workers 1 3)
+    add_test(NAME tutorial_hello_${layout}_w${workers}
+             COMMAND tutorial_hello_cells --points 20000 --cells ${layout} --workers ${workers})
+    set_tests_properties(tutorial_hello_${layout}_w${workers} PROPERTIES LABELS "examples;threads"
+                         PASS_REGULAR_EXPRESSION "\nok\n")
+  endforeach()
+endforeach()
+add_test(NAME tutorial_hello_stress COMMAND tutorial_hello_cells --points 20000 --cells 4x4x4 --workers 4)
+set_tests_properties(tutorial_hello_stress PROPERTIES LABELS "examples;threads"
+                     ENVIRONMENT "VW_STRESS=3;VW_STRESS_SPLIT=1" PASS_REGULAR_EXPRESSION "\nok\n")
+if(VW_HAVE_MPI)
+  add_test(NAME tutorial_hello_mpi_np2
+           COMMAND ${MPIEXEC_EXECUTABLE} ${MPIEXEC_NUMPROC_FLAG} 2 ${MPIEXEC_PREFLAGS}
+                   $<TARGET_FILE:tutorial_hello_cells> --points 20000 --cells 4x2x2 --workers 2
+                   ${MPIEXEC_POSTFLAGS})
+  add_executable(tutorial_own_mpi ${PROJECT_SOURCE_DIR}/docs/tutorial/own_mpi.c
+                                  ${PROJECT_SOURCE_DIR}/docs/tutorial/hello_module.c)
+  target_link_libraries(tutorial_own_mpi PRIVATE vwalls::vwalls)   # MPI::MPI_C comes with it
+  foreach(np 2 4)
+    add_test(NAME tutorial_own_mpi_np${np}
+             COMMAND ${MPIEXEC_EXECUTABLE} ${MPIEXEC_NUMPROC_FLAG} ${np} ${MPIEXEC_PREFLAGS}
+                     $<TARGET_FILE:tutorial_own_mpi> ${MPIEXEC_POSTFLAGS})
+  endforeach()
+  set_tests_properties(tutorial_hello_mpi_np2 tutorial_own_mpi_np2 tutorial_own_mpi_np4 PROPERTIES
+                       LABELS "examples;mpi" TIMEOUT 120 PROCESSORS 2 ENVIRONMENT "${_vw_ex_env}")
+endif()

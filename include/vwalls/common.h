@@ -19,10 +19,8 @@ extern "C" {
 #define VW_API
 #endif
 
-#define VW_VERSION_MAJOR 0
-#define VW_VERSION_MINOR 1
-#define VW_VERSION_PATCH 0
-#define VW_VERSION_STRING "0.1.0"
+/* VW_VERSION_MAJOR, _MINOR, _PATCH, _STRING: generated from the CMake project version. */
+#include "vwalls/version.h"
 
 /* X(name, message) */
 #define VW_STATUS_MAP(X)                                              \

@@ -7,7 +7,8 @@
 add_test(NAME install_symbols
          COMMAND sh ${PROJECT_SOURCE_DIR}/tests/install/symbols.sh $<TARGET_FILE:vwalls>
                  ${PROJECT_SOURCE_DIR}/include/vwalls ${PROJECT_BINARY_DIR}/include/vwalls)
-set_tests_properties(install_symbols PROPERTIES LABELS "install")
+# nosan: a sanitizer build exports its instrumentation too; the contract is the plain build.
+set_tests_properties(install_symbols PROPERTIES LABELS "install;nosan")
 
 # vw_version() (from the generated header) is the CMake project version.
 add_test(NAME install_version COMMAND vwalls_tool --version)
@@ -31,7 +32,9 @@ add_test(NAME install_out_of_tree
          COMMAND sh ${PROJECT_SOURCE_DIR}/tests/install/run.sh ${PROJECT_BINARY_DIR}
                  ${PROJECT_SOURCE_DIR}/tests/install ${CMAKE_C_COMPILER} ${PROJECT_VERSION}
                  ${CMAKE_INSTALL_DOCDIR} ${CMAKE_INSTALL_LIBDIR} ${_vw_install_mpi})
-set_tests_properties(install_out_of_tree PROPERTIES LABELS "install" TIMEOUT 300 PROCESSORS 2
+# nosan: a program built out of tree without the sanitizer flags cannot link an
+# instrumented library.
+set_tests_properties(install_out_of_tree PROPERTIES LABELS "install;nosan" TIMEOUT 300 PROCESSORS 2
   RESOURCE_LOCK vw_docs
   ENVIRONMENT "OMPI_ALLOW_RUN_AS_ROOT=1;OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1;OMPI_MCA_rmaps_base_oversubscribe=1")
 

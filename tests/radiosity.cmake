@@ -10,6 +10,10 @@ foreach(t ffsum parallel perpendicular box layouts checkpoint)
   set_tests_properties(radiosity_${t} PROPERTIES LABELS "radiosity;threads" TIMEOUT 60)
 endforeach()
 
+# The full-matrix Gauss-Seidel reference, and the progressive solution against it.
+add_test(NAME radiosity_reference COMMAND test_radiosity reference)
+set_tests_properties(radiosity_reference PROPERTIES LABELS "radiosity;threads" TIMEOUT 180 PROCESSORS 2)
+
 # The command line: bad input (exit 2, file:line, no output) and kill -9 after a
 # checkpoint, then --resume, against the uninterrupted run.
 add_test(NAME radiosity_cli

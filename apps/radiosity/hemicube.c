@@ -196,3 +196,18 @@ void rad_hemicube_raster(const rad_hemicube *h, const double (*hv)[3], int nv, c
         }
     }
 }
+
+void rad_hemicube_orientation(const double n[3], uint64_t seed, double u[3])
+{
+    double t[3] = {1, 0, 0};
+    if (fabs(n[0]) > 0.6) t[0] = 0, t[1] = 1;
+    double a[3], b[3];
+    rad_cross(n, t, a);
+    rad_normalize(a);
+    rad_cross(n, a, b);
+    uint64_t z = seed * 0x9e3779b97f4a7c15ull;
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+    z ^= z >> 31;
+    double ang = 2 * M_PI * (double)(z >> 11) * 0x1.0p-53;
+    for (int k = 0; k < 3; k++) u[k] = cos(ang) * a[k] + sin(ang) * b[k];
+}

@@ -546,23 +546,6 @@ static void on_full(vw_ctx *ctx, void *state, const void *msg)
     on_shot_common(ctx, state, msg, NULL);
 }
 
-/* A hemicube orientation turned about the normal by an angle drawn from the shot id:
-   the aliasing of successive shots then does not line up. */
-static void orientation(const double n[3], uint64_t id, double u[3])
-{
-    double t[3] = {1, 0, 0};
-    if (fabs(n[0]) > 0.6) t[0] = 0, t[1] = 1;
-    double a[3], b[3];
-    rad_cross(n, t, a);
-    rad_normalize(a);
-    rad_cross(n, a, b);
-    uint64_t z = id * 0x9e3779b97f4a7c15ull;
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
-    z ^= z >> 31;
-    double ang = 2 * M_PI * (double)(z >> 11) * 0x1.0p-53;
-    for (int k = 0; k < 3; k++) u[k] = cos(ang) * a[k] + sin(ang) * b[k];
-}
-
 /* Shoots this cell's patch of largest unshot power, while the round's budget lasts. */
 static int step(vw_ctx *ctx, void *state)
 {
@@ -588,7 +571,7 @@ static int step(vw_ctx *ctx, void *state)
     h.piece = pt->pc.id;
     h.src_cell = c->cell;
     h.round = c->round;
-    orientation(h.n, (uint64_t)pt->pc.id * 1000003u + (uint64_t)pt->nshots, h.u);
+    rad_hemicube_orientation(h.n, rad_shot_seed(pt->pc.id, pt->nshots), h.u);
     for (int k = 0; k < 3; k++) {
         c->shot[k] += pt->unshot[k];
         pt->unshot[k] = 0;

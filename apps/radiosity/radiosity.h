@@ -108,6 +108,15 @@ void rad_hemicube_free(rad_hemicube *h);
 /* Bytes of a coverage bitmap. */
 size_t rad_hemicube_bitmap_bytes(int res);
 
+/* The hemicube's x axis for a shooter of normal n: a direction perpendicular to n turned
+   about it by an angle drawn from seed, so that the aliasing of successive shots of a
+   patch does not line up. The seed of shot k of piece p is rad_shot_seed(p, k). */
+void rad_hemicube_orientation(const double n[3], uint64_t seed, double u[3]);
+static inline uint64_t rad_shot_seed(int64_t piece, int64_t shot)
+{
+    return (uint64_t)piece * 1000003u + (uint64_t)shot;
+}
+
 /* Rasterises a polygon given in hemicube coordinates (x, y along the orientation, z
    along the shooter normal; origin at the shooter) into a z-buffer: pixels whose bit in
    mask is clear and whose stored depth is larger take depth and id. stamp/cur mark the
@@ -181,6 +190,29 @@ void rad_solver_traffic(const rad_solver *s, int64_t *shot_msgs, int64_t *shot_b
    polygon id (arrays of npoly entries, zero where a polygon has no element). */
 void rad_polygon_sums(const rad_elem_result *e, size_t n, size_t npoly, double *area,
                       double (*B)[3], double (*incident)[3]);
+
+/* ---- the full-matrix reference (reference.c) ---- */
+
+/* Patch-to-patch hemicube form factors on one cell (a shot's, with the orientation of
+   its first shot) and P = E + diag(rho) F^T P solved by Gauss-Seidel, P being the power
+   leaving each patch. For the bench and the tests; dense, n^2 doubles for n pieces.
+   Build the mesh on one cell, so that pieces are the progressive solver's shooters. */
+typedef struct rad_reference {
+    size_t n;               /* patches: the mesh's pieces */
+    double (*P)[3];         /* power leaving each patch (emitted + reflected) */
+    int sweeps;             /* Gauss-Seidel sweeps done */
+    double change;          /* largest change in the last sweep / total emitted */
+    double ff_s, solve_s;   /* seconds: form factors; Gauss-Seidel */
+    size_t matrix_bytes;
+} rad_reference;
+/* Sweeps until change < tol (fails with VW_E_LIMIT after max_sweeps). world: the box
+   the progressive solver would use (for its near-plane epsilon). */
+vw_status rad_reference_solve(const rad_mesh *m, const vw_box *world, int res, double tol, int max_sweeps,
+                              rad_reference *out, char *err, size_t errlen);
+void rad_reference_free(rad_reference *r);
+/* The solution as one result per piece (B = P / area), for rad_polygon_sums and
+   rad_write_csv; free() it. NULL when out of memory. */
+rad_elem_result *rad_reference_elements(const rad_mesh *m, const rad_reference *r);
 
 /* ---- outputs (output.c) ---- */
 

@@ -310,6 +310,129 @@ static int t_checkpoint(void)
     return 0;
 }
 
+/* The full-matrix Gauss-Seidel reference (reference.c) on one cell, as polygon sums. */
+static result reference(const vw_scene *sc, rad_options o, rad_reference *ref)
+{
+    result r;
+    memset(&r, 0, sizeof r);
+    o.quiet = 1;
+    o.dims[0] = o.dims[1] = o.dims[2] = 1;
+    vw_box wb = rad_world_box(sc);
+    vw_decomp *d;
+    CHECK(vw_decomp_create_grid(&wb, o.dims, &d) == VW_OK);
+    rad_mesh m;
+    char err[512] = "";
+    CHECK(rad_mesh_build(sc, "test", d, &o, &m, err, sizeof err) == VW_OK);
+    vw_status st = rad_reference_solve(&m, &wb, o.res, 1e-13, 100000, ref, err, sizeof err);
+    if (st != VW_OK) fprintf(stderr, "%s\n", err);
+    CHECK(st == VW_OK);
+    rad_elem_result *e = rad_reference_elements(&m, ref);
+    CHECK(e != NULL);
+    r.npoly = m.npolys;
+    r.area = calloc(r.npoly, sizeof *r.area);
+    r.B = calloc(r.npoly, sizeof *r.B);
+    r.inc = calloc(r.npoly, sizeof *r.inc);
+    rad_polygon_sums(e, ref->n, r.npoly, r.area, r.B, r.inc);
+    free(e);
+    rad_mesh_free(&m);
+    vw_decomp_free(d);
+    return r;
+}
+
+/* Gauss-Seidel on the full matrix: the closed box gives sum B A = E / (1 - rho); on the
+   Cornell box the progressive solution on one cell approaches it as sf falls (0.03 % at
+   1e-5), and 2x2x2 at 1e-4 is within 1 %. */
+static int t_reference(void)
+{
+    const float rho = 0.5f;
+    vw_scene *sc = box_scene(rho, 1);
+    rad_options o;
+    rad_options_init(&o);
+    o.patch_size = 0.25;
+    o.workers = 2;
+    rad_reference ref;
+    result g = reference(sc, o, &ref);
+    double total = 0;
+    for (size_t i = 0; i < g.npoly; i++) total += g.B[i][0] * g.area[i];
+    printf("box: Gauss-Seidel %d sweeps, sum B*A = %.6f (want 2)\n", ref.sweeps, total);
+    CHECK_NEAR(total, 2.0, 0.01 * 2.0);
+    rad_reference_free(&ref);
+    result_free(&g);
+    vw_scene_free(sc);
+
+    sc = cornell();
+    rad_options_init(&o);
+    o.workers = 2;
+    g = reference(sc, o, &ref);
+    printf("cornell: %zu patches, form factors %.2f s, Gauss-Seidel %d sweeps %.3f s\n", ref.n, ref.ff_s,
+           ref.sweeps, ref.solve_s);
+    double last = 1;
+    const double sfs[] = {1e-3, 1e-4, 1e-5};
+    for (int i = 0; i < 3; i++) {
+        o.sf = sfs[i];
+        for (int l = 0; l < 1 + (i == 1); l++) {
+            vw_layout_parse(l ? "2x2x2" : "1", o.dims, NULL, 0);
+            result r = solve(sc, o);
+            double e = rel_rms(&r, &g);
+            printf("  progressive sf %.0e, %-5s: %lld shots, relative RMS vs Gauss-Seidel %.3f%%\n", sfs[i],
+                   l ? "2x2x2" : "1", (long long)r.shots, 100 * e);
+            if (l == 0) {
+                CHECK(e < last);
+                last = e;
+            } else {
+                CHECK(e <= 0.01);
+            }
+            result_free(&r);
+        }
+    }
+    CHECK(last <= 0.002);
+    rad_reference_free(&ref);
+    result_free(&g);
+    vw_scene_free(sc);
+    return 0;
+}
+
+/* reference SCENE OUT.csv PATCH_SIZE RES ELEMENTS: the Gauss-Seidel reference of a scene
+   file as a --csv file (the bench compares the progressive solution with it). */
+static int t_reference_file(const char *path, const char *csv, double ps, int res, int elems)
+{
+    vw_scene *sc = NULL;
+    char err[512] = "";
+    if (vw_scene_read_file(path, &sc, err, sizeof err) != VW_OK) {
+        fprintf(stderr, "%s\n", err);
+        return 2;
+    }
+    rad_options o;
+    rad_options_init(&o);
+    o.quiet = 1;
+    o.patch_size = ps;
+    o.res = res;
+    o.elem_split = elems;
+    vw_box wb = rad_world_box(sc);
+    vw_decomp *d;
+    CHECK(vw_decomp_create_grid(&wb, o.dims, &d) == VW_OK);
+    rad_mesh m;
+    CHECK(rad_mesh_build(sc, path, d, &o, &m, err, sizeof err) == VW_OK);
+    rad_reference ref;
+    vw_status st = rad_reference_solve(&m, &wb, o.res, 1e-13, 100000, &ref, err, sizeof err);
+    if (st != VW_OK) {
+        fprintf(stderr, "%s\n", err);
+        return 1;
+    }
+    rad_elem_result *e = rad_reference_elements(&m, &ref);
+    CHECK(e != NULL);
+    CHECK(rad_write_csv(csv, &m, sc, e, ref.n, err, sizeof err) == VW_OK);
+    printf("{\"patches\": %zu, \"matrix_bytes\": %zu, \"form_factors_s\": %.6f, \"gauss_seidel_s\": %.6f, "
+           "\"sweeps\": %d, \"change\": %.3g}\n",
+           ref.n, ref.matrix_bytes, ref.ff_s, ref.solve_s, ref.sweeps, ref.change);
+    free(e);
+    rad_reference_free(&ref);
+    rad_mesh_free(&m);
+    vw_decomp_free(d);
+    vw_scene_free(sc);
+    return 0;
+}
+
 /* Writes a generated scene as NFF (the CLI tests read it). */
 static int t_gen(const char *name, const char *path)
 {
@@ -356,7 +479,7 @@ static int t_csvcmp(const char *a, const char *b, double tol)
 int main(int argc, char **argv)
 {
     if (argc < 2) {
-        fprintf(stderr, "usage: test_radiosity ffsum|parallel|perpendicular|box|layouts|checkpoint|gen NAME FILE\n");
+        fprintf(stderr, "usage: test_radiosity ffsum|parallel|perpendicular|box|layouts|checkpoint|reference|gen NAME FILE\n");
         return 2;
     }
     const char *t = argv[1];
@@ -366,6 +489,9 @@ int main(int argc, char **argv)
     if (!strcmp(t, "box")) return t_box();
     if (!strcmp(t, "layouts")) return t_layouts();
     if (!strcmp(t, "checkpoint")) return t_checkpoint();
+    if (!strcmp(t, "reference") && argc == 2) return t_reference();
+    if (!strcmp(t, "reference") && argc == 7)
+        return t_reference_file(argv[2], argv[3], atof(argv[4]), atoi(argv[5]), atoi(argv[6]));
     if (!strcmp(t, "gen") && argc == 4) return t_gen(argv[2], argv[3]);
     if (!strcmp(t, "csvcmp") && argc == 5) return t_csvcmp(argv[2], argv[3], atof(argv[4]));
     fprintf(stderr, "unknown test '%s'\n", t);

@@ -10,6 +10,7 @@
 #include <string.h>
 #include <strings.h>
 #include <time.h>
+#include <unistd.h>
 
 #include "cli.h"
 #include "commands.h"
@@ -35,6 +36,17 @@ static void help(void)
            "  --stats FILE     write the stats JSON\n"
            "  --overlay FILE   write a PNG of the image with the walls drawn and each cell's\n"
            "                   pixels tinted by its measured load (green light .. red heavy)\n"
+           "  --balance S      none|tensor|rotate|staggered|divide: a sparse pre-pass measures\n"
+           "                   where the work lies, the balancer moves the walls, then the\n"
+           "                   full render (the image does not change)\n"
+           "  --balance-load M busy (measured time, default) | segments (counted ray-cell\n"
+           "                   visits: deterministic) | model (objects + pixels + messages)\n"
+           "  --balance-iters N  pre-pass / balance rounds (default 2)\n"
+           "  --prepass N      pre-pass traces every N-th row and column (default 8)\n"
+           "  --map K          block (default) | greedy (by load) | weighted (by --speeds)\n"
+           "  --speeds LIST    relative speed of every worker, like 1,1,2,4\n"
+           "  --slow W:K[,..]  worker W does its work K times slower (emulates a slow machine)\n"
+           "  --overlay-by B   load (default) or worker: what tints the overlay's cells\n"
            "  --quiet          no progress bar and no summary\n"
            "Runs under mpirun too; only the first process writes files.\n");
 }
@@ -81,6 +93,46 @@ static void *progress_main(void *arg)
     return NULL;
 }
 
+/* ---- balancing: a sparse pre-pass, the balancer, then the full render ----------------- */
+
+/* The stats JSON member "balance_detail" appended to the ray tracer's members. */
+static char *with_balance_json(char *rt, rt_job *job, vw_world *w, const vw_traffic *tr,
+                               const rt_balance_result *bi,
+                               vw_balance_strategy s, vw_map_kind map, const vw_load_spec *ls,
+                               const double *speeds)
+{
+    if (!rt) return NULL;
+    static const char *const models[] = {"busy", "segments", "model"};
+    size_t n = strlen(rt) + 1024;
+    char *out = malloc(n);
+    if (!out) return rt;
+    snprintf(out, n,
+             "%s,\n  \"balance_detail\": {\"strategy\": \"%s\", \"map\": \"%s\", "
+             "\"load_model\": \"%s\", \"rounds\": %d, \"imbalance_before\": %.6g, "
+             "\"imbalance_predicted\": %.6g, \"imbalance_after\": %.6g, "
+             "\"imbalance_work\": %.6g, \"migrated_objects\": %llu, \"bytes_moved\": %llu, "
+             "\"max_neighbours\": %d, \"prepass_s\": %.6f, \"balance_s\": %.6f},\n"
+             "  \"traffic\": {\"messages\": %llu, \"bytes\": %llu, \"worker_messages\": %llu, "
+             "\"worker_bytes\": %llu, \"process_messages\": %llu, \"process_bytes\": %llu, "
+             "\"machine_messages\": %llu, \"machine_bytes\": %llu, \"share_worker\": %.6g, "
+             "\"share_process\": %.6g, \"share_machine\": %.6g}",
+             rt, vw_balance_strategy_name(s), vw_map_kind_name(map),
+             models[ls->model <= VW_LOAD_MODEL ? ls->model : 0], bi->rounds,
+             bi->rep.imbalance_before, bi->rep.imbalance_predicted, vw_world_imbalance(w),
+             rt_job_work_imbalance(job, speeds), (unsigned long long)bi->migrated,
+             (unsigned long long)bi->bytes, vw_decomp_max_neighbours(vw_world_decomp(w)),
+             bi->prepass_s, vw_world_time(w, "balance"), (unsigned long long)tr->msgs,
+             (unsigned long long)tr->bytes, (unsigned long long)tr->msgs_worker,
+             (unsigned long long)tr->bytes_worker, (unsigned long long)tr->msgs_process,
+             (unsigned long long)tr->bytes_process, (unsigned long long)tr->msgs_machine,
+             (unsigned long long)tr->bytes_machine,
+             tr->msgs ? (double)tr->msgs_worker / (double)tr->msgs : 1.0,
+             tr->msgs ? (double)tr->msgs_process / (double)tr->msgs : 1.0,
+             tr->msgs ? (double)tr->msgs_machine / (double)tr->msgs : 1.0);
+    free(rt);
+    return out;
+}
+
 int vw_cmd_render(int argc, char **argv)
 {
     const char *scene_path = NULL, *out = NULL, *stats = NULL, *overlay = NULL;
@@ -88,6 +140,13 @@ int vw_cmd_render(int argc, char **argv)
     long workers = 0, depth = 5;
     double from[3], at[3], up[3], angle = 0;
     int has_from = 0, has_at = 0, has_up = 0, has_angle = 0;
+    const char *speeds_s = NULL, *slow_s = NULL;
+    vw_balance_strategy strategy = VW_BALANCE_NONE;
+    vw_map_kind map = VW_MAP_BLOCK;
+    int map_given = 0, by_worker = 0;
+    long iters = 2, prepass = 8;
+    vw_load_spec lspec;
+    vw_load_spec_init(&lspec);
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i], *v;
         if (!strcmp(a, "--help") || !strcmp(a, "-h")) {
@@ -113,6 +172,51 @@ int vw_cmd_render(int argc, char **argv)
             if (!(stats = vw_cli_value(CMD, argc, argv, &i))) return VW_EXIT_USAGE;
         } else if (!strcmp(a, "--overlay")) {
             if (!(overlay = vw_cli_value(CMD, argc, argv, &i))) return VW_EXIT_USAGE;
+        } else if (!strcmp(a, "--balance")) {
+            if (!(v = vw_cli_value(CMD, argc, argv, &i))) return VW_EXIT_USAGE;
+            if (vw_balance_strategy_parse(v, &strategy) != VW_OK || strategy == VW_BALANCE_DUPLICATE) {
+                vw_cli_error(CMD, "--balance: bad value '%s' (expected none, tensor, rotate, "
+                                  "staggered or divide)", v);
+                return VW_EXIT_USAGE;
+            }
+        } else if (!strcmp(a, "--balance-load")) {
+            if (!(v = vw_cli_value(CMD, argc, argv, &i))) return VW_EXIT_USAGE;
+            if (!strcmp(v, "busy")) {
+                lspec.model = VW_LOAD_BUSY;
+            } else if (!strcmp(v, "segments")) {
+                lspec.model = VW_LOAD_COUNTER;
+                lspec.counter = RT_C_SEGMENTS;
+            } else if (!strcmp(v, "model")) {
+                lspec.model = VW_LOAD_MODEL;
+                lspec.counter = RT_C_PIXELS;
+            } else {
+                vw_cli_error(CMD, "--balance-load: bad value '%s' (expected busy, segments or model)", v);
+                return VW_EXIT_USAGE;
+            }
+        } else if (!strcmp(a, "--balance-iters")) {
+            if (!(v = vw_cli_value(CMD, argc, argv, &i)) || vw_cli_int(CMD, a, v, 1, 20, &iters))
+                return VW_EXIT_USAGE;
+        } else if (!strcmp(a, "--prepass")) {
+            if (!(v = vw_cli_value(CMD, argc, argv, &i)) || vw_cli_int(CMD, a, v, 1, 256, &prepass))
+                return VW_EXIT_USAGE;
+        } else if (!strcmp(a, "--map")) {
+            if (!(v = vw_cli_value(CMD, argc, argv, &i))) return VW_EXIT_USAGE;
+            if (vw_map_kind_parse(v, &map) != VW_OK) {
+                vw_cli_error(CMD, "--map: bad value '%s' (expected block, greedy or weighted)", v);
+                return VW_EXIT_USAGE;
+            }
+            map_given = 1;
+        } else if (!strcmp(a, "--speeds")) {
+            if (!(speeds_s = vw_cli_value(CMD, argc, argv, &i))) return VW_EXIT_USAGE;
+        } else if (!strcmp(a, "--slow")) {
+            if (!(slow_s = vw_cli_value(CMD, argc, argv, &i))) return VW_EXIT_USAGE;
+        } else if (!strcmp(a, "--overlay-by")) {
+            if (!(v = vw_cli_value(CMD, argc, argv, &i))) return VW_EXIT_USAGE;
+            if (strcmp(v, "load") && strcmp(v, "worker")) {
+                vw_cli_error(CMD, "--overlay-by: bad value '%s' (expected load or worker)", v);
+                return VW_EXIT_USAGE;
+            }
+            by_worker = !strcmp(v, "worker");
         } else if (!strcmp(a, "--from")) {
             if (parse_vec(a, vw_cli_value(CMD, argc, argv, &i), from)) return VW_EXIT_USAGE;
             has_from = 1;
@@ -151,6 +255,48 @@ int vw_cmd_render(int argc, char **argv)
         return VW_EXIT_USAGE;
     }
 
+    /* Workers of the whole job, for --speeds and --slow (the world's own default when
+       --workers is not given: one per core). */
+    long cores = sysconf(_SC_NPROCESSORS_ONLN);
+    int gw = (int)(workers > 0 ? workers : cores > 0 ? cores : 1) * vw_engine_size();
+    double *speeds = NULL, *slowdown = NULL;
+    if (speeds_s) {
+        speeds = malloc(sizeof(double) * (size_t)gw);
+        if (!speeds || vw_map_parse_speeds(speeds_s, speeds, gw) != VW_OK) {
+            vw_cli_error(CMD, "--speeds: bad value '%s' (expected %d positive numbers, one per worker)",
+                         speeds_s, gw);
+            free(speeds);
+            return VW_EXIT_USAGE;
+        }
+    }
+    if (slow_s) {
+        slowdown = malloc(sizeof(double) * (size_t)gw);
+        if (!slowdown) return VW_EXIT_FAIL;
+        for (int g = 0; g < gw; g++) slowdown[g] = 1.0;
+        const char *q = slow_s;
+        while (*q) {
+            char *end;
+            long wk = strtol(q, &end, 10);
+            double k = 0;
+            if (end != q && *end == ':') k = strtod(end + 1, &end);
+            if (wk < 0 || wk >= gw || !(k >= 1) || k > 1000 || (*end && *end != ',')) {
+                vw_cli_error(CMD, "--slow: bad value '%s' (expected W:K with worker W < %d and K >= 1)",
+                             slow_s, gw);
+                free(speeds);
+                free(slowdown);
+                return VW_EXIT_USAGE;
+            }
+            slowdown[wk] = k;
+            q = *end ? end + 1 : end;
+        }
+        /* A known slow-down is the calibration: its speed is 1/K. */
+        if (!speeds) {
+            speeds = malloc(sizeof(double) * (size_t)gw);
+            if (!speeds) return VW_EXIT_FAIL;
+            for (int g = 0; g < gw; g++) speeds[g] = 1.0 / slowdown[g];
+        }
+    }
+
     double t_load0 = vw_cli_now();
     char err[1024];
     vw_scene *scene = NULL;
@@ -177,6 +323,10 @@ int vw_cmd_render(int argc, char **argv)
     memcpy(p.dims, dims, sizeof dims);
     p.workers = (int)workers;
     p.camera = &cam;
+    vw_config cfg;
+    vw_config_init(&cfg);
+    cfg.worker_slowdown = slowdown;
+    p.config = &cfg;
     rt_job *job = NULL;
     vw_status st = rt_job_create(scene, &p, &job, err, sizeof err);
     size_t nobjects = vw_scene_count_objects(scene);
@@ -186,11 +336,36 @@ int vw_cmd_render(int argc, char **argv)
         return st == VW_E_INVAL ? VW_EXIT_USAGE : VW_EXIT_FAIL;
     }
     vw_world *w = rt_job_world(job);
-    double t_build0 = vw_cli_now();
     int rc = VW_EXIT_OK;
+    /* The mapping of the initial cells (greedy and weighted refine it by load after the
+       pre-pass, when there is one). */
+    int balancing = strategy != VW_BALANCE_NONE || map != VW_MAP_BLOCK;
+    rt_balance_result bi;
+    memset(&bi, 0, sizeof bi);
+    if ((map_given || speeds) && rt_job_map(job, map, NULL, speeds, err, sizeof err) != VW_OK) {
+        vw_cli_error(CMD, "%s", err);
+        rt_job_free(job);
+        free(speeds), free(slowdown);
+        return VW_EXIT_FAIL;
+    }
+    if (balancing) {
+        double tb0 = vw_cli_now();
+        rt_balance rb = {strategy, map, speeds, lspec, (int)iters, (int)prepass};
+        st = rt_job_balance(job, &rb, &bi, err, sizeof err);
+        if (st != VW_OK) {
+            vw_cli_error(CMD, "%s", err);
+            rt_job_free(job);
+            free(speeds), free(slowdown);
+            return VW_EXIT_FAIL;
+        }
+        /* The balancer recorded its own computing time; add the pre-pass's. */
+        vw_world_add_time(w, "balance", vw_cli_now() - tb0 - vw_world_time(w, "balance"));
+    }
+    double t_build0 = vw_cli_now();
     if (rt_job_commit(job, err, sizeof err) != VW_OK) {
         vw_cli_error(CMD, "%s", err);
         rt_job_free(job);
+        free(speeds), free(slowdown);
         return VW_EXIT_FAIL;
     }
     double t_run0 = vw_cli_now();
@@ -213,8 +388,16 @@ int vw_cmd_render(int argc, char **argv)
     if (st != VW_OK) {
         vw_cli_error(CMD, "%s", err);
         rt_job_free(job);
+        free(speeds), free(slowdown);
         return VW_EXIT_FAIL;
     }
+    /* Collective: every process calls it, only the output process writes it. */
+    vw_traffic traffic;
+    vw_world_traffic(w, &traffic);
+    if (strategy != VW_BALANCE_NONE)
+        /* After: measured on the full render (busy time over workers), not predicted. */
+        vw_world_set_balance_info(w, vw_balance_strategy_name(strategy), bi.rep.imbalance_before,
+                                  vw_world_imbalance(w), bi.migrated);
     vw_world_add_time(w, "load", t_build0 - t_load0);
     vw_world_add_time(w, "build", t_run0 - t_build0);
     vw_world_add_time(w, "compute", t_run1 - t_run0);
@@ -253,7 +436,10 @@ int vw_cmd_render(int argc, char **argv)
         if (overlay && rc == VW_EXIT_OK) {
             uint8_t *img = malloc(n);
             if (img) {
-                rt_job_overlay(job, img);
+                if (by_worker)
+                    rt_job_overlay_workers(job, img);
+                else
+                    rt_job_overlay(job, img);
                 if (vw_image_write_png(overlay, W, H, img, err, sizeof err) != VW_OK) {
                     vw_cli_error(CMD, "%s", err);
                     rc = VW_EXIT_FAIL;
@@ -264,7 +450,8 @@ int vw_cmd_render(int argc, char **argv)
         double t_end = vw_cli_now();
         vw_world_add_time(w, "write", t_end - t_run1);
         if (stats && rc == VW_EXIT_OK) {
-            char *extra = rt_job_stats_json(job);
+            char *extra = with_balance_json(rt_job_stats_json(job), job, w, &traffic, &bi, strategy, map, &lspec,
+                                            speeds);
             if (vw_world_write_stats(w, stats, CMD, extra) != VW_OK) {
                 vw_cli_error(CMD, "%s", vw_world_errmsg(w));
                 rc = VW_EXIT_FAIL;
@@ -284,6 +471,13 @@ int vw_cmd_render(int argc, char **argv)
                    vw_decomp_cell_count(vw_world_decomp(w)), vw_world_workers(w),
                    vw_world_processes(w), vw_world_processes(w) == 1 ? "" : "es",
                    vw_world_imbalance(w));
+            if (balancing)
+                printf("balance %s, map %s: lambda before %.3f, predicted %.3f, after %.3f "
+                       "(work lambda %.3f); %llu objects migrated, %.3f s\n",
+                       vw_balance_strategy_name(strategy), vw_map_kind_name(map),
+                       bi.rep.imbalance_before, bi.rep.imbalance_predicted, vw_world_imbalance(w),
+                       rt_job_work_imbalance(job, speeds), (unsigned long long)bi.migrated,
+                       vw_world_time(w, "balance"));
             printf("time: load %.3f s, build %.3f s, compute %.3f s, write %.3f s, total %.3f s\n",
                    t_build0 - t_load0, t_run0 - t_build0, comp, t_end - t_run1, t_end - t_load0);
             printf("rays: eye %lld, reflect %lld, refract %lld, shadow %lld; %lld in all, "
@@ -292,5 +486,6 @@ int vw_cmd_render(int argc, char **argv)
         }
     }
     rt_job_free(job);
+    free(speeds), free(slowdown);
     return rc;
 }

@@ -30,6 +30,24 @@ void rt_job_free(rt_job *j)
     free(j);
 }
 
+/* Output process: the cell owning each pixel's eye ray, by the same walk every cell
+   does in cell_build (on the world's current decomposition), so owners agree with them. */
+static void owners(rt_job *j)
+{
+    const vw_decomp *d = vw_world_decomp(j->world);
+    int w = j->sh.view.width, h = j->sh.view.height;
+    j->primary = 0;
+    for (int y = 0; y < h; y++)
+        for (int x = 0; x < w; x++) {
+            double dir[3];
+            vw_segment seg;
+            rt_view_ray(&j->sh.view, x, y, dir);
+            int hitw = vw_decomp_first_segment(d, j->sh.view.eye, dir, 0.0, INFINITY, &seg);
+            j->owner[(size_t)y * w + x] = hitw ? seg.cell : -1;
+            j->primary += hitw;
+        }
+}
+
 vw_status rt_job_create(const vw_scene *s, const rt_params *p, rt_job **out, char *err,
                         size_t errlen)
 {
@@ -148,17 +166,7 @@ vw_status rt_job_create(const vw_scene *s, const rt_params *p, rt_job **out, cha
         sh->accum = calloc(np, sizeof *sh->accum);
         j->owner = malloc(np * sizeof *j->owner);
         if (!sh->accum || !j->owner) goto nomem;
-        /* The same walk every cell does in cell_build, so owners agree with them. */
-        for (int y = 0; y < h; y++)
-            for (int x = 0; x < w; x++) {
-                double dir[3];
-                vw_segment seg;
-                rt_view_ray(&sh->view, x, y, dir);
-                int hitw = vw_decomp_first_segment(j->decomp, sh->view.eye, dir, 0.0, INFINITY,
-                                                   &seg);
-                j->owner[(size_t)y * w + x] = hitw ? seg.cell : -1;
-                j->primary += hitw;
-            }
+        owners(j);
     }
     *out = j;
     return VW_OK;
@@ -195,6 +203,22 @@ vw_status rt_job_run(rt_job *j, char *err, size_t errlen)
                 for (int k = 0; k < 3; k++) j->sh.accum[i][k] += bg[k];
     }
     j->ran = 1;
+    return VW_OK;
+}
+
+void rt_job_set_sample(rt_job *j, int stride) { j->sh.sample = stride > 1 ? stride : 1; }
+
+vw_status rt_job_reset(rt_job *j)
+{
+    if (j->sh.accum) {
+        memset(j->sh.accum, 0, sizeof *j->sh.accum * (size_t)j->sh.view.width * j->sh.view.height);
+        owners(j);
+    }
+    atomic_store(&j->sh.pixels_done, 0);
+    atomic_store(&j->sh.entries, 0);
+    atomic_store(&j->sh.rays, 0);
+    j->ran = 0;
+    vw_world_reset_stats(j->world);
     return VW_OK;
 }
 
@@ -262,12 +286,14 @@ static void line(uint8_t *img, int w, int h, double x0, double y0, double x1, do
     }
 }
 
+static void draw_walls(const rt_job *j, uint8_t *out);
+
 void rt_job_overlay(const rt_job *j, uint8_t *out)
 {
     const rt_view *v = &j->sh.view;
     int w = v->width, h = v->height;
     rt_job_rgb8(j, out);
-    int nc = vw_decomp_cell_count(j->decomp);
+    int nc = vw_decomp_cell_count(vw_world_decomp(j->world));
     double *load = calloc((size_t)nc, sizeof *load);
     if (!load) return;
     double maxl = 0, minl = INFINITY;
@@ -288,12 +314,46 @@ void rt_job_overlay(const rt_job *j, uint8_t *out)
                 out[i * 3 + k] = (uint8_t)lround(0.55 * out[i * 3 + k] + 0.45 * tint[k]);
         }
     free(load);
+    draw_walls(j, out);
+}
+
+/* Tint by hosting worker: a fixed palette of well-separated hues (golden-angle steps),
+   so the mapping (which cells share a worker) can be seen at a glance. */
+void rt_job_overlay_workers(const rt_job *j, uint8_t *out)
+{
+    const rt_view *v = &j->sh.view;
+    int w = v->width, h = v->height;
+    rt_job_rgb8(j, out);
+    if (j->owner)
+        for (size_t i = 0; i < (size_t)w * h; i++) {
+            int c = j->owner[i];
+            if (c < 0) continue;
+            int g = vw_world_cell_worker(j->world, c);
+            double hh = fmod(g * 137.508, 360.0) / 60.0, f = hh - floor(hh);
+            static const double ramp[6][3][2] = { /* (constant, slope) per channel */
+                {{1, 0}, {0, 1}, {0, 0}}, {{1, -1}, {1, 0}, {0, 0}}, {{0, 0}, {1, 0}, {0, 1}},
+                {{0, 0}, {1, -1}, {1, 0}}, {{0, 1}, {0, 0}, {1, 0}}, {{1, 0}, {0, 0}, {1, -1}}};
+            int sx = (int)hh % 6;
+            double rgb[3];
+            for (int k = 0; k < 3; k++) rgb[k] = ramp[sx][k][0] + ramp[sx][k][1] * f;
+            for (int k = 0; k < 3; k++)
+                out[i * 3 + k] = (uint8_t)lround(0.5 * out[i * 3 + k] + 0.5 * 255.0 * rgb[k]);
+        }
+    draw_walls(j, out);
+}
+
+static void draw_walls(const rt_job *j, uint8_t *out)
+{
+    const rt_view *v = &j->sh.view;
+    int w = v->width, h = v->height;
+    const vw_decomp *d = vw_world_decomp(j->world);
+    int nc = vw_decomp_cell_count(d);
     /* Walls: the edges of every cell box, clipped to the half-space in front of the eye. */
     static const uint8_t white[3] = {255, 255, 255};
-    const double *F = vw_decomp_frame(j->decomp);
+    const double *F = vw_decomp_frame(d);
     double near = 1e-6;
     for (int c = 0; c < nc; c++) {
-        vw_box b = vw_decomp_cell_box(j->decomp, c);
+        vw_box b = vw_decomp_cell_box(d, c);
         double P[8][3];
         for (int i = 0; i < 8; i++) {
             double q[3] = {(i & 1) ? b.hi[0] : b.lo[0], (i & 2) ? b.hi[1] : b.lo[1],
@@ -334,7 +394,7 @@ void rt_job_overlay(const rt_job *j, uint8_t *out)
 
 char *rt_job_stats_json(const rt_job *j)
 {
-    int nc = vw_decomp_cell_count(j->decomp);
+    int nc = vw_decomp_cell_count(vw_world_decomp(j->world));
     size_t cap = 512 + (size_t)nc * 24;
     char *s = malloc(cap);
     if (!s) return NULL;

@@ -380,8 +380,11 @@ static vw_status primary_pixels(vw_ctx *ctx, rt_cell *c)
         y1 = (int)fmin(v->height - 1, ceil(hi[1]) + 1);
     }
     size_t cap = 0;
+    int sample = c->sh->sample > 1 ? c->sh->sample : 1; /* the balancer's pre-pass */
     for (int y = y0; y <= y1; y++) {
+        if (y % sample) continue;
         for (int x = x0; x <= x1; x++) {
+            if (x % sample) continue;
             double dir[3];
             vw_segment s;
             rt_view_ray(v, x, y, dir);

@@ -94,6 +94,8 @@ typedef struct rt_shared {
     double eps;      /* minimum t of a secondary ray: avoids self-intersection */
     double bpad;     /* objects' bounds are widened by this before placement */
     void *device;    /* RTCDevice, one per process, shared by every cell */
+    int sample;      /* primary pixels: every sample-th row and column only (the load
+                        balancer's cheap pre-pass); 0 or 1 = every pixel */
     /* Output process only: */
     int64_t (*accum)[3];        /* width*height fixed-point sums */
     /* The counters below are written while every worker reads the fields above for
@@ -138,6 +140,46 @@ int64_t rt_job_primary_pixels(const rt_job *j);
 /* Thread-safe progress: eye rays ended so far (output process), rays created so far
    (this process). */
 void rt_job_progress(const rt_job *j, int64_t *pixels_done, int64_t *rays);
+/* The balancer's pre-pass: from the next commit on, cells generate eye rays for every
+   stride-th row and column only (1 = all). Takes effect when cells are (re)built. */
+void rt_job_set_sample(rt_job *j, int stride);
+/* Forget the last run's image and measurements, and recompute which cell owns each
+   pixel from the world's current decomposition (after the balancer changed it), so
+   the next run renders from scratch. The world's cells are rebuilt at the next commit. */
+vw_status rt_job_reset(rt_job *j);
+/* The overlay variant that tints each cell's pixels by the worker hosting it. */
+void rt_job_overlay_workers(const rt_job *j, uint8_t *out);
+/* ---- load balancing (apps/raytrace/balance.c) ---------------------------------------- */
+
+typedef struct rt_balance {
+    vw_balance_strategy strategy;
+    vw_map_kind map;          /* how balanced cells go onto workers */
+    const double *speeds;     /* per global worker, or NULL */
+    vw_load_spec load;        /* what a cell's load is */
+    int rounds;               /* pre-pass / balance rounds (>= 1) */
+    int stride;               /* the pre-pass traces every stride-th row and column */
+} rt_balance;
+
+typedef struct rt_balance_result {
+    vw_balance_report rep;    /* the first round's "before", the last round's prediction */
+    uint64_t migrated, bytes; /* over all rounds */
+    int rounds;
+    double prepass_s;
+} rt_balance_result;
+
+/* Single image: a cheap sparse pre-pass measures where the work lies, the balancer
+   builds the load field and moves the walls (repeated b->rounds times, each pre-pass
+   re-calibrating the field on the new layout); then the job is reset for the full
+   render (commit + run). Strategy none with map greedy/weighted maps by the measured
+   loads instead. Collective under MPI. */
+vw_status rt_job_balance(rt_job *j, const rt_balance *b, rt_balance_result *out, char *err,
+                         size_t errlen);
+/* Re-maps the cells (kind, loads or NULL, speeds or NULL) before or between runs. */
+vw_status rt_job_map(rt_job *j, vw_map_kind kind, const double *load, const double *speeds,
+                     char *err, size_t errlen);
+/* lambda of the deterministic work (ray-cell visits, RT_C_SEGMENTS) over workers. */
+double rt_job_work_imbalance(const rt_job *j, const double *speeds);
+
 /* After run, output process: the fixed-point sums (background of pixels that miss the
    world included), width*height*3, row-major from the top row. */
 const int64_t *rt_job_sums(const rt_job *j);

@@ -3,7 +3,9 @@
  * What is not declared in these headers is not the API. The topic headers:
  * common.h (status, boxes), decomp.h (cells and walls), module.h (writing a module),
  * world.h (the runtime), engine.h (MPI set-up and agreement between processes),
- * scene.h, image.h and gen.h (reading and generating scenes, writing images).
+ * scene.h, image.h and gen.h (reading and generating scenes, writing images),
+ * balance.h (load balancing by walls, frames, cell shape, division) and map.h (cells
+ * onto workers and processes).
  */
 #ifndef VWALLS_VWALLS_H
 #define VWALLS_VWALLS_H
@@ -16,5 +18,7 @@
 #include "vwalls/scene.h"
 #include "vwalls/image.h"
 #include "vwalls/gen.h"
+#include "vwalls/balance.h"
+#include "vwalls/map.h"
 
 #endif

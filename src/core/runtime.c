@@ -180,6 +180,13 @@ static void enqueue(vw_ctx *ctx, int slot, int dest, int cell, int kind, const v
                                          : (w->cfg.packet_bytes > stride ? w->cfg.packet_bytes : stride);
         p = wk->out[slot] = vw__packet_new(dest, wk->global, cap);
     }
+    if (dest != VW__OUTPUT) {
+        /* Traffic by destination class, for the mapping's locality figures. */
+        if (dest == wk->global) wk->tr_self_msgs++, wk->tr_self_bytes += stride;
+        int dp = vw__worker_process(w, dest);
+        wk->tr_proc[2 * dp]++;
+        wk->tr_proc[2 * dp + 1] += stride;
+    }
     vw__msg_header *h = (vw__msg_header *)(p->data + p->used);
     h->cell = cell;
     h->kind = (uint16_t)kind;

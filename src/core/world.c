@@ -171,7 +171,8 @@ vw_status vw_world_create(const vw_module *m, void *user, const vw_decomp *d, co
         atomic_init(&wk->outstanding, 0);
         wk->rng = w->cfg.stress_seed * 0x2545f4914f6cdd1dull + (uint64_t)wk->global + 1;
         wk->out = calloc((size_t)w->gworkers + 1, sizeof *wk->out);
-        if (!wk->out) st = VW_E_NOMEM;
+        wk->tr_proc = calloc(2 * (size_t)w->nprocs, sizeof *wk->tr_proc);
+        if (!wk->out || !wk->tr_proc) st = VW_E_NOMEM;
     }
     if (st == VW_OK) st = map_cells(w, c ? c->cell_worker : NULL);
     if (st != VW_OK) {
@@ -194,6 +195,7 @@ void vw_world_free(vw_world *w)
             if (wk->out)
                 for (int d = 0; d <= w->gworkers; d++) free(wk->out[d]);
             free(wk->out);
+            free(wk->tr_proc);
             free(wk->cells);
             while (wk->head) {
                 vw__packet *p = wk->head;
@@ -474,6 +476,8 @@ void vw_world_reset_stats(vw_world *w)
         wk->busy_s = 0;
         wk->msgs_sent = wk->bytes_sent = wk->packets_sent = 0;
         wk->msgs_remote = wk->bytes_remote = 0;
+        wk->tr_self_msgs = wk->tr_self_bytes = 0;
+        if (wk->tr_proc) memset(wk->tr_proc, 0, 2 * sizeof *wk->tr_proc * (size_t)w->nprocs);
     }
     memset(w->wstats, 0, sizeof *w->wstats * (size_t)w->gworkers);
 }

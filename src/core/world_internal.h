@@ -67,6 +67,11 @@ typedef struct vw__worker {
     double busy_s;
     uint64_t msgs_sent, bytes_sent, packets_sent;
     uint64_t msgs_remote, bytes_remote; /* to other processes */
+    /* Cell-to-cell traffic by destination, for the mapping's locality figures
+       (vw_world_traffic, src/map): messages and bytes to this same worker, and per
+       destination process [2p] messages, [2p+1] bytes (nprocs pairs). */
+    uint64_t tr_self_msgs, tr_self_bytes;
+    uint64_t *tr_proc;
     vw_status build_status;
 } vw__worker;
 

@@ -1,0 +1,80 @@
+/* vwalls/map.h - mapping cells onto workers and processes (the paper's "mapping"):
+ * which worker thread of which process hosts each cell.
+ *
+ * A mapping is a table cell -> global worker (process * workers_per_process + local
+ * worker), the form vw_config.cell_worker and vw_world_redecompose take. Invariant of
+ * every mapper: each cell is mapped exactly once, to a worker in [0, gworkers).
+ */
+#ifndef VWALLS_MAP_H
+#define VWALLS_MAP_H
+
+#include "vwalls/common.h"
+#include "vwalls/decomp.h"
+#include "vwalls/world.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef enum vw_map_kind {
+    VW_MAP_BLOCK = 0, /* contiguous blocks of the cell grid per process, then per worker */
+    VW_MAP_GREEDY,    /* by load, longest first, neighbours together where loads allow */
+    VW_MAP_WEIGHTED   /* like greedy, load in proportion to each worker's speed */
+} vw_map_kind;
+
+VW_API const char *vw_map_kind_name(vw_map_kind k);
+VW_API vw_status vw_map_kind_parse(const char *s, vw_map_kind *out);
+
+/* Factor n into dims[0]*dims[1]*dims[2] matched to the cell grid cells[3] (as
+   MPI_Dims_create does, but preferring factors that divide the cell counts and the
+   longest cell axes), so that each part is a compact block. */
+VW_API void vw_map_dims(int n, const int cells[3], int dims[3]);
+
+/* Block mapping: a grid decomposition is cut into nprocs blocks (process grid matched
+   to the cell grid) and each block into wpp worker blocks, so that most neighbour
+   traffic stays inside a worker, then inside a process. Non-grid decompositions are
+   mapped in kd-tree leaf order (cells close in the tree are close in space). */
+VW_API vw_status vw_map_block(const vw_decomp *d, int nprocs, int wpp, int *cell_worker);
+
+/* Greedy (over-decomposition): cells sorted by load, longest first, each to the worker
+   that finishes it first (load / speed); among workers within `slack` (relative) of the
+   best, one already hosting a face neighbour is preferred. speeds NULL = all equal. */
+VW_API vw_status vw_map_greedy(const vw_decomp *d, const double *cell_load, int gworkers,
+                               const double *speeds, double slack, int *cell_worker);
+
+/* Weighted (unequal workers): greedy with speeds and no neighbour preference beyond 2%:
+   each worker's load ends near its share speed / sum(speeds). */
+VW_API vw_status vw_map_weighted(const vw_decomp *d, const double *cell_load, int gworkers,
+                                 const double *speeds, int *cell_worker);
+
+/* One entry point for the command line: kind, loads (NULL: the cells' volumes ... 1 each). */
+VW_API vw_status vw_map_compute(vw_map_kind kind, const vw_decomp *d, const double *cell_load,
+                                int nprocs, int wpp, const double *speeds, int *cell_worker);
+
+/* "1,1,2,4" -> speeds (n entries, each > 0); VW_E_INVAL otherwise. */
+VW_API vw_status vw_map_parse_speeds(const char *s, double *speeds, int n);
+
+/* Re-maps the world's cells onto workers between runs (cells move with their objects
+   and are rebuilt on their new worker). Before the first commit nothing has been built,
+   so nothing counts as migrated. */
+VW_API vw_status vw_world_remap(vw_world *w, const int *cell_worker);
+
+/* Share of neighbour traffic that stayed inside the sending worker, inside its process
+   and inside its machine (messages and bytes, from the runtime's counters by
+   destination class) since the last vw_world_reset_stats. Collective under MPI. */
+typedef struct vw_traffic {
+    uint64_t msgs, bytes;                 /* cell-to-cell messages */
+    uint64_t msgs_worker, bytes_worker;   /* ... whose destination is the same worker */
+    uint64_t msgs_process, bytes_process; /* ... the same process */
+    uint64_t msgs_machine, bytes_machine; /* ... the same machine */
+} vw_traffic;
+VW_API vw_status vw_world_traffic(vw_world *w, vw_traffic *out);
+/* The machine of every process (machine_of[vw_world_processes()]): the lowest rank that
+   shares memory with it (MPI_Comm_split_type(MPI_COMM_TYPE_SHARED)); without MPI, 0.
+   Collective under MPI. */
+VW_API vw_status vw_world_machines(vw_world *w, int *machine_of);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

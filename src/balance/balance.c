@@ -1,0 +1,125 @@
+/* balance.c - the balancer's front: strategy names, dispatch to the tensor, rotation,
+ * staggered and division balancers, and applying a new decomposition and mapping to a
+ * world between runs (with the "does it pay" test and the stats it records).
+ */
+#include "balance/balance_internal.h"
+#include "core/world_internal.h"
+#include "vwalls/map.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+static const char *const names[] = {"none", "tensor", "rotate", "staggered", "divide", "duplicate"};
+
+const char *vw_balance_strategy_name(vw_balance_strategy s)
+{
+    return (unsigned)s < sizeof names / sizeof *names ? names[s] : "unknown";
+}
+
+vw_status vw_balance_strategy_parse(const char *s, vw_balance_strategy *out)
+{
+    if (!s || !out) return VW_E_INVAL;
+    for (unsigned i = 0; i < sizeof names / sizeof *names; i++)
+        if (!strcmp(s, names[i])) {
+            *out = (vw_balance_strategy)i;
+            return VW_OK;
+        }
+    return VW_E_INVAL;
+}
+
+void vw_balance_params_init(vw_balance_params *p)
+{
+    memset(p, 0, sizeof *p);
+    p->min_width = 1e-3;
+    p->tolerance = 0.03;
+}
+
+vw_status vw_balance_decompose(const vw_decomp *current, const vw_load_field *f,
+                               const vw_balance_params *p, vw_decomp **out, int *cell_worker)
+{
+    if (!out) return VW_E_INVAL;
+    *out = NULL;
+    if (!current || !f || !p) return VW_E_INVAL;
+    int dims[3];
+    if (p->dims[0] > 0 || p->dims[1] > 0 || p->dims[2] > 0)
+        for (int a = 0; a < 3; a++) dims[a] = p->dims[a] > 0 ? p->dims[a] : 1;
+    else
+        vw_decomp_dims(current, dims);
+    switch (p->strategy) {
+    case VW_BALANCE_NONE:
+    case VW_BALANCE_DUPLICATE: /* duplication keeps the walls (see vw_balance_world) */
+        return vw_decomp_clone(current, out);
+    case VW_BALANCE_TENSOR: return vw__balance_tensor(current, f, p, dims, out);
+    case VW_BALANCE_ROTATE: return vw__balance_rotate(current, f, p, dims, out);
+    case VW_BALANCE_STAGGERED: return vw__balance_staggered(current, f, p, dims, out);
+    case VW_BALANCE_DIVIDE: return vw__balance_divide(current, f, p, out, cell_worker);
+    }
+    return VW_E_INVAL;
+}
+
+vw_status vw_balance_world(vw_world *w, const vw_load_field *f, const vw_balance_params *p,
+                           const vw_balance_apply *a, vw_balance_report *rep)
+{
+    if (!w || !f || !p) return VW_E_INVAL;
+    double t0 = vw__now();
+    vw_balance_report r;
+    memset(&r, 0, sizeof r);
+    r.strategy = p->strategy;
+    vw_balance_params pp = *p;
+    if (pp.gworkers <= 0) pp.gworkers = w->gworkers;
+    const double *speeds = a && a->speeds ? a->speeds : p->speeds;
+    pp.speeds = speeds;
+
+    /* Before: the field's loads on the current layout and mapping (the field was made
+       from, or calibrated by, the last measurement, so these are the measured loads). */
+    double *load = malloc(sizeof(double) * VW_MAX_CELLS);
+    int *map = malloc(sizeof(int) * VW_MAX_CELLS);
+    vw_decomp *nd = NULL;
+    vw_status st = load && map ? VW_OK : VW_E_NOMEM;
+    if (st == VW_OK) {
+        vw_load_field_cell_loads(f, w->decomp, load);
+        r.imbalance_before = vw_balance_imbalance(load, w->cell_worker, w->ncells, w->gworkers, speeds);
+        st = vw_balance_decompose(w->decomp, f, &pp, &nd, map);
+    }
+    int nc = nd ? vw_decomp_cell_count(nd) : 0;
+    if (st == VW_OK) {
+        vw_load_field_cell_loads(f, nd, load);
+        if (p->strategy != VW_BALANCE_DIVIDE) {
+            vw_map_kind mk = a ? (vw_map_kind)a->map : VW_MAP_BLOCK;
+            st = vw_map_compute(mk, nd, load, w->nprocs, w->nworkers, speeds, map);
+        }
+    }
+    if (st == VW_OK) {
+        r.imbalance_predicted = vw_balance_imbalance(load, map, nc, w->gworkers, speeds);
+        r.cells = nc;
+        r.max_neighbours = vw_decomp_max_neighbours(nd);
+        /* Does it pay? The expected gain is the part of the last compute time the
+           better balance saves; the cost is what re-placing and rebuilding took. */
+        int pays = r.imbalance_predicted < r.imbalance_before;
+        if (pays && a && a->last_compute_s > 0) {
+            double gain = (1.0 - r.imbalance_predicted / r.imbalance_before) * a->last_compute_s;
+            pays = gain > a->rebuild_s;
+        }
+        if (pays) {
+            uint64_t before = w->migrated;
+            st = vw_world_redecompose(w, nd, map);
+            r.migrated_objects = w->migrated - before;
+            r.bytes_moved = r.migrated_objects * (uint64_t)w->m->object_size;
+            r.applied = st == VW_OK;
+        } else {
+            r.imbalance_predicted = r.imbalance_before;
+        }
+    }
+    vw_decomp_free(nd);
+    free(load);
+    free(map);
+    r.seconds = vw__now() - t0;
+    if (st == VW_OK) {
+        vw_world_set_balance_info(w, vw_balance_strategy_name(p->strategy), r.imbalance_before,
+                                  r.imbalance_predicted, r.migrated_objects);
+        vw_world_add_time(w, "balance", r.seconds);
+    }
+    if (rep) *rep = r;
+    return st;
+}

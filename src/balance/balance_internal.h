@@ -1,0 +1,47 @@
+/* balance_internal.h - what the balancers share: the load field's representation and
+ * the weighted-quantile cut that every wall-placing balancer uses.
+ */
+#ifndef VW_BALANCE_INTERNAL_H
+#define VW_BALANCE_INTERNAL_H
+
+#include "vwalls/balance.h"
+
+/* The load field: point masses in world coordinates. A measured cell load becomes k^3
+   points on a regular sub-grid of the cell, so "uniform inside the cell" is kept to
+   within 1/k of the cell's width, and rotated frames need no special case. */
+struct vw_load_field {
+    size_t n, cap;
+    double (*p)[3];
+    double *w;
+};
+
+/* A point of the field in some frame, as the balancers sort and cut them. */
+typedef struct vw__lpt {
+    double x[3]; /* frame coordinates */
+    double w;
+} vw__lpt;
+
+/* The field's points in the frame of d's frame matrix F (NULL = identity); *out is
+   malloc'ed (NULL when the field is empty); returns the count or -1 without memory. */
+long vw__field_points(const vw_load_field *f, const double *F, vw__lpt **out);
+
+/* Wall positions cutting pts[0..n) along axis into `parts` pieces of equal load, inside
+   [lo, hi], each piece at least minw wide, increasing. walls gets parts-1 values.
+   Reorders pts (sorted along axis). */
+void vw__cut(vw__lpt *pts, long n, int axis, double lo, double hi, int parts, double minw,
+             double *walls);
+
+/* Tensor walls in frame F over world box (frame coordinates) wb: walls[a] dims[a]-1. */
+vw_status vw__tensor_walls(const vw_load_field *f, const double *F, const vw_box *wb,
+                           const int dims[3], double minw_frac, double *walls[3]);
+
+vw_status vw__balance_tensor(const vw_decomp *cur, const vw_load_field *f,
+                             const vw_balance_params *p, const int dims[3], vw_decomp **out);
+vw_status vw__balance_rotate(const vw_decomp *cur, const vw_load_field *f,
+                             const vw_balance_params *p, const int dims[3], vw_decomp **out);
+vw_status vw__balance_staggered(const vw_decomp *cur, const vw_load_field *f,
+                                const vw_balance_params *p, const int dims[3], vw_decomp **out);
+vw_status vw__balance_divide(const vw_decomp *cur, const vw_load_field *f,
+                             const vw_balance_params *p, vw_decomp **out, int *cell_worker);
+
+#endif

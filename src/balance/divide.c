@@ -1,0 +1,91 @@
+/* divide.c - cell division: an overloaded cell is split (extra kd-tree splits below its
+ * leaf) and the pieces go to underloaded workers. The walls of the rest of the
+ * decomposition stay where they are, so only the divided cell's objects move.
+ *
+ * Loop: map the cells onto the workers longest-processing-time first; while the
+ * predicted imbalance exceeds the tolerance, split the heaviest cell in two at the
+ * median of its load along its longest side. Bounded by max_extra splits.
+ */
+#include "balance/balance_internal.h"
+#include "vwalls/map.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+vw_status vw__balance_divide(const vw_decomp *cur, const vw_load_field *f,
+                             const vw_balance_params *p, vw_decomp **out, int *cell_worker)
+{
+    int nn0;
+    const vw_kd_node *n0 = vw_decomp_nodes(cur, &nn0);
+    int nc = vw_decomp_cell_count(cur);
+    int gw = p->gworkers > 0 ? p->gworkers : nc;
+    int max_extra = p->max_extra > 0 ? p->max_extra : 4 * gw;
+    if (nc + max_extra > VW_MAX_CELLS) max_extra = VW_MAX_CELLS - nc;
+    int cap_nodes = nn0 + 2 * max_extra, cap_cells = nc + max_extra;
+    vw_kd_node *nodes = malloc(sizeof *nodes * (size_t)cap_nodes);
+    double *load = calloc((size_t)cap_cells, sizeof *load);
+    int *map = malloc(sizeof(int) * (size_t)cap_cells);
+    vw__lpt *pts = NULL;
+    long npts = vw__field_points(f, NULL, &pts); /* world coordinates */
+    vw__lpt *tmp = malloc(sizeof *tmp * (size_t)(npts > 0 ? npts : 1));
+    vw_decomp *d = NULL;
+    vw_status st = (!nodes || !load || !map || npts < 0 || !tmp) ? VW_E_NOMEM : VW_OK;
+    if (st == VW_OK) {
+        memcpy(nodes, n0, sizeof *nodes * (size_t)nn0);
+        st = vw_decomp_clone(cur, &d);
+    }
+    int nn = nn0, extra = 0;
+    const double *F = vw_decomp_frame(cur);
+    vw_box wb = vw_decomp_world(cur);
+    while (st == VW_OK) {
+        vw_load_field_cell_loads(f, d, load);
+        st = vw_map_greedy(d, load, gw, p->speeds, 0.0, map);
+        if (st != VW_OK) break;
+        double lam = vw_balance_imbalance(load, map, nc, gw, p->speeds);
+        if (lam <= 1.0 + p->tolerance || extra >= max_extra) break;
+        int heavy = 0;
+        for (int c = 1; c < nc; c++)
+            if (load[c] > load[heavy]) heavy = c;
+        /* The heaviest cell's points, in its frame, and its longest side. */
+        vw_box b = vw_decomp_cell_box(d, heavy);
+        long m = 0;
+        for (long i = 0; i < npts; i++)
+            if (vw_decomp_locate(d, pts[i].x, NULL) == heavy) {
+                tmp[m] = pts[i];
+                if (F)
+                    for (int a = 0; a < 3; a++)
+                        tmp[m].x[a] = F[3 * a] * pts[i].x[0] + F[3 * a + 1] * pts[i].x[1] +
+                                      F[3 * a + 2] * pts[i].x[2];
+                m++;
+            }
+        int axis = 0;
+        for (int a = 1; a < 3; a++)
+            if (b.hi[a] - b.lo[a] > b.hi[axis] - b.lo[axis]) axis = a;
+        double split;
+        vw__cut(tmp, m, axis, b.lo[axis], b.hi[axis], 2,
+                p->min_width * (wb.hi[axis] - wb.lo[axis]), &split);
+        if (!(split > b.lo[axis] && split < b.hi[axis])) break; /* too thin to divide */
+        /* The leaf becomes a wall with the old cell on its low side, a new cell above. */
+        int leaf = -1;
+        for (int i = 0; i < nn; i++)
+            if (nodes[i].axis < 0 && nodes[i].cell == heavy) leaf = i;
+        nodes[nn] = (vw_kd_node){-1, 0, -1, -1, heavy};
+        nodes[nn + 1] = (vw_kd_node){-1, 0, -1, -1, nc};
+        nodes[leaf] = (vw_kd_node){axis, split, nn, nn + 1, -1};
+        nn += 2;
+        nc++;
+        extra++;
+        vw_decomp *nd;
+        st = vw_decomp_create_kd(&wb, nodes, nn, F, VW_DECOMP_DIVIDED, &nd);
+        if (st != VW_OK) break;
+        vw_decomp_free(d);
+        d = nd;
+    }
+    if (st == VW_OK && cell_worker) memcpy(cell_worker, map, sizeof(int) * (size_t)nc);
+    if (st == VW_OK)
+        *out = d;
+    else
+        vw_decomp_free(d);
+    free(nodes), free(load), free(map), free(pts), free(tmp);
+    return st;
+}

@@ -1,0 +1,192 @@
+/* tensor.c - the tensor balancer (the paper's "division by hyperplanes in all
+ * dimensions", walls moved as whole hyperplanes) and frame rotation ("rotating the
+ * scene": the principal axis of the load made axis-parallel, then tensor).
+ *
+ * Tensor keeps a grid a grid: every cell keeps exactly one neighbour per face, because
+ * a wall is moved as a whole. Per axis, the walls go where the marginal load (the load
+ * projected onto that axis) splits into equal slabs; load that is concentrated in one
+ * corner therefore cannot be evened out per cell, which is what rotation and the
+ * staggered balancer improve on.
+ */
+#include "balance/balance_internal.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+vw_status vw__tensor_walls(const vw_load_field *f, const double *F, const vw_box *wb,
+                           const int dims[3], double minw_frac, double *walls[3])
+{
+    vw__lpt *pts;
+    long n = vw__field_points(f, F, &pts);
+    if (n < 0) return VW_E_NOMEM;
+    for (int a = 0; a < 3; a++) {
+        if (dims[a] < 2) continue;
+        double ext = wb->hi[a] - wb->lo[a];
+        vw__cut(pts, n, a, wb->lo[a], wb->hi[a], dims[a], minw_frac * ext, walls[a]);
+    }
+    free(pts);
+    return VW_OK;
+}
+
+static vw_status tensor_in_frame(const vw_load_field *f, const double *F, const vw_box *wb,
+                                 const int dims[3], double minw, vw_decomp **out)
+{
+    double *walls[3] = {0};
+    vw_status st = VW_OK;
+    for (int a = 0; a < 3 && st == VW_OK; a++) {
+        walls[a] = malloc(sizeof(double) * (size_t)(dims[a] > 1 ? dims[a] - 1 : 1));
+        if (!walls[a]) st = VW_E_NOMEM;
+    }
+    if (st == VW_OK) st = vw__tensor_walls(f, F, wb, dims, minw, walls);
+    if (st == VW_OK) {
+        const double *cw[3] = {walls[0], walls[1], walls[2]};
+        st = vw_decomp_create_grid_walls(wb, dims, cw, F, out);
+    }
+    for (int a = 0; a < 3; a++) free(walls[a]);
+    return st;
+}
+
+/* The world box in world coordinates' corners, as points (frame -> world: p = F^T q). */
+static void world_corners(const vw_decomp *cur, double P[8][3])
+{
+    vw_box b = vw_decomp_world(cur);
+    const double *F = vw_decomp_frame(cur);
+    for (int i = 0; i < 8; i++) {
+        double q[3] = {(i & 1) ? b.hi[0] : b.lo[0], (i & 2) ? b.hi[1] : b.lo[1],
+                       (i & 4) ? b.hi[2] : b.lo[2]};
+        for (int a = 0; a < 3; a++)
+            P[i][a] = F ? F[0 * 3 + a] * q[0] + F[1 * 3 + a] * q[1] + F[2 * 3 + a] * q[2] : q[a];
+    }
+}
+
+vw_status vw__balance_tensor(const vw_decomp *cur, const vw_load_field *f,
+                             const vw_balance_params *p, const int dims[3], vw_decomp **out)
+{
+    vw_box wb = vw_decomp_world(cur);
+    return tensor_in_frame(f, vw_decomp_frame(cur), &wb, dims, p->min_width, out);
+}
+
+/* Eigen-decomposition of a symmetric 3x3 matrix by Jacobi rotations: columns of V are
+   the eigenvectors, ev the eigenvalues. */
+static void jacobi3(double A[3][3], double V[3][3], double ev[3])
+{
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++) V[i][j] = i == j;
+    for (int sweep = 0; sweep < 50; sweep++) {
+        double off = fabs(A[0][1]) + fabs(A[0][2]) + fabs(A[1][2]);
+        if (off < 1e-300) break;
+        for (int p = 0; p < 2; p++)
+            for (int q = p + 1; q < 3; q++) {
+                if (fabs(A[p][q]) < 1e-300) continue;
+                double th = 0.5 * (A[q][q] - A[p][p]) / A[p][q];
+                double t = (th >= 0 ? 1.0 : -1.0) / (fabs(th) + sqrt(th * th + 1.0));
+                double c = 1.0 / sqrt(t * t + 1.0), s = t * c;
+                for (int k = 0; k < 3; k++) {
+                    double akp = A[k][p], akq = A[k][q];
+                    A[k][p] = c * akp - s * akq;
+                    A[k][q] = s * akp + c * akq;
+                }
+                for (int k = 0; k < 3; k++) {
+                    double apk = A[p][k], aqk = A[q][k];
+                    A[p][k] = c * apk - s * aqk;
+                    A[q][k] = s * apk + c * aqk;
+                }
+                for (int k = 0; k < 3; k++) {
+                    double vkp = V[k][p], vkq = V[k][q];
+                    V[k][p] = c * vkp - s * vkq;
+                    V[k][q] = s * vkp + c * vkq;
+                }
+            }
+    }
+    for (int i = 0; i < 3; i++) ev[i] = A[i][i];
+}
+
+vw_status vw__balance_rotate(const vw_decomp *cur, const vw_load_field *f,
+                             const vw_balance_params *p, const int dims[3], vw_decomp **out)
+{
+    /* 1. Load-weighted centre of gravity of every cell of the current decomposition. */
+    int nc = vw_decomp_cell_count(cur);
+    double(*cg)[4] = calloc((size_t)nc, sizeof *cg);
+    if (!cg) return VW_E_NOMEM;
+    for (size_t i = 0; i < f->n; i++) {
+        int c = vw_decomp_locate(cur, f->p[i], NULL);
+        if (c < 0) continue;
+        for (int a = 0; a < 3; a++) cg[c][a] += f->w[i] * f->p[i][a];
+        cg[c][3] += f->w[i];
+    }
+    /* 2. Weighted straight-line fit through the centres: the principal axis of their
+       weighted scatter matrix. With one loaded cell (nothing to fit) use the field's
+       points themselves. */
+    int loaded = 0;
+    for (int c = 0; c < nc; c++) loaded += cg[c][3] > 0;
+    double m[3] = {0, 0, 0}, W = 0, S[3][3] = {{0}};
+    if (loaded >= 3) {
+        for (int c = 0; c < nc; c++)
+            if (cg[c][3] > 0) {
+                for (int a = 0; a < 3; a++) m[a] += cg[c][a];
+                W += cg[c][3];
+            }
+        for (int a = 0; a < 3; a++) m[a] /= W;
+        for (int c = 0; c < nc; c++) {
+            if (!(cg[c][3] > 0)) continue;
+            double d[3];
+            for (int a = 0; a < 3; a++) d[a] = cg[c][a] / cg[c][3] - m[a];
+            for (int a = 0; a < 3; a++)
+                for (int b = 0; b < 3; b++) S[a][b] += cg[c][3] * d[a] * d[b];
+        }
+    } else {
+        for (size_t i = 0; i < f->n; i++) {
+            for (int a = 0; a < 3; a++) m[a] += f->w[i] * f->p[i][a];
+            W += f->w[i];
+        }
+        if (W > 0)
+            for (int a = 0; a < 3; a++) m[a] /= W;
+        for (size_t i = 0; i < f->n; i++)
+            for (int a = 0; a < 3; a++)
+                for (int b = 0; b < 3; b++)
+                    S[a][b] += f->w[i] * (f->p[i][a] - m[a]) * (f->p[i][b] - m[b]);
+    }
+    free(cg);
+    double V[3][3], ev[3];
+    jacobi3(S, V, ev);
+    /* 3. The frame: the principal axis becomes the axis with the most cells, the second
+       axis the next, so the long direction of the load gets the most walls. */
+    int order[3] = {0, 1, 2}; /* eigenvectors by decreasing eigenvalue */
+    for (int i = 0; i < 3; i++)
+        for (int j = i + 1; j < 3; j++)
+            if (ev[order[j]] > ev[order[i]]) {
+                int t = order[i];
+                order[i] = order[j];
+                order[j] = t;
+            }
+    int axes[3] = {0, 1, 2}; /* frame axes by decreasing cell count (stable) */
+    for (int i = 0; i < 3; i++)
+        for (int j = i + 1; j < 3; j++)
+            if (dims[axes[j]] > dims[axes[i]]) {
+                int t = axes[i];
+                axes[i] = axes[j];
+                axes[j] = t;
+            }
+    double F[9];
+    for (int i = 0; i < 3; i++)
+        for (int k = 0; k < 3; k++) F[3 * axes[i] + k] = V[k][order[i]];
+    /* 4. The world box in the new frame: bounds of the rotated old world box. */
+    double P[8][3];
+    world_corners(cur, P);
+    vw_box wb;
+    for (int a = 0; a < 3; a++) wb.lo[a] = INFINITY, wb.hi[a] = -INFINITY;
+    for (int i = 0; i < 8; i++)
+        for (int a = 0; a < 3; a++) {
+            double q = F[3 * a] * P[i][0] + F[3 * a + 1] * P[i][1] + F[3 * a + 2] * P[i][2];
+            wb.lo[a] = fmin(wb.lo[a], q);
+            wb.hi[a] = fmax(wb.hi[a], q);
+        }
+    /* A hair of padding: rounding in the rotation must not push a corner outside. */
+    for (int a = 0; a < 3; a++) {
+        double pad = 1e-9 * (wb.hi[a] - wb.lo[a]);
+        wb.lo[a] -= pad;
+        wb.hi[a] += pad;
+    }
+    return tensor_in_frame(f, F, &wb, dims, p->min_width, out);
+}

@@ -1,0 +1,232 @@
+/* map.c - the mapping of cells onto workers and processes: block (compact blocks of the
+ * cell grid, so neighbour traffic stays inside a worker, then a process), greedy (over-
+ * decomposition: longest processing time first, neighbours kept together where the
+ * loads allow) and weighted (unequal workers get load in proportion to their speed).
+ *
+ * Every mapper maps each cell exactly once, to a worker in [0, gworkers); a global
+ * worker is process * workers_per_process + local worker, as in vw_config.cell_worker.
+ */
+#include "core/world_internal.h"
+#include "vwalls/map.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+const char *vw_map_kind_name(vw_map_kind k)
+{
+    switch (k) {
+    case VW_MAP_BLOCK: return "block";
+    case VW_MAP_GREEDY: return "greedy";
+    case VW_MAP_WEIGHTED: return "weighted";
+    }
+    return "unknown";
+}
+
+vw_status vw_map_kind_parse(const char *s, vw_map_kind *out)
+{
+    if (!s || !out) return VW_E_INVAL;
+    for (int k = VW_MAP_BLOCK; k <= VW_MAP_WEIGHTED; k++)
+        if (!strcmp(s, vw_map_kind_name((vw_map_kind)k))) {
+            *out = (vw_map_kind)k;
+            return VW_OK;
+        }
+    return VW_E_INVAL;
+}
+
+vw_status vw_map_parse_speeds(const char *s, double *speeds, int n)
+{
+    if (!s || !speeds || n < 1) return VW_E_INVAL;
+    int k = 0;
+    const char *q = s;
+    while (*q) {
+        char *end;
+        double v = strtod(q, &end);
+        if (end == q || !(v > 0) || !isfinite(v) || k >= n) return VW_E_INVAL;
+        speeds[k++] = v;
+        if (*end == ',') end++;
+        else if (*end) return VW_E_INVAL;
+        q = end;
+    }
+    return k == n ? VW_OK : VW_E_INVAL;
+}
+
+/* ---- block ------------------------------------------------------------------------------ */
+
+void vw_map_dims(int n, const int cells[3], int dims[3])
+{
+    /* Every factorisation n = a*b*c is scored: parts larger than the cell count leave
+       blocks empty (never, if avoidable), uneven blocks cost balance, and every cut
+       costs the faces it crosses (the neighbour traffic that leaves a block). */
+    double best = INFINITY;
+    dims[0] = n, dims[1] = dims[2] = 1;
+    for (int a = 1; a <= n; a++) {
+        if (n % a) continue;
+        for (int b = 1; b <= n / a; b++) {
+            if ((n / a) % b) continue;
+            int c = n / a / b, d[3] = {a, b, c};
+            double score = 0;
+            for (int x = 0; x < 3; x++) {
+                int cx = cells[x] > 0 ? cells[x] : 1;
+                if (d[x] > cx) score += 1e12;
+                else if (cx % d[x]) score += 1e6;
+                double faces = 1;
+                for (int y = 0; y < 3; y++)
+                    if (y != x) faces *= cells[y] > 0 ? cells[y] : 1;
+                score += (d[x] - 1) * faces;
+            }
+            if (score < best) {
+                best = score;
+                memcpy(dims, d, sizeof d);
+            }
+        }
+    }
+}
+
+/* Leaves of the kd-tree in depth-first order: neighbours in space are near in it. */
+static void leaf_order(const vw_kd_node *nodes, int node, int *order, int *k)
+{
+    if (nodes[node].axis < 0) {
+        order[(*k)++] = nodes[node].cell;
+        return;
+    }
+    leaf_order(nodes, nodes[node].left, order, k);
+    leaf_order(nodes, nodes[node].right, order, k);
+}
+
+vw_status vw_map_block(const vw_decomp *d, int nprocs, int wpp, int *cell_worker)
+{
+    if (!d || nprocs < 1 || wpp < 1 || !cell_worker) return VW_E_INVAL;
+    int nc = vw_decomp_cell_count(d);
+    if (vw_decomp_get_kind(d) != VW_DECOMP_GRID) {
+        int nn, k = 0;
+        const vw_kd_node *nodes = vw_decomp_nodes(d, &nn);
+        int *order = malloc(sizeof(int) * (size_t)nc);
+        if (!order) return VW_E_NOMEM;
+        leaf_order(nodes, 0, order, &k);
+        long g = (long)nprocs * wpp;
+        for (int i = 0; i < nc; i++) cell_worker[order[i]] = (int)((long)i * g / nc);
+        free(order);
+        return VW_OK;
+    }
+    int cells[3], pd[3];
+    vw_decomp_dims(d, cells);
+    vw_map_dims(nprocs, cells, pd);
+    for (int c = 0; c < nc; c++) {
+        int ix[3] = {c % cells[0], (c / cells[0]) % cells[1], c / (cells[0] * cells[1])};
+        int pb[3], lo[3], hi[3], sub[3], wd[3], wb[3];
+        for (int a = 0; a < 3; a++) {
+            /* The process block holding index ix[a], and that block's extent. */
+            pb[a] = (int)((long)ix[a] * pd[a] / cells[a]);
+            lo[a] = (int)(((long)pb[a] * cells[a] + pd[a] - 1) / pd[a]);
+            hi[a] = (int)(((long)(pb[a] + 1) * cells[a] + pd[a] - 1) / pd[a]);
+            sub[a] = hi[a] - lo[a];
+        }
+        vw_map_dims(wpp, sub, wd);
+        for (int a = 0; a < 3; a++) wb[a] = (int)((long)(ix[a] - lo[a]) * wd[a] / (sub[a] ? sub[a] : 1));
+        int proc = pb[0] + pd[0] * (pb[1] + pd[1] * pb[2]);
+        int local = wb[0] + wd[0] * (wb[1] + wd[1] * wb[2]);
+        cell_worker[c] = proc * wpp + local;
+    }
+    return VW_OK;
+}
+
+/* ---- greedy and weighted ----------------------------------------------------------------- */
+
+static const double *sort_load;
+static int cmp_load_desc(const void *a, const void *b)
+{
+    int x = *(const int *)a, y = *(const int *)b;
+    if (sort_load[x] != sort_load[y]) return sort_load[x] > sort_load[y] ? -1 : 1;
+    return x - y; /* ties by id: every process computes the same mapping */
+}
+
+vw_status vw_map_greedy(const vw_decomp *d, const double *cell_load, int gworkers,
+                        const double *speeds, double slack, int *cell_worker)
+{
+    if (!d || gworkers < 1 || !cell_worker) return VW_E_INVAL;
+    int nc = vw_decomp_cell_count(d);
+    int *order = malloc(sizeof(int) * (size_t)nc);
+    double *ones = NULL, *t = calloc((size_t)gworkers, sizeof *t);
+    if (!cell_load) {
+        ones = malloc(sizeof(double) * (size_t)nc);
+        if (ones)
+            for (int c = 0; c < nc; c++) ones[c] = 1.0;
+        cell_load = ones;
+    }
+    if (!order || !t || !cell_load) {
+        free(order), free(t), free(ones);
+        return VW_E_NOMEM;
+    }
+    for (int c = 0; c < nc; c++) {
+        order[c] = c;
+        cell_worker[c] = -1;
+    }
+    sort_load = cell_load;
+    qsort(order, (size_t)nc, sizeof *order, cmp_load_desc);
+    int nb[64];
+    for (int i = 0; i < nc; i++) {
+        int c = order[i];
+        double l = cell_load[c] > 0 ? cell_load[c] : 0;
+        /* Longest processing time first: the worker that would finish this cell first. */
+        double best = INFINITY;
+        for (int g = 0; g < gworkers; g++) {
+            double f = (t[g] + l) / (speeds ? speeds[g] : 1.0);
+            if (f < best) best = f;
+        }
+        /* Among workers nearly as good, the one hosting most of the cell's neighbours. */
+        int pick = -1, pick_nb = -1;
+        double pick_f = INFINITY;
+        for (int g = 0; g < gworkers; g++) {
+            double f = (t[g] + l) / (speeds ? speeds[g] : 1.0);
+            if (f > best * (1.0 + slack) + 1e-300) continue;
+            int cnt = 0;
+            if (slack > 0)
+                for (int face = 0; face < 6; face++) {
+                    int n = vw_decomp_neighbours(d, c, face, nb, 64);
+                    for (int k = 0; k < n && k < 64; k++) cnt += cell_worker[nb[k]] == g;
+                }
+            if (cnt > pick_nb || (cnt == pick_nb && f < pick_f)) {
+                pick = g;
+                pick_nb = cnt;
+                pick_f = f;
+            }
+        }
+        cell_worker[c] = pick;
+        t[pick] += l;
+    }
+    free(order), free(t), free(ones);
+    return VW_OK;
+}
+
+vw_status vw_map_weighted(const vw_decomp *d, const double *cell_load, int gworkers,
+                          const double *speeds, int *cell_worker)
+{
+    return vw_map_greedy(d, cell_load, gworkers, speeds, 0.02, cell_worker);
+}
+
+vw_status vw_map_compute(vw_map_kind kind, const vw_decomp *d, const double *cell_load,
+                         int nprocs, int wpp, const double *speeds, int *cell_worker)
+{
+    switch (kind) {
+    case VW_MAP_BLOCK: return vw_map_block(d, nprocs, wpp, cell_worker);
+    case VW_MAP_GREEDY: return vw_map_greedy(d, cell_load, nprocs * wpp, speeds, 0.05, cell_worker);
+    case VW_MAP_WEIGHTED: return vw_map_weighted(d, cell_load, nprocs * wpp, speeds, cell_worker);
+    }
+    return VW_E_INVAL;
+}
+
+/* ---- applying a mapping --------------------------------------------------------------- */
+
+vw_status vw_world_remap(vw_world *w, const int *cell_worker)
+{
+    if (!w || !cell_worker) return VW_E_INVAL;
+    int built = 0;
+    for (int c = 0; c < w->ncells; c++) built |= w->cells[c].built;
+    uint64_t before = w->migrated;
+    vw_status st = vw_world_redecompose(w, w->decomp, cell_worker);
+    /* Before anything was built no object has really been anywhere yet. */
+    if (!built) w->migrated = before;
+    return st;
+}

@@ -1,0 +1,41 @@
+# balance.cmake - tests of the load balancers (src/balance) and the mappers (src/map):
+# images bit-identical with every strategy and mapping, objects conserved by migration,
+# staggered reaching lambda <= 1.10 on deterministic work, rotation following the load,
+# and the mapping invariants. Deterministic work counts only: no timings are asserted.
+
+add_executable(vw_test_balance ${PROJECT_SOURCE_DIR}/tests/balance/bal_test.c)
+target_link_libraries(vw_test_balance PRIVATE vwalls_apps)
+
+set(VW_BAL_TSAN "TSAN_OPTIONS=suppressions=${PROJECT_SOURCE_DIR}/tests/raytrace/tsan.supp")
+add_test(NAME balance_identical_spheres COMMAND vw_test_balance identical spheres:0.5:2 48x48)
+add_test(NAME balance_identical_mixed
+         COMMAND vw_test_balance identical ${PROJECT_SOURCE_DIR}/tests/raytrace/mixed.nff 48x48)
+add_test(NAME balance_conserve COMMAND vw_test_balance conserve)
+add_test(NAME balance_staggered8 COMMAND vw_test_balance staggered8)
+add_test(NAME balance_rotate COMMAND vw_test_balance rotate)
+add_test(NAME balance_map COMMAND vw_test_balance map)
+set_tests_properties(balance_identical_spheres balance_identical_mixed balance_conserve
+  balance_staggered8 balance_rotate balance_map PROPERTIES LABELS "balance;threads"
+  ENVIRONMENT "${VW_BAL_TSAN}")
+
+# The command line: PNG bytes equal for every --balance and --map, under the threads
+# engine and (when the build has MPI) under mpirun -np 2.
+# (This file is included before mpi.cmake, so it finds the launcher flags itself.)
+set(_vw_bal_mpi "")
+if(VW_HAVE_MPI AND MPIEXEC_EXECUTABLE)
+  set(_vw_bal_pre ${MPIEXEC_PREFLAGS})
+  execute_process(COMMAND ${MPIEXEC_EXECUTABLE} --version OUTPUT_VARIABLE _vw_bal_ver ERROR_QUIET)
+  if(_vw_bal_ver MATCHES "Open MPI|OpenRTE")
+    list(APPEND _vw_bal_pre --oversubscribe)
+  endif()
+  string(REPLACE ";" "|" _vw_bal_pre "${_vw_bal_pre}")
+  set(_vw_bal_mpi -DMPIRUN=${MPIEXEC_EXECUTABLE} -DNPFLAG=${MPIEXEC_NUMPROC_FLAG}
+      "-DPREFLAGS=${_vw_bal_pre}")
+endif()
+add_test(NAME balance_cli
+  COMMAND ${CMAKE_COMMAND} -DVWALLS=$<TARGET_FILE:vwalls_tool>
+          -DSCENE=${PROJECT_SOURCE_DIR}/tests/raytrace/mixed.nff
+          -DWORK=${CMAKE_CURRENT_BINARY_DIR}/balance_cli ${_vw_bal_mpi}
+          -P ${PROJECT_SOURCE_DIR}/tests/balance/cli.cmake)
+set_tests_properties(balance_cli PROPERTIES LABELS "balance" TIMEOUT 300 PROCESSORS 2
+  ENVIRONMENT "OMPI_ALLOW_RUN_AS_ROOT=1;OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1;${VW_BAL_TSAN}")

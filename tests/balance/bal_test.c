@@ -1,0 +1,488 @@
+/* bal_test.c - tests of the load balancers and the mappers, one executable, one test per
+ * subcommand (registered in tests/balance.cmake):
+ *   identical SCENE WxH   every strategy (and mapping) renders the same fixed-point sums
+ *                         as one cell on one worker
+ *   conserve              migration keeps every object in exactly the cells its bounds
+ *                         overlap (ids, counts and checksums) through a chain of balancers
+ *   staggered8            staggered reaches lambda <= 1.10 on the counted work of a
+ *                         50%-clustered 1000-sphere scene with 8 cells
+ *   rotate                the principal-axis frame of an oblique line of load is the line
+ *   map                   every cell mapped once; block keeps a hand layout's neighbour
+ *                         share; weighted gives speeds 1,1,2,4 proportional load
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "raytrace/raytrace.h"
+#include "vwalls/gen.h"
+#include "vwalls/vwalls.h"
+
+static int failures;
+
+#define CHECK(cond, ...)                                                             \
+    do {                                                                             \
+        if (!(cond)) {                                                               \
+            fprintf(stderr, "%s:%d: check failed: %s: ", __FILE__, __LINE__, #cond); \
+            fprintf(stderr, __VA_ARGS__);                                            \
+            fputc('\n', stderr);                                                     \
+            failures++;                                                              \
+        }                                                                            \
+    } while (0)
+
+static vw_scene *load_scene(const char *spec)
+{
+    char err[512];
+    vw_scene *s = NULL;
+    if (!strncmp(spec, "spheres:", 8)) { /* spheres:CLUSTER:SEED */
+        vw_gen_params p;
+        vw_gen_params_init(&p);
+        p.count = 1000;
+        p.cluster = atof(spec + 8);
+        const char *c = strchr(spec + 8, ':');
+        p.seed = c ? (uint64_t)atoll(c + 1) : 1;
+        if (vw_gen("spheres", &p, &s, err, sizeof err) != VW_OK) {
+            fprintf(stderr, "gen %s: %s\n", spec, err);
+            exit(1);
+        }
+    } else if (!strncmp(spec, "gen:", 4)) {
+        vw_gen_params p;
+        vw_gen_params_init(&p);
+        p.size = 2;
+        if (vw_gen(spec + 4, &p, &s, err, sizeof err) != VW_OK) {
+            fprintf(stderr, "gen %s: %s\n", spec, err);
+            exit(1);
+        }
+    } else if (vw_scene_read_file(spec, &s, err, sizeof err) != VW_OK) {
+        fprintf(stderr, "%s\n", err);
+        exit(1);
+    }
+    return s;
+}
+
+/* One render, optionally balanced; returns the sums (malloc'ed) and keeps the job. */
+static int64_t *render(const vw_scene *s, int w, int h, const int dims[3], int workers,
+                       const rt_balance *b, rt_job **keep)
+{
+    rt_params p;
+    memset(&p, 0, sizeof p);
+    p.width = w;
+    p.height = h;
+    memcpy(p.dims, dims, sizeof p.dims);
+    p.workers = workers;
+    char err[512] = "";
+    rt_job *j;
+    if (rt_job_create(s, &p, &j, err, sizeof err) != VW_OK) {
+        fprintf(stderr, "create: %s\n", err);
+        exit(1);
+    }
+    rt_balance_result res;
+    if (b && rt_job_balance(j, b, &res, err, sizeof err) != VW_OK) {
+        fprintf(stderr, "balance: %s\n", err);
+        exit(1);
+    }
+    if (rt_job_commit(j, err, sizeof err) || rt_job_run(j, err, sizeof err)) {
+        fprintf(stderr, "render failed: %s\n", err);
+        exit(1);
+    }
+    size_t n = (size_t)w * h * 3;
+    int64_t *sums = malloc(n * sizeof *sums);
+    memcpy(sums, rt_job_sums(j), n * sizeof *sums);
+    if (keep)
+        *keep = j;
+    else
+        rt_job_free(j);
+    return sums;
+}
+
+static void balance_spec(rt_balance *b, vw_balance_strategy s)
+{
+    memset(b, 0, sizeof *b);
+    b->strategy = s;
+    b->map = VW_MAP_BLOCK;
+    vw_load_spec_init(&b->load);
+    b->load.model = VW_LOAD_COUNTER; /* deterministic: the same walls on every run */
+    b->load.counter = RT_C_SEGMENTS;
+    b->rounds = 2;
+    b->stride = 4;
+}
+
+/* ---- identical ----------------------------------------------------------------------- */
+
+static int t_identical(const char *spec, const char *size)
+{
+    vw_scene *s = load_scene(spec);
+    int w = 64, h = 64;
+    if (size) sscanf(size, "%dx%d", &w, &h);
+    int one[3] = {1, 1, 1};
+    int64_t *ref = render(s, w, h, one, 1, NULL, NULL);
+    size_t n = (size_t)w * h * 3;
+    static const vw_balance_strategy strat[] = {VW_BALANCE_NONE, VW_BALANCE_TENSOR,
+                                                VW_BALANCE_ROTATE, VW_BALANCE_STAGGERED,
+                                                VW_BALANCE_DIVIDE};
+    static const int layouts[][3] = {{2, 2, 2}, {2, 4, 1}, {4, 4, 4}};
+    static const vw_map_kind maps[] = {VW_MAP_BLOCK, VW_MAP_GREEDY, VW_MAP_WEIGHTED};
+    double speeds[3] = {1, 2, 1};
+    int k = 0;
+    for (size_t si = 0; si < sizeof strat / sizeof *strat; si++)
+        for (size_t li = 0; li < sizeof layouts / sizeof *layouts; li++) {
+            int workers = 1 + (int)((si + li) % 3);
+            rt_balance b;
+            balance_spec(&b, strat[si]);
+            b.map = maps[k++ % 3];
+            if (b.map == VW_MAP_WEIGHTED) b.speeds = speeds;
+            if (b.map == VW_MAP_WEIGHTED && workers != 3) b.speeds = NULL;
+            b.load.model = (si + li) % 2 ? VW_LOAD_BUSY : VW_LOAD_COUNTER;
+            rt_job *j;
+            int64_t *got = render(s, w, h, layouts[li], workers, &b, &j);
+            size_t diff = 0;
+            for (size_t i = 0; i < n; i++) diff += got[i] != ref[i];
+            CHECK(diff == 0, "%s, %dx%dx%d, %d workers, map %s: %zu of %zu sums differ",
+                  vw_balance_strategy_name(strat[si]), layouts[li][0], layouts[li][1],
+                  layouts[li][2], workers, vw_map_kind_name(b.map), diff, n);
+            vw_world *wd = rt_job_world(j);
+            CHECK(vw_world_counter(wd, RT_C_EYE) + vw_world_counter(wd, RT_C_REFLECT) +
+                          vw_world_counter(wd, RT_C_REFRACT) + vw_world_counter(wd, RT_C_SHADOW) ==
+                      vw_world_counter(wd, RT_C_ENDED),
+                  "%s: rays created != rays ended", vw_balance_strategy_name(strat[si]));
+            free(got);
+            rt_job_free(j);
+        }
+    free(ref);
+    vw_scene_free(s);
+    return failures ? 1 : 0;
+}
+
+/* ---- conserve: a module whose cells checksum the ids they were built with ------------- */
+
+typedef struct tobj {
+    int64_t id;
+    double lo[3], hi[3];
+} tobj;
+
+typedef struct tcell {
+    double sum; /* sum of hash(id): exact in a double (each < 2^20, < 2^30 objects) */
+} tcell;
+
+static double hash_id(int64_t id) { return (double)(((uint64_t)id * 2654435761u) & 0xfffff); }
+
+static void tbounds(const void *o, vw_box *b, void *user)
+{
+    (void)user;
+    const tobj *t = o;
+    memcpy(b->lo, t->lo, sizeof b->lo);
+    memcpy(b->hi, t->hi, sizeof b->hi);
+}
+
+static vw_status tbuild(vw_ctx *ctx, const void *objects, size_t n, void **state)
+{
+    (void)ctx;
+    tcell *c = calloc(1, sizeof *c);
+    if (!c) return VW_E_NOMEM;
+    const tobj *o = objects;
+    for (size_t i = 0; i < n; i++) c->sum += hash_id(o[i].id);
+    *state = c;
+    return VW_OK;
+}
+
+static void tfree(void *state, void *user)
+{
+    (void)user;
+    free(state);
+}
+
+static double tload(vw_ctx *ctx, void *state)
+{
+    (void)ctx;
+    return ((tcell *)state)->sum;
+}
+
+static const vw_module tmodule = {.abi = VW_MODULE_ABI, .name = "conserve",
+                                  .object_size = sizeof(tobj), .object_bounds = tbounds,
+                                  .cell_build = tbuild, .cell_free = tfree, .load = tload};
+
+/* Every cell holds exactly the objects whose bounds overlap it: count and checksum. */
+static void check_placement(vw_world *w, const tobj *objs, size_t n, const char *what)
+{
+    const vw_decomp *d = vw_world_decomp(w);
+    int nc = vw_decomp_cell_count(d);
+    double *sum = calloc((size_t)nc, sizeof *sum);
+    size_t *cnt = calloc((size_t)nc, sizeof *cnt);
+    vw_box wb = vw_decomp_world(d);
+    double ext = 0;
+    for (int a = 0; a < 3; a++) ext = fmax(ext, wb.hi[a] - wb.lo[a]);
+    int cells[VW_MAX_CELLS > 4096 ? 4096 : VW_MAX_CELLS];
+    for (size_t i = 0; i < n; i++) {
+        vw_box b;
+        tbounds(&objs[i], &b, NULL);
+        int m = vw_decomp_cells_overlapping(d, &b, ext * 1e-9, cells, 4096);
+        CHECK(m >= 1, "%s: object %zu is in no cell", what, i);
+        for (int k = 0; k < m && k < 4096; k++) {
+            sum[cells[k]] += hash_id(objs[i].id);
+            cnt[cells[k]]++;
+        }
+    }
+    for (int c = 0; c < nc; c++) {
+        vw_cell_stats cs;
+        vw_world_cell_stats(w, c, &cs);
+        CHECK(cs.objects == cnt[c], "%s: cell %d holds %zu objects, its bounds overlap %zu",
+              what, c, cs.objects, cnt[c]);
+        CHECK(cs.load == sum[c], "%s: cell %d was built with the wrong objects (checksum %.0f, "
+                                 "expected %.0f)", what, c, cs.load, sum[c]);
+    }
+    free(sum);
+    free(cnt);
+}
+
+static int t_conserve(void)
+{
+    size_t n = 3000;
+    tobj *objs = malloc(n * sizeof *objs);
+    uint64_t r = 12345;
+    for (size_t i = 0; i < n; i++) {
+        objs[i].id = (int64_t)i;
+        for (int a = 0; a < 3; a++) {
+            r = r * 6364136223846793005ull + 1442695040888963407ull;
+            double u = (double)(r >> 11) / 9007199254740992.0;
+            /* Half the objects in a corner cluster: walls move far. */
+            double x = i % 2 ? 0.8 * u * u * u : u;
+            objs[i].lo[a] = x;
+            objs[i].hi[a] = x + 0.01 + 0.02 * (double)(i % 3);
+        }
+    }
+    vw_box world = {{-0.01, -0.01, -0.01}, {1.05, 1.05, 1.05}};
+    int dims[3] = {2, 2, 2};
+    vw_decomp *d;
+    vw_decomp_create_grid(&world, dims, &d);
+    vw_config cfg;
+    vw_config_init(&cfg);
+    cfg.workers = 3;
+    vw_world *w;
+    CHECK(vw_world_create(&tmodule, NULL, d, &cfg, &w) == VW_OK, "create");
+    vw_world_add_objects(w, objs, n);
+    vw_world_commit(w);
+    check_placement(w, objs, n, "initial");
+    /* The load field: where the objects are (one point per object's centre). */
+    vw_load_field *f;
+    vw_load_field_create(&f);
+    for (size_t i = 0; i < n; i++) {
+        double p[3];
+        for (int a = 0; a < 3; a++) p[a] = 0.5 * (objs[i].lo[a] + objs[i].hi[a]);
+        vw_load_field_add_point(f, p, 1.0);
+    }
+    static const vw_balance_strategy chain[] = {VW_BALANCE_TENSOR, VW_BALANCE_STAGGERED,
+                                                VW_BALANCE_ROTATE, VW_BALANCE_DIVIDE,
+                                                VW_BALANCE_TENSOR};
+    for (size_t k = 0; k < sizeof chain / sizeof *chain; k++) {
+        vw_balance_params p;
+        vw_balance_params_init(&p);
+        p.strategy = chain[k];
+        vw_balance_report rep;
+        vw_status st = vw_balance_world(w, f, &p, NULL, &rep);
+        CHECK(st == VW_OK, "balance %s: %s", vw_balance_strategy_name(chain[k]), vw_status_name(st));
+        CHECK(rep.imbalance_predicted <= rep.imbalance_before + 1e-12,
+              "%s made it worse: %.3f -> %.3f", vw_balance_strategy_name(chain[k]),
+              rep.imbalance_before, rep.imbalance_predicted);
+        CHECK(rep.bytes_moved == rep.migrated_objects * sizeof(tobj), "bytes moved");
+        vw_world_commit(w);
+        check_placement(w, objs, n, vw_balance_strategy_name(chain[k]));
+        printf("conserve: %-9s cells %3d lambda %.3f -> %.3f, %llu migrated, max neighbours %d\n",
+               vw_balance_strategy_name(chain[k]), rep.cells, rep.imbalance_before,
+               rep.imbalance_predicted, (unsigned long long)rep.migrated_objects,
+               rep.max_neighbours);
+    }
+    vw_load_field_free(f);
+    vw_world_free(w);
+    vw_decomp_free(d);
+    free(objs);
+    return failures ? 1 : 0;
+}
+
+/* ---- staggered8 ------------------------------------------------------------------------ */
+
+static int t_staggered8(void)
+{
+    vw_scene *s = load_scene("spheres:0.5:1");
+    int dims[3] = {2, 2, 2};
+    double lam[2];
+    for (int strat = 0; strat < 2; strat++) {
+        rt_balance b;
+        balance_spec(&b, strat ? VW_BALANCE_STAGGERED : VW_BALANCE_NONE);
+        b.rounds = 3;
+        rt_job *j;
+        int64_t *sums = render(s, 128, 128, dims, 8, strat ? &b : NULL, &j);
+        lam[strat] = rt_job_work_imbalance(j, NULL);
+        CHECK(vw_decomp_cell_count(vw_world_decomp(rt_job_world(j))) == 8, "8 cells");
+        free(sums);
+        rt_job_free(j);
+    }
+    printf("staggered8: work lambda none %.3f, staggered %.3f\n", lam[0], lam[1]);
+    CHECK(lam[1] <= 1.10, "staggered lambda %.3f > 1.10 (none: %.3f)", lam[1], lam[0]);
+    vw_scene_free(s);
+    return failures ? 1 : 0;
+}
+
+/* ---- rotate: the frame follows an oblique line of load --------------------------------- */
+
+static int t_rotate(void)
+{
+    vw_load_field *f;
+    vw_load_field_create(&f);
+    double dir[3] = {1 / sqrt(3.0), 1 / sqrt(3.0), 1 / sqrt(3.0)};
+    /* A line from (0.1,0.1,0.1) to (0.9,0.9,0.9), with a little spread across it. */
+    double across[3] = {1 / sqrt(2.0), -1 / sqrt(2.0), 0};
+    for (int i = 0; i < 400; i++) {
+        double p[3], off = 0.02 * ((i * 7919 % 101) / 100.0 - 0.5);
+        for (int a = 0; a < 3; a++)
+            p[a] = 0.1 + 0.8 * (i / 399.0) * dir[a] * sqrt(3.0) + off * across[a];
+        vw_load_field_add_point(f, p, 1.0);
+    }
+    vw_box world = {{0, 0, 0}, {1, 1, 1}};
+    int dims[3] = {2, 2, 2};
+    vw_decomp *d;
+    vw_decomp_create_grid(&world, dims, &d);
+    double load[8];
+    vw_load_field_cell_loads(f, d, load);
+    vw_decomp *t = NULL, *r = NULL;
+    vw_balance_params p;
+    vw_balance_params_init(&p);
+    p.strategy = VW_BALANCE_TENSOR;
+    p.dims[0] = 2, p.dims[1] = 2, p.dims[2] = 1; /* tensor: the line crosses 2 of 4 cells */
+    CHECK(vw_balance_decompose(d, f, &p, &t, NULL) == VW_OK, "tensor");
+    p.strategy = VW_BALANCE_ROTATE;
+    CHECK(vw_balance_decompose(d, f, &p, &r, NULL) == VW_OK, "rotate");
+    const double *F = r ? vw_decomp_frame(r) : NULL;
+    CHECK(F != NULL, "rotate kept the identity frame");
+    if (F) {
+        double c = fabs(F[0] * dir[0] + F[1] * dir[1] + F[2] * dir[2]);
+        CHECK(c > 0.999, "frame x axis is not the line: cos %.4f", c);
+    }
+    /* The rotated world box holds the whole old world box. */
+    if (r) {
+        for (int i = 0; i < 8; i++) {
+            double q[3] = {(double)(i & 1), (double)((i >> 1) & 1), (double)((i >> 2) & 1)};
+            CHECK(vw_decomp_locate(r, q, NULL) >= 0, "corner %d outside the rotated world", i);
+        }
+        double lt[4], lr[4];
+        vw_load_field_cell_loads(f, t, lt);
+        vw_load_field_cell_loads(f, r, lr);
+        int ident[4] = {0, 1, 2, 3};
+        double lamt = vw_balance_imbalance(lt, ident, 4, 4, NULL);
+        double lamr = vw_balance_imbalance(lr, ident, 4, 4, NULL);
+        printf("rotate: 2x2x1 on an oblique line: tensor %.3f, rotate %.3f\n", lamt, lamr);
+        CHECK(lamr <= 1.10 && lamt >= 1.5, "rotate %.3f vs tensor %.3f", lamr, lamt);
+    }
+    vw_decomp_free(t);
+    vw_decomp_free(r);
+    vw_decomp_free(d);
+    vw_load_field_free(f);
+    return failures ? 1 : 0;
+}
+
+/* ---- map --------------------------------------------------------------------------------- */
+
+static void shares(const vw_decomp *d, const int *cw, int wpp, int *same_worker, int *same_proc,
+                   int *pairs)
+{
+    *same_worker = *same_proc = *pairs = 0;
+    int nb[64];
+    for (int c = 0; c < vw_decomp_cell_count(d); c++)
+        for (int f = 1; f < 6; f += 2) { /* + faces: every pair once */
+            int n = vw_decomp_neighbours(d, c, f, nb, 64);
+            for (int k = 0; k < n; k++) {
+                (*pairs)++;
+                *same_worker += cw[c] == cw[nb[k]];
+                *same_proc += cw[c] / wpp == cw[nb[k]] / wpp;
+            }
+        }
+}
+
+static int t_map(void)
+{
+    vw_box world = {{0, 0, 0}, {1, 1, 1}};
+    /* Every cell mapped exactly once, to a valid worker, by every mapper. */
+    static const int layouts[][3] = {{2, 4, 1}, {3, 3, 3}, {8, 8, 1}, {5, 1, 1}};
+    static const int pw[][2] = {{1, 1}, {2, 2}, {3, 2}, {1, 7}};
+    for (size_t li = 0; li < 4; li++) {
+        vw_decomp *d;
+        vw_decomp_create_grid(&world, layouts[li], &d);
+        int nc = vw_decomp_cell_count(d);
+        double *load = malloc(sizeof(double) * (size_t)nc);
+        int *cw = malloc(sizeof(int) * (size_t)nc);
+        for (int c = 0; c < nc; c++) load[c] = 1.0 + (c * 7 % 5);
+        for (size_t pi = 0; pi < 4; pi++)
+            for (int kind = VW_MAP_BLOCK; kind <= VW_MAP_WEIGHTED; kind++) {
+                int gw = pw[pi][0] * pw[pi][1];
+                for (int c = 0; c < nc; c++) cw[c] = -1;
+                CHECK(vw_map_compute((vw_map_kind)kind, d, load, pw[pi][0], pw[pi][1], NULL, cw) ==
+                          VW_OK,
+                      "map");
+                for (int c = 0; c < nc; c++)
+                    CHECK(cw[c] >= 0 && cw[c] < gw, "%s: cell %d -> worker %d of %d",
+                          vw_map_kind_name((vw_map_kind)kind), c, cw[c], gw);
+            }
+        free(load);
+        free(cw);
+        vw_decomp_free(d);
+    }
+    /* 2x4 on 2 processes x 2 workers: block keeps at least the neighbour share of the
+       hand layout (processes split y into halves, each worker one row of 2 cells):
+       4 of 10 face pairs inside a worker, 8 inside a process. */
+    {
+        int dims[3] = {2, 4, 1};
+        vw_decomp *d;
+        vw_decomp_create_grid(&world, dims, &d);
+        int cw[8], hand[8];
+        for (int c = 0; c < 8; c++) {
+            int j = c / 2;
+            hand[c] = (j / 2) * 2 + (j % 2);
+        }
+        vw_map_block(d, 2, 2, cw);
+        int sw, sp, np, hw, hp, hn;
+        shares(d, cw, 2, &sw, &sp, &np);
+        shares(d, hand, 2, &hw, &hp, &hn);
+        printf("map: 2x4 on 2x2: block keeps %d/%d pairs in a worker, %d in a process; hand "
+               "layout %d, %d\n", sw, np, sp, hw, hp);
+        CHECK(sw >= hw && sp >= hp, "block %d/%d below the hand layout %d/%d", sw, sp, hw, hp);
+        int per[4] = {0};
+        for (int c = 0; c < 8; c++) per[cw[c]]++;
+        for (int g = 0; g < 4; g++) CHECK(per[g] == 2, "worker %d hosts %d cells", g, per[g]);
+        vw_decomp_free(d);
+    }
+    /* Weighted: speeds 1,1,2,4 over 256 cells of uneven load -> shares 1/8,1/8,1/4,1/2. */
+    {
+        int dims[3] = {16, 16, 1};
+        vw_decomp *d;
+        vw_decomp_create_grid(&world, dims, &d);
+        double load[256], sp[4] = {1, 1, 2, 4}, got[4] = {0}, total = 0;
+        int cw[256];
+        for (int c = 0; c < 256; c++) total += load[c] = 1.0 + (double)((c * 37) % 11);
+        CHECK(vw_map_weighted(d, load, 4, sp, cw) == VW_OK, "weighted");
+        for (int c = 0; c < 256; c++) got[cw[c]] += load[c];
+        for (int g = 0; g < 4; g++) {
+            double want = total * sp[g] / 8.0;
+            printf("map: weighted worker %d speed %.0f: load %.1f, proportional share %.1f\n", g,
+                   sp[g], got[g], want);
+            CHECK(fabs(got[g] - want) <= 0.10 * want, "worker %d: %.1f vs %.1f", g, got[g], want);
+        }
+        vw_decomp_free(d);
+    }
+    return failures ? 1 : 0;
+}
+
+int main(int argc, char **argv)
+{
+    if (argc < 2) {
+        fprintf(stderr, "usage: bal_test identical|conserve|staggered8|rotate|map [...]\n");
+        return 2;
+    }
+    const char *cmd = argv[1];
+    if (!strcmp(cmd, "identical")) return t_identical(argc > 2 ? argv[2] : "gen:balls", argc > 3 ? argv[3] : NULL);
+    if (!strcmp(cmd, "conserve")) return t_conserve();
+    if (!strcmp(cmd, "staggered8")) return t_staggered8();
+    if (!strcmp(cmd, "rotate")) return t_rotate();
+    if (!strcmp(cmd, "map")) return t_map();
+    fprintf(stderr, "bal_test: unknown test '%s'\n", cmd);
+    return 2;
+}

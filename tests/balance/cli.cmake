@@ -1,0 +1,67 @@
+# cli.cmake (balance) - `vwalls render --balance S --map K` writes the very PNG bytes of
+# the unbalanced 1-cell render, for every strategy and mapping, on the threads engine and
+# (when MPIRUN is given) under mpirun -np 2; the stats JSON carries the balance members;
+# bad values exit 2. Variables: VWALLS, SCENE, WORK, and MPIRUN, NPFLAG, PREFLAGS ('|').
+file(REMOVE_RECURSE ${WORK})
+file(MAKE_DIRECTORY ${WORK})
+string(REPLACE "|" ";" pre "${PREFLAGS}")
+
+function(render out)
+  execute_process(COMMAND ${ARGN} RESULT_VARIABLE rc ERROR_VARIABLE err OUTPUT_QUIET TIMEOUT 120)
+  if(NOT rc EQUAL 0)
+    message(FATAL_ERROR "${ARGN}: exit ${rc}: ${err}")
+  endif()
+  if(NOT "${out}" STREQUAL "")
+    execute_process(COMMAND ${CMAKE_COMMAND} -E compare_files ${WORK}/ref.png ${out}
+                    RESULT_VARIABLE same)
+    if(NOT same EQUAL 0)
+      message(FATAL_ERROR "${ARGN}: PNG differs from the unbalanced render")
+    endif()
+  endif()
+endfunction()
+
+set(common --size 80x60 --quiet)
+render("" ${VWALLS} render ${SCENE} -o ${WORK}/ref.png ${common})
+foreach(case "tensor;block;2x2x2;2" "rotate;block;2x4;2" "staggered;greedy;2x2x2;3"
+             "divide;block;2x2;2" "none;greedy;4x4x1;2" "staggered;weighted;4x2x2;2")
+  list(GET case 0 bal)
+  list(GET case 1 map)
+  list(GET case 2 cells)
+  list(GET case 3 workers)
+  set(out ${WORK}/${bal}_${map}_${cells}.png)
+  render(${out} ${VWALLS} render ${SCENE} -o ${out} ${common} --cells ${cells}
+         --workers ${workers} --balance ${bal} --map ${map} --stats ${WORK}/${bal}.json
+         --overlay ${WORK}/${bal}_overlay.png --overlay-by worker)
+  if(MPIRUN)
+    set(mout ${WORK}/mpi_${bal}_${map}_${cells}.png)
+    render(${mout} ${MPIRUN} ${NPFLAG} 2 ${pre} ${VWALLS} render ${SCENE} -o ${mout} ${common}
+           --cells ${cells} --workers 1 --balance ${bal} --map ${map} --balance-load segments)
+  endif()
+endforeach()
+
+file(READ ${WORK}/staggered.json json)
+foreach(key "\"strategy\": \"staggered\"" "\"imbalance_before\"" "\"imbalance_after\""
+            "\"migrated_objects\"" "\"bytes_moved\"" "\"max_neighbours\"" "\"balance\": "
+            "\"kind\": \"staggered\"")
+  string(FIND "${json}" "${key}" at)
+  if(at LESS 0)
+    message(FATAL_ERROR "stats JSON lacks ${key}")
+  endif()
+endforeach()
+
+# --slow and --speeds: same image.
+render(${WORK}/slow.png ${VWALLS} render ${SCENE} -o ${WORK}/slow.png ${common} --cells 4x2
+       --workers 2 --map weighted --slow 1:3)
+render(${WORK}/speeds.png ${VWALLS} render ${SCENE} -o ${WORK}/speeds.png ${common} --cells 4x2
+       --workers 2 --map weighted --speeds 1,2)
+
+# Bad values: exit 2, no output.
+foreach(bad "--balance;sideways" "--map;random" "--speeds;1,x" "--speeds;1" "--slow;9:2"
+            "--slow;0:0.5" "--balance-load;guess" "--overlay-by;colour")
+  execute_process(COMMAND ${VWALLS} render ${SCENE} -o ${WORK}/bad.png --workers 2 ${bad}
+                  RESULT_VARIABLE rc OUTPUT_QUIET ERROR_VARIABLE err)
+  if(NOT rc EQUAL 2 OR EXISTS ${WORK}/bad.png)
+    message(FATAL_ERROR "${bad}: exit ${rc} (expected 2): ${err}")
+  endif()
+endforeach()
+message(STATUS "balance_cli: every strategy and mapping gives the same PNG")

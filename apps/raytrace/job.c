@@ -64,6 +64,7 @@ vw_status rt_job_create(const vw_scene *s, const rt_params *p, rt_job **out, cha
     double diag = 0;
     for (int a = 0; a < 3; a++) diag += (hi[a] - lo[a]) * (hi[a] - lo[a]);
     diag = sqrt(diag);
+    if (p->scale > 0) diag = p->scale;
     if (!(diag > 0)) diag = 1;
 
     vw_camera cam;
@@ -111,7 +112,15 @@ vw_status rt_job_create(const vw_scene *s, const rt_params *p, rt_job **out, cha
 
     rt_object *objs = NULL;
     size_t nobjs = 0;
-    vw_status st = rt_objects_from_scene(s, &objs, &nobjs);
+    vw_status st = VW_OK;
+    if (p->objects) {
+        objs = malloc((p->nobjects ? p->nobjects : 1) * sizeof *objs);
+        if (!objs) goto nomem;
+        memcpy(objs, p->objects, p->nobjects * sizeof *objs);
+        nobjs = p->nobjects;
+    } else {
+        st = rt_objects_from_scene(s, &objs, &nobjs);
+    }
     if (st != VW_OK) goto fail;
 
     /* The world box: the scene bounds padded so no primitive touches the outer walls,
@@ -122,6 +131,7 @@ vw_status rt_job_create(const vw_scene *s, const rt_params *p, rt_job **out, cha
         world.lo[a] = lo[a] - pad;
         world.hi[a] = hi[a] + pad;
     }
+    if (p->world) world = *p->world;
     int dims[3];
     for (int a = 0; a < 3; a++) dims[a] = p->dims[a] > 0 ? p->dims[a] : 1;
     st = vw_decomp_create_grid(&world, dims, &j->decomp);
@@ -187,6 +197,7 @@ vw_status rt_job_commit(rt_job *j, char *err, size_t errlen)
 
 vw_status rt_job_run(rt_job *j, char *err, size_t errlen)
 {
+    j->sh.frame++;
     vw_status st = vw_world_run(j->world);
     if (st != VW_OK) {
         snprintf(err, errlen, "rendering: %s", vw_world_errmsg(j->world));

@@ -51,6 +51,7 @@ typedef struct rt_cell {
     size_t npixels, next; /* next pixel to generate */
     rt_package pkg;       /* contributions not yet sent */
     int64_t rays_pending; /* rays created, not yet added to sh->rays */
+    unsigned frame;       /* the run whose eye rays next/npixels describe */
 } rt_cell;
 
 static const char *const counter_names[RT_NCOUNTERS] = {
@@ -430,6 +431,10 @@ static vw_status cell_build(vw_ctx *ctx, const void *objects, size_t n, void **s
 static int step(vw_ctx *ctx, void *state)
 {
     rt_cell *c = state;
+    if (c->frame != c->sh->frame) { /* a new run: all of this cell's eye rays again */
+        c->frame = c->sh->frame;
+        c->next = 0;
+    }
     if (c->next < c->npixels) {
         const rt_view *v = &c->sh->view;
         size_t end = c->next + RT_BATCH < c->npixels ? c->next + RT_BATCH : c->npixels;

@@ -133,3 +133,54 @@ void rt_object_bounds(const rt_object *o, double pad, vw_box *out)
         out->hi[a] += pad;
     }
 }
+
+void rt_object_empty(rt_object *o)
+{
+    /* A zero sphere far beyond any world box: vw_decomp_cells_overlapping() gives no
+       cell for it, so no cell holds it and Embree never sees it. */
+    memset(o, 0, sizeof *o);
+    o->kind = RT_SPHERE;
+    o->id = -1;
+    for (int a = 0; a < 3; a++) o->g.sphere.c[a] = 1e300;
+}
+
+size_t rt_object_records(const vw_scene *s, vw_prim_kind kind, size_t index, rt_object *out)
+{
+    if (kind != VW_PRIM_POLYGON) {
+        /* The one-object scene trick keeps a single code path for records. */
+        vw_scene one = *s;
+        one.nspheres = one.ncones = one.npolygons = 0;
+        if (kind == VW_PRIM_SPHERE) one.spheres = &s->spheres[index], one.nspheres = 1;
+        else one.cones = &s->cones[index], one.ncones = 1;
+        rt_object *o;
+        size_t n;
+        if (rt_objects_from_scene(&one, &o, &n) != VW_OK || n != 1) {
+            rt_object_empty(out);
+            return 1;
+        }
+        *out = *o;
+        free(o);
+        return 1;
+    }
+    const vw_polygon *p = &s->polygons[index];
+    size_t n = p->count >= 3 ? (size_t)p->count - 2 : 0;
+    vw_scene one = *s;
+    one.nspheres = one.ncones = 0;
+    one.polygons = (vw_polygon *)p;
+    one.npolygons = 1;
+    rt_object *o;
+    size_t got;
+    for (size_t k = 0; k < n; k++) rt_object_empty(&out[k]);
+    if (rt_objects_from_scene(&one, &o, &got) != VW_OK) return n;
+    /* Match the surviving triangles to their fan positions (same vertices). */
+    const int *idx = &s->indices[p->first];
+    size_t g = 0;
+    for (size_t k = 0; k < n && g < got; k++) {
+        const double *v1 = s->vertices[idx[k + 1]], *v2 = s->vertices[idx[k + 2]];
+        if (!memcmp(o[g].g.tri.v[1], v1, sizeof o[g].g.tri.v[1]) &&
+            !memcmp(o[g].g.tri.v[2], v2, sizeof o[g].g.tri.v[2]))
+            out[k] = o[g++];
+    }
+    free(o);
+    return n;
+}

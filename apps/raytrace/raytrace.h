@@ -107,6 +107,9 @@ typedef struct rt_shared {
        progress bar's rays/s; the exact counts are the module counters). */
     _Alignas(64) atomic_llong rays;
     char pad_end[64 - sizeof(atomic_llong)];
+    /* Bumped by every rt_job_run(): a cell not rebuilt since the last run (dynamic
+       scenes rebuild only touched cells) sees a new frame and restarts its eye rays. */
+    _Alignas(64) unsigned frame;
 } rt_shared;
 
 extern const vw_module rt_module;
@@ -120,7 +123,21 @@ typedef struct rt_params {
     int workers;         /* per process; 0 = cores */
     const vw_camera *camera; /* NULL: the scene's (or a default framing for OBJ) */
     vw_config *config;   /* NULL: vw_config_init() defaults (incl. VW_STRESS) */
+    /* Dynamic scenes (vwalls animate) fix these for a whole animation, so that a frame
+       depends only on where the objects are, not on where they were at the start: */
+    const vw_box *world;       /* NULL: the scene bounds, padded */
+    double scale;              /* 0: the scene's diagonal; sets the epsilons */
+    const rt_object *objects;  /* NULL: rt_objects_from_scene(); else these records, */
+    size_t nobjects;           /* in this order (world object ids = their index) */
 } rt_params;
+
+/* The records of one scene object into out[0..n) (n = 1, or count-2 for a polygon),
+   the same as rt_objects_from_scene() makes, except that a degenerate triangle becomes
+   an empty record (rt_object_empty) instead of being dropped, so every object keeps a
+   fixed number of records. Returns n. */
+size_t rt_object_records(const vw_scene *s, vw_prim_kind kind, size_t index, rt_object *out);
+/* A record that no cell holds: its bounds lie beyond any world box. */
+void rt_object_empty(rt_object *o);
 
 typedef struct rt_job rt_job;
 

@@ -1,0 +1,42 @@
+# dynamic.cmake - tests of the dynamic-scene handler (src/dynamic, apps/raytrace/anim.c,
+# vwalls animate / edit): pairwise tests on hand-made cases; the placement rule after
+# every edit of random scripts (brute force over all cells, both worlds); distributed
+# batch decisions equal to the one-at-a-time O(n^2) reference; tunnelling; a frame after
+# edits bit-identical to rendering the edited scene from scratch; the command line.
+
+add_executable(test_dynamic ${PROJECT_SOURCE_DIR}/tests/dynamic/test_dynamic.c)
+target_include_directories(test_dynamic PRIVATE ${PROJECT_SOURCE_DIR}/tests)
+target_link_libraries(test_dynamic PRIVATE vwalls_apps m)
+
+add_test(NAME dynamic_primitives COMMAND test_dynamic primitives)
+add_test(NAME dynamic_tunnel COMMAND test_dynamic tunnel)
+foreach(w 1 2 4)
+  add_test(NAME dynamic_placement_w${w} COMMAND test_dynamic placement 4 --workers ${w})
+  add_test(NAME dynamic_decisions_w${w} COMMAND test_dynamic decisions 4 --workers ${w})
+endforeach()
+add_test(NAME dynamic_frame COMMAND test_dynamic frame 2 --workers 2)
+add_test(NAME dynamic_decisions_stress COMMAND test_dynamic decisions 2 --workers 3)
+set_tests_properties(dynamic_decisions_stress PROPERTIES ENVIRONMENT "VW_STRESS=42;VW_STRESS_SPLIT=1")
+
+# The command line: summary, frames, stats; bad lines give file:line and status 2 (or
+# are skipped with --keep-going); vwalls edit answers from stdin.
+add_test(NAME dynamic_cli
+  COMMAND sh ${PROJECT_SOURCE_DIR}/tests/dynamic/cli.sh $<TARGET_FILE:vwalls_tool>
+          ${CMAKE_CURRENT_BINARY_DIR}/dynamic_cli)
+
+# Under mpirun -np 2. This file is included before mpi.cmake (alphabetical order), so it
+# works out Open MPI's flags itself, as mpi.cmake does.
+if(VW_HAVE_MPI AND MPIEXEC_EXECUTABLE)
+  set(_vw_dyn_pre ${MPIEXEC_PREFLAGS})
+  execute_process(COMMAND ${MPIEXEC_EXECUTABLE} --version OUTPUT_VARIABLE _vw_dyn_ver ERROR_QUIET)
+  if(_vw_dyn_ver MATCHES "Open MPI|OpenRTE")
+    list(APPEND _vw_dyn_pre --oversubscribe)
+  endif()
+  foreach(t placement decisions frame)
+    add_test(NAME dynamic_mpi_${t}
+             COMMAND ${MPIEXEC_EXECUTABLE} ${MPIEXEC_NUMPROC_FLAG} 2 ${_vw_dyn_pre}
+                     $<TARGET_FILE:test_dynamic> ${t} 2 --workers 1 ${MPIEXEC_POSTFLAGS})
+    set_tests_properties(dynamic_mpi_${t} PROPERTIES LABELS "mpi" TIMEOUT 180 PROCESSORS 2
+                         ENVIRONMENT "OMPI_ALLOW_RUN_AS_ROOT=1;OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1")
+  endforeach()
+endif()

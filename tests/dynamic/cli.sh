@@ -1,0 +1,52 @@
+#!/bin/sh
+# cli.sh - vwalls animate / edit on the command line: frames and summary, stats JSON,
+# bad lines (file:line on stderr, status 2, or skipped with --keep-going), edit on stdin.
+# Usage: cli.sh VWALLS WORKDIR
+set -u
+V=$1
+W=$2
+rm -rf "$W" && mkdir -p "$W" && cd "$W" || exit 1
+fail() { echo "FAIL: $*" >&2; exit 1; }
+
+"$V" gen spheres --count 200 --seed 3 --resolution 32x32 -o scene.nff || fail "gen"
+cat > ok.txt <<'E'
+# two frames
+frame
+check on
+sweep on
+move 0 0.1 0 0
+add sphere 0 0 0 0.01
+frame
+E
+"$V" animate scene.nff ok.txt -o 'f%02d.png' --cells 2x2x1 --workers 2 --stats s.json --log log.txt > out.txt \
+  || fail "animate status $?"
+[ -s f00.png ] && [ -s f01.png ] || fail "frames missing"
+grep -q '"animation"' s.json || fail "no animation member in the stats"
+grep -q '"command": "animate"' s.json || fail "stats command"
+grep -q "accepted" out.txt || fail "no summary"
+[ "$(wc -l < log.txt)" -eq 2 ] || fail "log should list both edits"
+
+printf 'frame\nmove 999999 1 0 0\nfrobnicate 3\nmove 1 nan 0 0\nmoveto 2 1e9 0 0\nframe\n' > bad.txt
+"$V" animate scene.nff bad.txt -o 'b%02d.png' --workers 2 > bout.txt 2> berr.txt
+rc=$?
+[ $rc -eq 2 ] || fail "bad script: status $rc, expected 2"
+grep -q '^bad.txt:2: no object 999999' berr.txt || fail "unknown id message: $(cat berr.txt)"
+[ -e b01.png ] && fail "a frame after the bad line was rendered"
+
+"$V" animate scene.nff bad.txt -o 'k%02d.png' --workers 2 --keep-going > kout.txt 2> kerr.txt
+rc=$?
+[ $rc -eq 0 ] || fail "--keep-going: status $rc"
+grep -q '^bad.txt:3: unknown command' kerr.txt || fail "unknown command message"
+grep -q '^bad.txt:4: bad number' kerr.txt || fail "NaN message"
+grep -q '^bad.txt:5: object 2 would leave the world' kerr.txt || fail "outside-world message: $(cat kerr.txt)"
+[ -s k01.png ] || fail "--keep-going: second frame missing"
+
+printf 'move 0 0.05 0 0\nbogus\nremove 1\nremove 1\nframe\n' | "$V" edit scene.nff -o 'e%02d.png' --workers 1 > eout.txt 2> eerr.txt
+rc=$?
+[ $rc -eq 0 ] || fail "edit: status $rc"
+grep -q 'remove 1: accepted' eout.txt || fail "edit: no answer"
+grep -q '^stdin:2: unknown command' eerr.txt || fail "edit: bad line message"
+grep -q '^stdin:4: no object 1' eerr.txt || fail "edit: removed id message"
+[ -s e00.png ] || fail "edit: frame missing"
+"$V" animate scene.nff 2> /dev/null; [ $? -eq 2 ] || fail "usage status"
+echo "cli ok"

@@ -1,0 +1,424 @@
+/* cmd_animate.c - vwalls animate: runs an edit script (docs/edit-language.md) on a scene,
+ * deciding every move with the distributed collision and sweep tests, rendering a frame
+ * at every 'frame', rebalancing between frames; and the session both it and vwalls edit
+ * (the same language from stdin) share.
+ */
+#define _POSIX_C_SOURCE 200809L
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "cli.h"
+#include "commands.h"
+#include "raytrace/anim.h"
+
+/* Object edits wait in a batch, decided together by one distributed query, until a line
+   that needs the state (frame, check, sweep, balance) or the end; so a frame's thousand
+   moves cost one collider run, not a thousand. */
+#define MAX_BATCH 4096
+
+typedef struct vw_anim_session vw_anim_session;
+
+typedef struct frame_rec {
+    int frame;
+    size_t edits, accepted, rejected, records, cells;
+    double apply_s, update_s, build_s, render_s, lambda, balance_s;
+    int balanced;
+} frame_rec;
+
+struct vw_anim_session {
+    const char *cmd, *name, *pattern, *strategy;
+    rt_anim *anim;
+    int check, sweep, keep_going, interactive, quiet;
+    double threshold;            /* rebalance when lambda > 1 + threshold */
+    FILE *log;                   /* every edit's outcome (output process), or NULL */
+    vw_edit batch[MAX_BATCH];
+    size_t nbatch;
+    rt_anim_stats acc;           /* since the last frame */
+    size_t total_acc, total_coll, total_sweep, total_invalid;
+    int frame, failed;           /* failed: 2 bad input, 1 other */
+    frame_rec *frames;
+    size_t nframes, capframes;
+};
+
+static void say(const vw_anim_session *s, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+static void say(const vw_anim_session *s, const char *fmt, ...)
+{
+    if (!vw_cli_is_output() || s->quiet) return;
+    va_list ap;
+    va_start(ap, fmt);
+    vfprintf(stdout, fmt, ap);
+    va_end(ap);
+}
+
+static const char *op_name(vw_edit_op op)
+{
+    static const char *const n[] = {"", "move", "moveto", "rotate", "add", "remove",
+                                    "check", "sweep", "frame", "balance"};
+    return op <= VW_EDIT_BALANCE ? n[op] : "?";
+}
+
+/* Decides the waiting batch and reports every outcome. */
+static int flush(vw_anim_session *s)
+{
+    if (!s->nbatch) return 0;
+    vw_result *res = calloc(s->nbatch, sizeof *res);
+    if (!res) return s->failed = 1;
+    rt_anim_stats st;
+    memset(&st, 0, sizeof st);
+    vw_status rc = rt_anim_apply(s->anim, s->batch, s->nbatch, s->check, s->sweep, res, &st);
+    if (rc != VW_OK) {
+        vw_cli_error(s->cmd, "applying edits: %s", vw_status_message(rc));
+        free(res);
+        s->nbatch = 0;
+        return s->failed = 1;
+    }
+    s->acc.accepted += st.accepted, s->acc.collisions += st.collisions;
+    s->acc.sweeps += st.sweeps, s->acc.invalid += st.invalid;
+    s->acc.records_updated += st.records_updated, s->acc.cells_touched += st.cells_touched;
+    s->acc.apply_s += st.apply_s, s->acc.update_s += st.update_s;
+    s->total_acc += st.accepted, s->total_coll += st.collisions;
+    s->total_sweep += st.sweeps, s->total_invalid += st.invalid;
+    for (size_t i = 0; i < s->nbatch; i++) {
+        const vw_result *r = &res[i];
+        const char *op = op_name(r->edit.op);
+        int out = vw_cli_is_output();
+        switch (r->outcome) {
+        case VW_OUT_ACCEPTED:
+            if (s->interactive) say(s, "%s %d: accepted\n", op, r->id);
+            if (s->log && out) fprintf(s->log, "%s:%d: %s %d: accepted\n", s->name, r->edit.line, op, r->id);
+            break;
+        case VW_OUT_COLLISION:
+        case VW_OUT_SWEEP: {
+            const char *why = r->outcome == VW_OUT_COLLISION ? "collides at its destination with"
+                                                             : "would pass through";
+            say(s, "%s:%d: %s %d rejected: %s object %d\n", s->name, r->edit.line, op, r->id, why,
+                r->obstacle);
+            if (s->log && out)
+                fprintf(s->log, "%s:%d: %s %d: rejected: %s object %d\n", s->name, r->edit.line, op,
+                        r->id, why, r->obstacle);
+            break;
+        }
+        default:
+            if (out) fprintf(stderr, "%s:%d: %s\n", s->name, r->edit.line, r->msg);
+            if (s->log && out) fprintf(s->log, "%s:%d: %s: invalid: %s\n", s->name, r->edit.line, op, r->msg);
+            if (!s->interactive && !s->keep_going && !s->failed) s->failed = 2;
+            break;
+        }
+    }
+    free(res);
+    s->nbatch = 0;
+    return s->failed;
+}
+
+static int do_frame(vw_anim_session *s)
+{
+    char err[512] = "";
+    rt_anim_stats st;
+    memset(&st, 0, sizeof st);
+    vw_status rc = rt_anim_render(s->anim, &st, err, sizeof err);
+    if (rc != VW_OK) {
+        vw_cli_error(s->cmd, "frame %d: %s", s->frame, err);
+        return s->failed = 1;
+    }
+    rt_job *job = rt_anim_job(s->anim);
+    const rt_shared *sh = rt_job_shared(job);
+    int w = sh->view.width, h = sh->view.height;
+    /* Without -o (vwalls edit) a frame still renders; its times are reported. */
+    if (vw_cli_is_output() && s->pattern) {
+        char path[4096];
+        snprintf(path, sizeof path, s->pattern, s->frame);
+        uint8_t *rgb = malloc((size_t)w * h * 3);
+        if (!rgb) return s->failed = 1;
+        rt_job_rgb8(job, rgb);
+        rc = vw_image_write_png(path, w, h, rgb, err, sizeof err);
+        free(rgb);
+        if (rc != VW_OK) {
+            vw_cli_error(s->cmd, "%s", err);
+            return s->failed = 1;
+        }
+    }
+    if (s->nframes == s->capframes) {
+        size_t cap = s->capframes ? 2 * s->capframes : 16;
+        frame_rec *f = realloc(s->frames, cap * sizeof *f);
+        if (!f) return s->failed = 1;
+        s->frames = f;
+        s->capframes = cap;
+    }
+    frame_rec *f = &s->frames[s->nframes++];
+    memset(f, 0, sizeof *f);
+    f->frame = s->frame;
+    f->accepted = s->acc.accepted;
+    f->rejected = s->acc.collisions + s->acc.sweeps + s->acc.invalid;
+    f->edits = f->accepted + f->rejected;
+    f->records = s->acc.records_updated;
+    f->cells = s->acc.cells_touched;
+    f->apply_s = s->acc.apply_s;
+    f->update_s = s->acc.update_s;
+    f->build_s = st.build_s;
+    f->render_s = st.render_s;
+    f->lambda = rt_anim_imbalance(s->anim);
+    say(s, "frame %d: %zu edits (%zu accepted), %zu records, %zu cells rebuilt; decide %.3f s, "
+           "update %.3f s, build %.3f s, render %.3f s, lambda %.3f\n",
+        s->frame, f->edits, f->accepted, f->records, f->cells, f->apply_s, f->update_s, f->build_s,
+        f->render_s, f->lambda);
+    memset(&s->acc, 0, sizeof s->acc);
+    s->frame++;
+    /* Between frames: rebalance when the frame just rendered was uneven enough. */
+    if (s->strategy && strcmp(s->strategy, "none") && f->lambda > 1.0 + s->threshold) {
+        double before = 0, pred = 0, t0 = vw_cli_now();
+        rc = rt_anim_balance(s->anim, s->strategy, &before, &pred, err, sizeof err);
+        f->balance_s = vw_cli_now() - t0;
+        if (rc != VW_OK) {
+            vw_cli_error(s->cmd, "%s", err);
+            return s->failed = rc == VW_E_INVAL ? 2 : 1;
+        }
+        f->balanced = 1;
+        say(s, "  rebalanced (%s): lambda %.3f -> %.3f predicted, %.3f s\n", s->strategy, before,
+            pred, f->balance_s);
+    }
+    return 0;
+}
+
+/* One line of the language. Returns nonzero when the session must stop. */
+static int session_line(vw_anim_session *s, const char *line, int lineno)
+{
+    vw_edit e;
+    char err[512];
+    if (vw_edit_parse(line, s->name, lineno, &e, err, sizeof err) != VW_OK) {
+        if (vw_cli_is_output()) fprintf(stderr, "%s\n", err);
+        if (!s->interactive && !s->keep_going) {
+            flush(s);
+            return s->failed = 2;
+        }
+        return 0;
+    }
+    switch (e.op) {
+    case VW_EDIT_NONE:
+        break;
+    case VW_EDIT_MOVE:
+    case VW_EDIT_MOVETO:
+    case VW_EDIT_ROTATE:
+    case VW_EDIT_ADD:
+    case VW_EDIT_REMOVE:
+        s->batch[s->nbatch++] = e;
+        if (s->nbatch == MAX_BATCH || s->interactive) flush(s);
+        break;
+    case VW_EDIT_CHECK:
+        flush(s);
+        s->check = e.on;
+        break;
+    case VW_EDIT_SWEEP:
+        flush(s);
+        s->sweep = e.on;
+        break;
+    case VW_EDIT_FRAME:
+        if (!flush(s)) do_frame(s);
+        break;
+    case VW_EDIT_BALANCE: {
+        if (flush(s)) break;
+        double before = 0, pred = 0;
+        vw_status rc = rt_anim_balance(s->anim, s->strategy && strcmp(s->strategy, "none") ? s->strategy : "tensor",
+                                       &before, &pred, err, sizeof err);
+        if (rc != VW_OK) {
+            if (vw_cli_is_output()) fprintf(stderr, "%s:%d: balance: %s\n", s->name, lineno, err);
+            if (rc != VW_E_UNSUPPORTED && !s->interactive) s->failed = 1;
+        } else {
+            say(s, "balanced: lambda %.3f -> %.3f predicted\n", before, pred);
+        }
+        break;
+    }
+    }
+    return s->failed;
+}
+
+static void help(const char *cmd)
+{
+    if (!strcmp(cmd, "edit"))
+        printf("usage: vwalls edit SCENE [-o 'frames/%%04d.png'] [options]\n"
+               "\nReads the edit language (docs/edit-language.md) from stdin, one command per line,\n"
+               "and answers every edit at once; 'frame' renders the current scene.\n");
+    else
+        printf("usage: vwalls animate SCENE EDITS -o 'frames/%%04d.png' [options]\n"
+               "\nRuns the edit script EDITS (docs/edit-language.md) on SCENE: moves are checked\n"
+               "for collisions at their destination (and along their path with 'sweep on') by\n"
+               "cells of the decomposition; every 'frame' renders a PNG.\n");
+    printf("  -o PATTERN       frame file names, printf-style with the frame number (from 0)\n"
+           "  --cells L        layout of cells, like 4, 2x4, 2x2x2 (default 1)\n"
+           "  --workers W      worker threads per process (default: number of cores)\n"
+           "  --size WxH       image size (default: the scene's, else 512x512)\n"
+           "  --depth D        maximum ray depth (default 5)\n"
+           "  --balance S      none|tensor|rotate|staggered|divide: rebalance between frames\n"
+           "                   when lambda exceeds 1 + --threshold (default 0.1)\n"
+           "  --margin F       the world box is the scene bounds grown by F x diagonal on\n"
+           "                   every side (default 0.25); objects cannot leave it\n"
+           "  --keep-going     (animate) report bad lines and go on instead of stopping\n"
+           "  --log FILE       every edit's outcome, one line each\n"
+           "  --stats FILE     the stats JSON, with an \"animation\" member (per frame)\n"
+           "  --full-rebuild   rebuild every cell at every frame (the benchmark's baseline)\n"
+           "  --brute-force    decide with the O(n^2) reference instead of the cells\n"
+           "  --quiet          no summary\n"
+           "Exit status: 0 success, 2 bad input (a bad line stops animate unless --keep-going), 1 other.\n");
+}
+
+static char *frames_json(const vw_anim_session *s)
+{
+    size_t cap = 512 + s->nframes * 320;
+    char *j = malloc(cap);
+    if (!j) return NULL;
+    size_t n = (size_t)snprintf(j, cap,
+                                "\"animation\": {\"frames\": %zu, \"accepted\": %zu, \"collisions\": %zu, "
+                                "\"sweeps\": %zu, \"invalid\": %zu, \"per_frame\": [",
+                                s->nframes, s->total_acc, s->total_coll, s->total_sweep, s->total_invalid);
+    for (size_t i = 0; i < s->nframes && n < cap; i++) {
+        const frame_rec *f = &s->frames[i];
+        n += (size_t)snprintf(j + n, cap - n,
+                              "%s\n    {\"frame\": %d, \"edits\": %zu, \"accepted\": %zu, \"records\": %zu, "
+                              "\"cells_rebuilt\": %zu, \"decide_s\": %.6f, \"update_s\": %.6f, "
+                              "\"build_s\": %.6f, \"render_s\": %.6f, \"lambda\": %.4f, \"balanced\": %d, "
+                              "\"balance_s\": %.6f}",
+                              i ? "," : "", f->frame, f->edits, f->accepted, f->records, f->cells,
+                              f->apply_s, f->update_s, f->build_s, f->render_s, f->lambda, f->balanced,
+                              f->balance_s);
+    }
+    if (n < cap) snprintf(j + n, cap - n, "]}");
+    return j;
+}
+
+/* The whole command, for both animate (edits from a file) and edit (from stdin). */
+int vw_anim_main(const char *cmd, int argc, char **argv)
+{
+    const char *scene_path = NULL, *edits_path = NULL, *stats = NULL, *log_path = NULL;
+    vw_anim_session *s = calloc(1, sizeof *s);
+    if (!s) return VW_EXIT_FAIL;
+    s->cmd = cmd;
+    s->check = 1;
+    s->threshold = 0.1;
+    s->interactive = !strcmp(cmd, "edit");
+    rt_anim_params p;
+    memset(&p, 0, sizeof p);
+    long workers = 0, depth = 0;
+    int rc = VW_EXIT_USAGE;
+    for (int i = 1; i < argc; i++) {
+        const char *a = argv[i], *v;
+        if (!strcmp(a, "--help") || !strcmp(a, "-h")) {
+            help(cmd);
+            free(s);
+            return VW_EXIT_OK;
+        } else if (!strcmp(a, "-o") || !strcmp(a, "--output")) {
+            if (!(s->pattern = vw_cli_value(cmd, argc, argv, &i))) goto done;
+        } else if (!strcmp(a, "--cells")) {
+            if (!(v = vw_cli_value(cmd, argc, argv, &i)) || vw_cli_layout(cmd, a, v, p.dims)) goto done;
+        } else if (!strcmp(a, "--workers")) {
+            if (!(v = vw_cli_value(cmd, argc, argv, &i)) || vw_cli_int(cmd, a, v, 1, 1024, &workers)) goto done;
+        } else if (!strcmp(a, "--size")) {
+            if (!(v = vw_cli_value(cmd, argc, argv, &i)) || vw_cli_size(cmd, a, v, &p.width, &p.height)) goto done;
+        } else if (!strcmp(a, "--depth")) {
+            if (!(v = vw_cli_value(cmd, argc, argv, &i)) || vw_cli_int(cmd, a, v, 1, 64, &depth)) goto done;
+        } else if (!strcmp(a, "--balance")) {
+            if (!(s->strategy = vw_cli_value(cmd, argc, argv, &i))) goto done;
+        } else if (!strcmp(a, "--threshold")) {
+            if (!(v = vw_cli_value(cmd, argc, argv, &i)) || vw_cli_double(cmd, a, v, 0, 100, &s->threshold)) goto done;
+        } else if (!strcmp(a, "--margin")) {
+            if (!(v = vw_cli_value(cmd, argc, argv, &i)) || vw_cli_double(cmd, a, v, 1e-6, 100, &p.margin)) goto done;
+        } else if (!strcmp(a, "--keep-going")) {
+            s->keep_going = 1;
+        } else if (!strcmp(a, "--log")) {
+            if (!(log_path = vw_cli_value(cmd, argc, argv, &i))) goto done;
+        } else if (!strcmp(a, "--stats")) {
+            if (!(stats = vw_cli_value(cmd, argc, argv, &i))) goto done;
+        } else if (!strcmp(a, "--full-rebuild")) {
+            p.full_rebuild = 1;
+        } else if (!strcmp(a, "--brute-force")) {
+            p.brute_force = 1;
+        } else if (!strcmp(a, "--quiet") || !strcmp(a, "-q")) {
+            s->quiet = 1;
+        } else if (a[0] == '-' && a[1]) {
+            vw_cli_error(cmd, "unknown option '%s' (try --help)", a);
+            goto done;
+        } else if (!scene_path) {
+            scene_path = a;
+        } else if (!s->interactive && !edits_path) {
+            edits_path = a;
+        } else {
+            vw_cli_error(cmd, "unexpected argument '%s' (try --help)", a);
+            goto done;
+        }
+    }
+    if (!scene_path || (!s->interactive && (!edits_path || !s->pattern))) {
+        vw_cli_error(cmd, s->interactive ? "usage: vwalls edit SCENE [-o PATTERN] (try --help)"
+                                          : "usage: vwalls animate SCENE EDITS -o PATTERN (try --help)");
+        goto done;
+    }
+    if (s->strategy && strcmp(s->strategy, "none") && strcmp(s->strategy, "tensor") &&
+        strcmp(s->strategy, "rotate") && strcmp(s->strategy, "staggered") && strcmp(s->strategy, "divide")) {
+        vw_cli_error(cmd, "--balance: bad value '%s' (expected none, tensor, rotate, staggered or divide)",
+                     s->strategy);
+        goto done;
+    }
+    p.workers = (int)workers;
+    p.depth = (int)depth;
+    FILE *in = stdin;
+    s->name = "stdin";
+    if (edits_path) {
+        in = fopen(edits_path, "r");
+        if (!in) {
+            vw_cli_error(cmd, "cannot open '%s'", edits_path);
+            goto done;
+        }
+        s->name = edits_path;
+    }
+    char err[1024];
+    vw_scene *scene = NULL;
+    if (vw_scene_read_file(scene_path, &scene, err, sizeof err) != VW_OK) {
+        if (vw_cli_is_output()) fprintf(stderr, "%s\n", err);
+        if (in != stdin) fclose(in);
+        goto done;
+    }
+    vw_status st = rt_anim_create(scene, &p, &s->anim, err, sizeof err);
+    if (st != VW_OK) {
+        vw_cli_error(cmd, "%s", err);
+        if (in != stdin) fclose(in);
+        rc = VW_EXIT_FAIL;
+        goto done;
+    }
+    if (log_path && vw_cli_is_output() && !(s->log = fopen(log_path, "w"))) {
+        vw_cli_error(cmd, "cannot write '%s'", log_path);
+        if (in != stdin) fclose(in);
+        rc = VW_EXIT_FAIL;
+        goto done;
+    }
+    char line[1024];
+    int lineno = 0;
+    if (s->interactive) say(s, "vwalls edit: %d objects; commands: move moveto rotate add remove check sweep frame balance\n",
+                            vw_dynscene_ids(rt_anim_dynscene(s->anim)));
+    while (fgets(line, sizeof line, in)) {
+        lineno++;
+        if (session_line(s, line, lineno)) break;
+        if (s->interactive) fflush(stdout);
+    }
+    if (!s->failed) flush(s);
+    if (in != stdin) fclose(in);
+    say(s, "%s: %zu accepted, %zu rejected at the destination, %zu rejected along the path, "
+           "%zu invalid; %zu frames\n",
+        cmd, s->total_acc, s->total_coll, s->total_sweep, s->total_invalid, s->nframes);
+    if (stats && s->failed != 1) {
+        char *extra = frames_json(s);
+        vw_world *w = rt_job_world(rt_anim_job(s->anim));
+        if (vw_world_write_stats(w, stats, cmd, extra) != VW_OK) {
+            vw_cli_error(cmd, "cannot write '%s'", stats);
+            if (!s->failed) s->failed = 1;
+        }
+        free(extra);
+    }
+    rc = s->failed ? s->failed : VW_EXIT_OK;
+done:
+    if (s->log) fclose(s->log);
+    rt_anim_free(s->anim);
+    free(s->frames);
+    free(s);
+    return rc;
+}
+
+int vw_cmd_animate(int argc, char **argv) { return vw_anim_main("animate", argc, argv); }

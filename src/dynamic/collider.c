@@ -26,11 +26,28 @@ struct vw_collider {
     size_t ncontacts, capcontacts;
 };
 
+/* A cell's shapes sorted by the low x of their bounds, with the bounds kept beside
+   them: a probe visits only the x-slab its box can reach (binary search on lo.x, less
+   the widest shape), not every shape of a crowded cell. */
 typedef struct cell {
     vw_shape *s;
+    vw_box *b;
     size_t n;
+    double maxw;      /* the widest shape's x extent */
     vw_collider *c;
 } cell;
+
+typedef struct keyed {
+    double lo;
+    size_t i;
+} keyed;
+
+static int keyed_cmp(const void *a, const void *b)
+{
+    const keyed *x = a, *y = b;
+    if (x->lo != y->lo) return x->lo < y->lo ? -1 : 1;
+    return (x->i > y->i) - (x->i < y->i);
+}
 
 static void shape_bounds(const void *object, vw_box *out, void *user)
 {
@@ -38,18 +55,36 @@ static void shape_bounds(const void *object, vw_box *out, void *user)
     vw_shape_bounds(object, NULL, out);
 }
 
+static void cell_free(void *state, void *user);
+
 static vw_status cell_build(vw_ctx *ctx, const void *objects, size_t n, void **state)
 {
     cell *c = calloc(1, sizeof *c);
     if (!c) return VW_E_NOMEM;
     c->c = vw_ctx_user(ctx);
     if (n) {
+        const vw_shape *in = objects;
         c->s = malloc(n * sizeof *c->s);
-        if (!c->s) {
-            free(c);
+        c->b = malloc(n * sizeof *c->b);
+        keyed *k = malloc(n * sizeof *k);
+        if (!c->s || !c->b || !k) {
+            free(k);
+            cell_free(c, NULL);
             return VW_E_NOMEM;
         }
-        memcpy(c->s, objects, n * sizeof *c->s);
+        for (size_t i = 0; i < n; i++) {
+            vw_box b;
+            vw_shape_bounds(&in[i], NULL, &b);
+            k[i].lo = b.lo[0];
+            k[i].i = i;
+        }
+        qsort(k, n, sizeof *k, keyed_cmp);
+        for (size_t i = 0; i < n; i++) {
+            c->s[i] = in[k[i].i];
+            vw_shape_bounds(&c->s[i], NULL, &c->b[i]);
+            if (c->b[i].hi[0] - c->b[i].lo[0] > c->maxw) c->maxw = c->b[i].hi[0] - c->b[i].lo[0];
+        }
+        free(k);
     }
     c->n = n;
     *state = c;
@@ -62,6 +97,7 @@ static void cell_free(void *state, void *user)
     cell *c = state;
     if (!c) return;
     free(c->s);
+    free(c->b);
     free(c);
 }
 
@@ -105,10 +141,16 @@ static void handle_probe(vw_ctx *ctx, void *state, const void *msg)
     }
     vw_count(ctx, C_PROBES, 1);
     int64_t tests = 0;
-    for (size_t i = 0; i < c->n; i++) {
-        vw_box ob;
-        vw_shape_bounds(&c->s[i], NULL, &ob);
-        if (!boxes_overlap(&pb, &ob)) continue;
+    /* First shape whose lo.x can reach the probe: lo.x >= pb.lo.x - maxw. */
+    size_t lo = 0, hi = c->n;
+    double from = pb.lo[0] - c->maxw;
+    while (lo < hi) {
+        size_t mid = lo + (hi - lo) / 2;
+        if (c->b[mid].lo[0] < from) lo = mid + 1;
+        else hi = mid;
+    }
+    for (size_t i = lo; i < c->n && c->b[i].lo[0] <= pb.hi[0]; i++) {
+        if (!boxes_overlap(&pb, &c->b[i])) continue;
         tests++;
         int how = vw__probe_test(p, &c->s[i], c->c->tol);
         if (!how) continue;

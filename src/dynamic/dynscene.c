@@ -355,6 +355,8 @@ vw_status vw_dynscene_redecompose(vw_dynscene *ds, const vw_decomp *d, const int
 
 /* An edit being decided: its object's new geometry and shapes. */
 typedef struct pending {
+    vw_box reach;               /* bounds of its end shapes and swept start (local tests) */
+    vw_box endb;                /* bounds of its end shapes */
     int id, slot0, nshapes;     /* slot0: first slot; shapes in end[] at probe0 */
     size_t probe0;
     int add, remove;
@@ -589,6 +591,24 @@ static vw_status run_batch(vw_dynscene *ds, const vw_edit *edits, size_t n, int 
         pd[i].probe0 = nends;
         pd[i].nshapes = (int)ns;
         geom_shapes(&pd[i].g, pd[i].id, ends + nends);
+        for (int a = 0; a < 3; a++) {
+            pd[i].endb.lo[a] = pd[i].reach.lo[a] = INFINITY;
+            pd[i].endb.hi[a] = pd[i].reach.hi[a] = -INFINITY;
+        }
+        for (size_t k = 0; k < ns; k++) {
+            vw_box eb, sb;
+            vw_shape_bounds(&ends[nends + k], NULL, &eb);
+            if (pd[i].add)
+                sb = eb;
+            else
+                vw_shape_bounds(&ds->shapes[ds->obj[pd[i].id].slot + k], sweep && pd[i].swept ? pd[i].d : NULL, &sb);
+            for (int a = 0; a < 3; a++) {
+                pd[i].endb.lo[a] = fmin(pd[i].endb.lo[a], eb.lo[a]);
+                pd[i].endb.hi[a] = fmax(pd[i].endb.hi[a], eb.hi[a]);
+                pd[i].reach.lo[a] = fmin(pd[i].reach.lo[a], fmin(eb.lo[a], sb.lo[a]));
+                pd[i].reach.hi[a] = fmax(pd[i].reach.hi[a], fmax(eb.hi[a], sb.hi[a]));
+            }
+        }
         nends += ns;
         if (!check) continue;
         for (size_t k = 0; k < ns && st == VW_OK; k++) {
@@ -636,6 +656,7 @@ static vw_status run_batch(vw_dynscene *ds, const vw_edit *edits, size_t n, int 
             /* The new places of the edits accepted before this one in the batch. */
             for (size_t j = 0; j < i; j++) {
                 if (!ok[j] || pd[j].remove || res[j].outcome != VW_OUT_ACCEPTED) continue;
+                if (!boxes_overlap(&pd[i].reach, &pd[j].endb, ds->tol)) continue;
                 for (size_t k = 0; k < (size_t)pd[i].nshapes; k++) {
                     vw_probe p;
                     memset(&p, 0, sizeof p);

@@ -105,6 +105,9 @@ static void jacobi3(double A[3][3], double V[3][3], double ev[3])
 vw_status vw__balance_rotate(const vw_decomp *cur, const vw_load_field *f,
                              const vw_balance_params *p, const int dims[3], vw_decomp **out)
 {
+    /* A decomposition already rotated keeps its frame: later rounds only move its walls
+       (refitting a field measured in another frame would make the frame wander). */
+    if (vw_decomp_frame(cur)) return vw__balance_tensor(cur, f, p, dims, out);
     /* 1. Load-weighted centre of gravity of every cell of the current decomposition. */
     int nc = vw_decomp_cell_count(cur);
     double(*cg)[4] = calloc((size_t)nc, sizeof *cg);

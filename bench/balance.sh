@@ -1,0 +1,79 @@
+#!/usr/bin/env bash
+# bench/balance.sh - the four Virtual Walls balancing strategies side by side: lambda
+# (max/mean) and efficiency 1/lambda of the counted work (ray-cell visits, one worker per
+# cell: deterministic) and of busy time (2 workers), for uniform, 50% and 100% clustered
+# 1000-sphere scenes and an oblique line of spheres, at 8, 16 and 64 cells; speedup of
+# the compute phase over no balancing with 2 workers; and a picture of the walls before
+# and after for the clustered scene. Usage: bench/balance.sh [OUTDIR] (default
+# bench/out/balance); VW_BUILD_DIR picks the build; SIZE=WxH (default 256x256).
+set -euo pipefail
+source "$(dirname "${BASH_SOURCE[0]}")/lib.sh"
+OUT=${1:-$(dirname "${BASH_SOURCE[0]}")/out/balance}
+SIZE=${SIZE:-256x256}
+mkdir -p "$OUT"
+
+"$VWALLS" gen spheres --count 1000 --seed 7 -o "$OUT/uniform.nff"
+"$VWALLS" gen spheres --count 1000 --cluster 0.5 --seed 7 -o "$OUT/cluster50.nff"
+"$VWALLS" gen spheres --count 1000 --cluster 1 --seed 7 -o "$OUT/cluster100.nff"
+# An oblique line of 400 spheres from one corner of the box to the other, seen from the side.
+awk 'BEGIN {
+  print "v\nfrom 22 -14 8\nat 5 5 5\nup 0 0 1\nangle 40\nhither 0.01\nresolution 256 256";
+  print "b 0.1 0.1 0.1\nl 30 -20 30\nl -10 -10 20";
+  srand(7);
+  for (i = 0; i < 400; i++) {
+    t = i / 399; j = 0.25 * (rand() - 0.5); k = 0.25 * (rand() - 0.5);
+    printf "f %.2f %.2f %.2f 0.8 0.2 10 0 1\n", 0.3 + 0.7 * t, 0.4, 1 - 0.7 * t;
+    printf "s %.4f %.4f %.4f 0.08\n", 1 + 8 * t + j, 1 + 8 * t + k, 1 + 8 * t + j - k;
+  }
+}' > "$OUT/oblique.nff"
+
+# json FILE KEY...: numbers from the stats JSON (python3 reads it).
+json() { python3 -c "import json,sys; d=json.load(open(sys.argv[1])); print(' '.join(str(eval('d'+k)) for k in sys.argv[2:]))" "$@"; }
+
+layout() { case $1 in 8) echo 2x2x2 ;; 16) echo 4x2x2 ;; 64) echo 4x4x4 ;; esac; }
+
+TABLE="$OUT/table.md"
+{
+  echo "| scene | cells | strategy | λ work | 1/λ work | λ busy (2 w) | 1/λ busy | compute s (2 w) | speedup | migrated | max nb |"
+  echo "|---|---|---|---|---|---|---|---|---|---|---|"
+} > "$TABLE"
+for scene in uniform cluster50 cluster100 oblique; do
+  for cells in 8 16 64; do
+    L=$(layout $cells)
+    base=""
+    for s in none tensor rotate staggered divide; do
+      # Deterministic: one worker per cell, loads = counted ray-cell visits.
+      "$VWALLS" render "$OUT/$scene.nff" -o "$OUT/img.png" --size "$SIZE" --cells "$L" \
+        --workers "$cells" --balance "$s" --balance-load segments --quiet \
+        --stats "$OUT/w.json"
+      read -r lw mig nb < <(json "$OUT/w.json" "['balance_detail']['imbalance_work']" \
+        "['balance_detail']['migrated_objects']" "['balance_detail']['max_neighbours']")
+      # Measured: 2 workers, loads = busy time; best compute time of 3.
+      best=""; lb=""
+      for _ in 1 2 3; do
+        "$VWALLS" render "$OUT/$scene.nff" -o "$OUT/img.png" --size "$SIZE" --cells "$L" \
+          --workers 2 --balance "$s" --quiet --stats "$OUT/b.json"
+        read -r c l < <(json "$OUT/b.json" "['time_s']['compute']" "['balance']['imbalance']")
+        if [ -z "$best" ] || awk -v a="$c" -v b="$best" 'BEGIN { exit !(a < b) }'; then best=$c; lb=$l; fi
+      done
+      [ "$s" = none ] && base=$best
+      printf "| %s | %s | %s | %.3f | %.3f | %.3f | %.3f | %.3f | %s | %s | %s |\n" "$scene" "$L" "$s" \
+        "$lw" "$(awk -v x="$lw" 'BEGIN{print 1/x}')" "$lb" "$(awk -v x="$lb" 'BEGIN{print 1/x}')" \
+        "$best" "$(ratio "$base" "$best")" "$mig" "$nb" | tee -a "$TABLE"
+    done
+  done
+done
+
+# Walls before and after for the 50% clustered scene (8 cells, staggered), and the
+# mapping of 16 cells onto 2 workers.
+"$VWALLS" render "$OUT/cluster50.nff" -o "$OUT/img.png" --size 384x384 --cells 2x2x2 --workers 8 \
+  --quiet --overlay "$OUT/walls_before.png"
+"$VWALLS" render "$OUT/cluster50.nff" -o "$OUT/img.png" --size 384x384 --cells 2x2x2 --workers 8 \
+  --balance staggered --balance-load segments --quiet --overlay "$OUT/walls_staggered.png"
+"$VWALLS" render "$OUT/cluster50.nff" -o "$OUT/img.png" --size 384x384 --cells 2x2x2 --workers 8 \
+  --balance tensor --balance-load segments --quiet --overlay "$OUT/walls_tensor.png"
+if command -v convert >/dev/null; then
+  convert "$OUT/walls_before.png" "$OUT/walls_tensor.png" "$OUT/walls_staggered.png" +append \
+    "$OUT/walls_before_after.png"
+fi
+echo "table: $TABLE"

@@ -7,8 +7,9 @@ set -euo pipefail
 want=()
 for what in "${@:-build}"; do
   case "$what" in
+    # python3: tests/radiosity/mpi.sh reads the stats JSON with it (radiosity_mpi_np*).
     build) want+=(gcc libc6-dev make cmake pkg-config libembree-dev libpng-dev
-                  libopenmpi-dev openmpi-bin openssh-client iproute2) ;;
+                  libopenmpi-dev openmpi-bin openssh-client iproute2 python3) ;;
     bench) want+=(povray gnuplot-nox time python3) ;;
     fuzz)  want+=(clang libclang-rt-14-dev) ;;
     mpich) want+=(libmpich-dev mpich) ;;

@@ -264,6 +264,7 @@ vw_status vw_world_add_objects(vw_world *w, const void *objects, size_t n)
     if (!w || (n && !objects)) return VW_E_INVAL;
     size_t osz = w->m->object_size;
     if (!osz) return n ? VW_E_INVAL : VW_OK;
+    if (n == 0) return VW_OK; /* also keeps memcpy away from a NULL buffer */
     if (w->nobjects + n > w->capobjects) {
         size_t cap = w->capobjects ? w->capobjects : 64;
         while (cap < w->nobjects + n) cap *= 2;

@@ -307,7 +307,7 @@ vw_status vw_collider_query(vw_collider *c, const vw_probe *probes, size_t n, vw
     c->ncontacts = 0;
     if (st == VW_OK) st = vw_world_run(c->world);
     if (st != VW_OK) return st;
-    qsort(c->contacts, c->ncontacts, sizeof *c->contacts, contact_cmp);
+    if (c->ncontacts) qsort(c->contacts, c->ncontacts, sizeof *c->contacts, contact_cmp);
     /* One contact per (tag, obstacle): the same obstacle is held by every cell it
        overlaps, and a polygon is several shapes. */
     size_t m = 0;
@@ -320,7 +320,7 @@ vw_status vw_collider_query(vw_collider *c, const vw_probe *probes, size_t n, vw
     }
     vw_contact *r = malloc((m ? m : 1) * sizeof *r);
     if (!r) return VW_E_NOMEM;
-    memcpy(r, c->contacts, m * sizeof *r);
+    if (m) memcpy(r, c->contacts, m * sizeof *r);
     *out = r;
     *nout = m;
     return VW_OK;

@@ -636,7 +636,7 @@ static vw_status run_batch(vw_dynscene *ds, const vw_edit *edits, size_t n, int 
             st = brute_contacts(ds, &b, &ct, &nct);
         else
             st = vw_collider_query(ds->col, b.probes, b.nprobes, &ct, &nct);
-        if (st == VW_OK) qsort(ct, nct, sizeof *ct, contact_cmp);
+        if (st == VW_OK && nct) qsort(ct, nct, sizeof *ct, contact_cmp);
     }
     /* moved[id] != 0: an earlier edit of this batch was accepted for id (its old
        place is gone). Ids in a batch are distinct, so a small map by id suffices. */

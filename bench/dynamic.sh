@@ -61,6 +61,24 @@ run incremental
 run full-rebuild --full-rebuild
 run incremental-tensor --balance tensor
 run full-tensor --full-rebuild --balance tensor
+# Few moves per frame (10 spheres): here the incremental update rebuilds only the few
+# cells they touch, where 10% of the spheres touch nearly every cell.
+python3 - "$N" "$FRAMES" 10 "$lo" "$hi" > "$OUT/edits-small.txt" <<'PY'
+import random, sys
+n, frames, k, lo, hi = int(sys.argv[1]), int(sys.argv[2]), int(sys.argv[3]), float(sys.argv[4]), float(sys.argv[5])
+step = 0.02 * (hi - lo)
+rnd = random.Random(5)
+print("check on\nsweep on")
+for f in range(frames):
+    for i in rnd.sample(range(n), k):
+        print("move %d %.6g %.6g %.6g" % (i, rnd.uniform(-step, step), rnd.uniform(-step, step), rnd.uniform(-step, step)))
+    print("frame")
+PY
+cp "$OUT/edits.txt" "$OUT/edits-many.txt"
+cp "$OUT/edits-small.txt" "$OUT/edits.txt"
+run small-incremental
+run small-full-rebuild --full-rebuild
+cp "$OUT/edits-many.txt" "$OUT/edits.txt"
 # The images must not depend on how the cells were rebuilt or balanced.
 for f in 0001 $(printf '%04d' $((FRAMES / 2))) $(printf '%04d' $((FRAMES - 1))); do
   [ -e "$OUT/incremental-$f.png" ] || continue

@@ -10,7 +10,7 @@ add_test(NAME experiments_smoke
   COMMAND sh -c "bash \"$0\" --smoke --out \"$1\" --build \"$2\" >\"$1.log\" 2>&1 || { cat \"$1.log\"; exit 1; }; cat \"$1.log\"; awk -F, -f \"$3\" \"$1/results.csv\""
           ${PROJECT_SOURCE_DIR}/bench/experiments.sh ${CMAKE_CURRENT_BINARY_DIR}/experiments_smoke
           $<TARGET_FILE_DIR:vwalls_tool> ${VW_EXP_DIR}/check.awk)
-set_tests_properties(experiments_smoke PROPERTIES LABELS "bench" TIMEOUT 120 PROCESSORS 2
+set_tests_properties(experiments_smoke PROPERTIES LABELS "bench;mpi" TIMEOUT 120 PROCESSORS 2
   ENVIRONMENT "OMPI_ALLOW_RUN_AS_ROOT=1;OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1")
 
 # The checker itself: it must accept a good CSV and reject each deliberately bad one.

@@ -5,6 +5,15 @@
  * delivers fixed-size messages to handlers. A cell is only ever touched by the one
  * worker thread that hosts it, so a cell's state needs no locking. Output handlers run
  * on the output process (rank 0), one call at a time.
+ *
+ * Duplicated cells (the balancer's "duplicate" strategy, vw_world_set_replicas): a cell
+ * may have copies on other workers, each with its own state built by cell_build from the
+ * same objects. The original is the master (replica 0). Messages of kinds flagged
+ * VW_MSG_INDEPENDENT sent to the cell are spread over the master and its copies; every
+ * other kind goes to the master only. step() runs on every copy (so a copy can flush
+ * what it buffers), so work that must happen once per cell (primary rays, a shot)
+ * belongs to the master: test vw_ctx_replica(ctx) == 0. Counters and measurements of
+ * the copies add up to the cell's.
  */
 #ifndef VWALLS_MODULE_H
 #define VWALLS_MODULE_H
@@ -21,6 +30,12 @@ extern "C" {
 #define VW_MAX_KINDS 64
 #define VW_MAX_COUNTERS 32
 
+/* vw_msg_kind.flags. INDEPENDENT: a message of this kind can be handled by any copy of
+   its destination cell with the same result (it reads only the cell's objects, writes
+   nothing a later message of the cell reads, and sends what it sends from the cell), so
+   a duplicated cell may share such messages with its copies (rays of a ray tracer). */
+#define VW_MSG_INDEPENDENT 1u
+
 /* Handed to every callback that runs for a cell: who am I, and how to send. */
 typedef struct vw_ctx vw_ctx;
 
@@ -31,6 +46,8 @@ typedef struct vw_msg_kind {
     void (*handle)(vw_ctx *ctx, void *cell_state, const void *msg);
     /* For kinds sent with vw_send_output: runs on the output process. */
     void (*output)(void *user, const void *msg);
+    /* VW_MSG_* flags; 0 (also when an initialiser omits it) = handled by the master. */
+    unsigned flags;
 } vw_msg_kind;
 
 typedef struct vw_module {
@@ -71,10 +88,16 @@ VW_API int vw_ctx_process(const vw_ctx *ctx);
 VW_API const vw_decomp *vw_ctx_decomp(const vw_ctx *ctx);
 VW_API vw_box vw_ctx_cell_box(const vw_ctx *ctx);
 VW_API void *vw_ctx_user(const vw_ctx *ctx);
+/* Which copy of a duplicated cell runs this callback (0 = the master, or no copies),
+   and how many copies besides the master the cell has. */
+VW_API int vw_ctx_replica(const vw_ctx *ctx);
+VW_API int vw_ctx_replicas(const vw_ctx *ctx);
 
 /* Sending. A message is copied when sent; the caller keeps its buffer.
    Messages are batched per destination into packets, flushed when full or when the
-   worker has nothing else to do. */
+   worker has nothing else to do. To a duplicated cell, a message of an independent kind
+   goes to the master or one of its copies in turn (round-robin per sending worker),
+   also when a cell sends to itself: that is how a master shares work it creates. */
 VW_API void vw_send_cell(vw_ctx *ctx, int cell, int kind, const void *msg);
 /* To the cell owning world point p (dir decides points on walls). Returns the cell, or
    -1 (message dropped) when p lies outside the world. */

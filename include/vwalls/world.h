@@ -71,6 +71,20 @@ VW_API vw_status vw_world_update_object(vw_world *w, size_t id, const void *obje
    tests and tools that check the placement rule, not for inner loops. */
 VW_API int vw_world_cells_of_object(const vw_world *w, size_t id, int *out, int max);
 
+/* Cell duplication (the paper's fourth strategy): the cell gets copies on the given
+   global workers, each built from the cell's objects at the next commit/run; messages
+   of VW_MSG_INDEPENDENT kinds are then shared between the master and the copies (see
+   module.h). n = 0 removes the copies. Between runs only, and with the same arguments
+   on every process. VW_E_INVAL when the module has no independent kind, a worker is out
+   of range, repeated, or the master's own. A copy whose worker stays keeps its state and
+   figures; the figures of dropped copies are dropped (reset the stats first). A new
+   decomposition or mapping (vw_world_redecompose, vw_world_remap) removes every copy;
+   the neighbourhood of cells never changes. */
+VW_API vw_status vw_world_set_replicas(vw_world *w, int cell, const int *workers, int n);
+/* The workers of the cell's copies (not the master): writes at most max to out (may be
+   NULL with max 0) and returns how many there are. */
+VW_API int vw_world_replicas(const vw_world *w, int cell, int *out, int max);
+
 /* Engine facts. */
 VW_API int vw_world_process(const vw_world *w);       /* this process's rank */
 VW_API int vw_world_processes(const vw_world *w);
@@ -86,12 +100,15 @@ typedef struct vw_cell_stats {
     uint64_t messages_in;
     double busy_s;      /* measured time in handlers and step() (all runs) */
     double load;        /* module's load() if given, else busy_s */
+    int replicas;       /* copies besides the master (figures above include theirs) */
 } vw_cell_stats;
 VW_API vw_status vw_world_cell_stats(const vw_world *w, int cell, vw_cell_stats *out);
 VW_API double vw_world_worker_busy(const vw_world *w, int global_worker);
 /* Sum over all cells and processes of module counter idx. */
 VW_API int64_t vw_world_counter(const vw_world *w, int idx);
 VW_API int64_t vw_world_cell_counter(const vw_world *w, int cell, int idx);
+/* Sum of module counter idx over the cells and copies that global worker g hosts. */
+VW_API int64_t vw_world_worker_counter(const vw_world *w, int g, int idx);
 /* Imbalance lambda = max / mean of worker busy times. */
 VW_API double vw_world_imbalance(const vw_world *w);
 VW_API void vw_world_reset_stats(vw_world *w);

@@ -25,7 +25,19 @@ struct vw_ctx {
     vw_world *w;
     vw__worker *wk;
     int cell;
+    int rep; /* which copy of the cell: 0 = the master */
 };
+
+/* The figures and state of copy rep of a cell (0: the master itself). */
+static void **unit_state(vw_world *w, int cell, int rep)
+{
+    return rep ? &w->cells[cell].reps[rep - 1].state : &w->cells[cell].state;
+}
+
+static int64_t *unit_counters(vw_world *w, int cell, int rep)
+{
+    return rep ? w->cells[cell].reps[rep - 1].counters : w->cells[cell].counters;
+}
 
 double vw__now(void)
 {
@@ -208,6 +220,11 @@ int vw_ctx_process(const vw_ctx *ctx) { return ctx->w->rank; }
 const vw_decomp *vw_ctx_decomp(const vw_ctx *ctx) { return ctx->w->decomp; }
 vw_box vw_ctx_cell_box(const vw_ctx *ctx) { return vw_decomp_cell_box(ctx->w->decomp, ctx->cell); }
 void *vw_ctx_user(const vw_ctx *ctx) { return ctx->w->user; }
+int vw_ctx_replica(const vw_ctx *ctx) { return ctx->rep; }
+int vw_ctx_replicas(const vw_ctx *ctx)
+{
+    return ctx->cell >= 0 ? ctx->w->cells[ctx->cell].nreps : 0;
+}
 
 void vw_send_cell(vw_ctx *ctx, int cell, int kind, const void *msg)
 {
@@ -217,6 +234,14 @@ void vw_send_cell(vw_ctx *ctx, int cell, int kind, const void *msg)
         abort();
     }
     int dest = w->cell_worker[cell];
+    const vw__cell *c = &w->cells[cell];
+    if (c->nreps && kind >= 0 && kind < w->m->nkinds &&
+        (w->m->kinds[kind].flags & VW_MSG_INDEPENDENT)) {
+        /* A duplicated cell: the master and its copies in turn. The receiving worker
+           finds its copy by (cell, worker), so the header needs no copy number. */
+        unsigned u = c->rr[ctx->wk->local]++ % (unsigned)(c->nreps + 1);
+        if (u) dest = c->reps[u - 1].worker;
+    }
     enqueue(ctx, dest, dest, cell, kind, msg);
 }
 
@@ -258,7 +283,7 @@ void vw_send_output(vw_ctx *ctx, int kind, const void *msg)
 void vw_count(vw_ctx *ctx, int idx, int64_t n)
 {
     if (idx >= 0 && idx < ctx->w->m->ncounters && ctx->cell >= 0)
-        ctx->w->cells[ctx->cell].counters[idx] += n;
+        unit_counters(ctx->w, ctx->cell, ctx->rep)[idx] += n;
 }
 
 /* ---- the worker loop ---------------------------------------------------------------- */
@@ -267,7 +292,7 @@ void vw_count(vw_ctx *ctx, int idx, int64_t n)
    charge ends. With a slow-down factor k (an emulated slower machine) the worker first
    spins for (k-1) times the time spent, and that is charged too. One clock read per
    switch of cell is all the hot path pays. */
-static double account(vw__worker *wk, int cell, double t0, double t1)
+static double account(vw__worker *wk, int cell, int rep, double t0, double t1)
 {
     const double *s = wk->w->cfg.worker_slowdown;
     if (s && s[wk->global] > 1.0) {
@@ -276,7 +301,8 @@ static double account(vw__worker *wk, int cell, double t0, double t1)
         }
     }
     wk->busy_s += t1 - t0;
-    if (cell >= 0) wk->w->cells[cell].busy_s += t1 - t0;
+    if (cell >= 0 && rep) wk->w->cells[cell].reps[rep - 1].busy_s += t1 - t0;
+    else if (cell >= 0) wk->w->cells[cell].busy_s += t1 - t0;
     return t1;
 }
 
@@ -284,22 +310,34 @@ static void handle_packet(vw__worker *wk, vw_ctx *ctx, vw__packet *p)
 {
     vw_world *w = wk->w;
     size_t off = 0;
-    int cur = -1;
+    int cur = -1, rep = 0;
+    void *state = NULL;
+    uint64_t *msgs_in = NULL;
     double t0 = vw__now();
     for (uint32_t i = 0; i < p->nmsgs; i++) {
         const vw__msg_header *h = (const vw__msg_header *)(p->data + off);
         if (h->cell != cur) {
-            t0 = account(wk, cur, t0, vw__now());
+            t0 = account(wk, cur, rep, t0, vw__now());
             cur = h->cell;
+            /* This worker's copy of the cell (the master, or a copy of a duplicated one). */
+            rep = vw__cell_rep_of(w, cur, wk->global);
+            if (rep < 0) {
+                fprintf(stderr, "vwalls: worker %d received a message for cell %d, which it "
+                        "does not host\n", wk->global, cur);
+                abort();
+            }
+            vw__cell *c = &w->cells[cur];
+            state = *unit_state(w, cur, rep);
+            msgs_in = rep ? &c->reps[rep - 1].messages_in : &c->messages_in;
         }
-        vw__cell *c = &w->cells[h->cell];
-        c->messages_in++;
+        (*msgs_in)++;
         ctx->cell = h->cell;
+        ctx->rep = rep;
         const vw_msg_kind *k = &w->m->kinds[h->kind];
-        if (k->handle) k->handle(ctx, c->state, p->data + off + sizeof *h);
+        if (k->handle) k->handle(ctx, state, p->data + off + sizeof *h);
         off += msg_stride(h->size);
     }
-    account(wk, cur, t0, vw__now());
+    account(wk, cur, rep, t0, vw__now());
     if (p->src >= 0 && vw__worker_process(w, p->src) == w->rank)
         atomic_fetch_sub(&w->workers[p->src - w->rank * w->nworkers].outstanding, p->used);
 }
@@ -313,12 +351,13 @@ static int run_step(vw__worker *wk, vw_ctx *ctx)
     if (!w->m->step || wk->ncells == 0) return 0;
     if (atomic_load(&wk->outstanding) > w->cfg.cap_bytes) return -1;
     for (int tries = 0; tries < wk->ncells; tries++) {
-        int cell = wk->cells[wk->step_cursor];
+        int cell = wk->cells[wk->step_cursor], rep = wk->cell_rep[wk->step_cursor];
         wk->step_cursor = (wk->step_cursor + 1) % wk->ncells;
         ctx->cell = cell;
+        ctx->rep = rep;
         double t0 = vw__now();
-        int did = w->m->step(ctx, w->cells[cell].state);
-        account(wk, cell, t0, vw__now());
+        int did = w->m->step(ctx, *unit_state(w, cell, rep));
+        account(wk, cell, rep, t0, vw__now());
         if (did) return 1;
     }
     return 0;
@@ -349,7 +388,7 @@ static void *worker_main(void *arg)
 {
     vw__worker *wk = arg;
     vw_world *w = wk->w;
-    vw_ctx ctx = {w, wk, -1};
+    vw_ctx ctx = {w, wk, -1, 0};
     for (;;) {
         pthread_mutex_lock(&wk->mu);
         vw__packet *p = take(wk);
@@ -452,6 +491,14 @@ static void *build_main(void *arg)
     wk->build_status = VW_OK;
     for (int i = 0; i < wk->ncells && wk->build_status == VW_OK; i++) {
         vw__cell *c = &wk->w->cells[wk->cells[i]];
+        int r = wk->cell_rep[i];
+        if (r) {
+            /* A copy rebuilds when the cell's objects changed since it was built. */
+            vw__replica *rp = &c->reps[r - 1];
+            if (rp->built && rp->built_version == c->version) continue;
+            wk->build_status = vw__world_build_replica(wk->w, wk->cells[i], r, wk);
+            continue;
+        }
         if (c->built && !c->dirty) continue;
         wk->build_status = vw__world_build_cell(wk->w, wk->cells[i], wk);
     }
@@ -472,11 +519,13 @@ vw_status vw__runtime_build(vw_world *w)
     return VW_OK;
 }
 
-/* The context handed to cell_build. */
-vw_status vw__world_build_cell(vw_world *w, int cell, vw__worker *wk)
+/* Builds copy rep of a cell (0: the master) from the cell's objects, in the order they
+   were added, on worker wk. */
+static vw_status build_unit(vw_world *w, int cell, int rep, vw__worker *wk)
 {
     vw__cell *c = &w->cells[cell];
-    vw_ctx ctx = {w, wk, cell};
+    vw__replica *rp = rep ? &c->reps[rep - 1] : NULL;
+    vw_ctx ctx = {w, wk, cell, rep};
     size_t osz = w->m->object_size;
     unsigned char *objs = NULL;
     if (c->nobjs) {
@@ -485,22 +534,45 @@ vw_status vw__world_build_cell(vw_world *w, int cell, vw__worker *wk)
         for (size_t i = 0; i < c->nobjs; i++)
             memcpy(objs + i * osz, w->objects + c->objs[i] * osz, osz);
     }
-    if (c->built && w->m->cell_free) w->m->cell_free(c->state, w->user);
-    c->state = NULL;
-    c->built = 0;
+    int *built = rp ? &rp->built : &c->built;
+    void **state = unit_state(w, cell, rep);
+    if (*built && w->m->cell_free) w->m->cell_free(*state, w->user);
+    *state = NULL;
+    *built = 0;
     vw_status st = VW_OK;
-    if (w->m->cell_build) st = w->m->cell_build(&ctx, objs, c->nobjs, &c->state);
+    if (w->m->cell_build) st = w->m->cell_build(&ctx, objs, c->nobjs, state);
     free(objs);
     if (st != VW_OK) return st;
-    c->built = 1;
-    c->dirty = 0;
+    *built = 1;
+    if (rp)
+        rp->built_version = c->version;
+    else
+        c->dirty = 0;
     return VW_OK;
+}
+
+/* The context handed to cell_build. */
+vw_status vw__world_build_cell(vw_world *w, int cell, vw__worker *wk)
+{
+    return build_unit(w, cell, 0, wk);
+}
+
+vw_status vw__world_build_replica(vw_world *w, int cell, int rep, vw__worker *wk)
+{
+    return build_unit(w, cell, rep, wk);
 }
 
 /* The module's load estimate of a cell, called between runs. */
 double vw__cell_load(vw_world *w, int cell)
 {
     vw__cell *c = &w->cells[cell];
-    vw_ctx ctx = {w, &w->workers[c->worker - w->rank * w->nworkers], cell};
+    vw_ctx ctx = {w, &w->workers[c->worker - w->rank * w->nworkers], cell, 0};
     return w->m->load(&ctx, c->state);
+}
+
+double vw__replica_load(vw_world *w, int cell, int rep)
+{
+    vw__replica *rp = &w->cells[cell].reps[rep - 1];
+    vw_ctx ctx = {w, &w->workers[rp->worker - w->rank * w->nworkers], cell, rep};
+    return w->m->load(&ctx, rp->state);
 }

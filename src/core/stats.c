@@ -119,6 +119,17 @@ static void write_body(vw_world *w, FILE *f, const char *command, const char *ex
             json_string(f, w->m->counters[k]);
             fprintf(f, ": %lld", (long long)vw_world_cell_counter(w, c, k));
         }
+        /* A duplicated cell: the figures above are the sums over the master and its
+           copies; each copy's worker and busy time follow. */
+        const vw__cell *cl = &w->cells[c];
+        if (cl->nreps) {
+            fprintf(f, ", \"replicas\": [");
+            for (int r = 0; r < cl->nreps; r++)
+                fprintf(f, "%s{\"worker\": %d, \"busy_s\": %.6f, \"messages_in\": %llu}", r ? ", " : "",
+                        cl->reps[r].worker, cl->reps[r].busy_s,
+                        (unsigned long long)cl->reps[r].messages_in);
+            fprintf(f, "], \"master_busy_s\": %.6f", cl->busy_s);
+        }
         fprintf(f, "}%s\n", c + 1 < w->ncells ? "," : "");
     }
     fprintf(f, "  ],\n  \"workers\": [\n");

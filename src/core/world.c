@@ -57,6 +57,32 @@ static int default_workers(void)
     return n < 1 ? 1 : (int)n;
 }
 
+/* The per-worker lists of what each worker of this process hosts: the cells it is the
+   master of, then the copies of duplicated cells (cell_rep says which). */
+static vw_status assign_units(vw_world *w)
+{
+    size_t cap = (size_t)w->ncells + (size_t)vw__replica_total(w);
+    for (int i = 0; i < w->nworkers; i++) {
+        vw__worker *wk = &w->workers[i];
+        wk->ncells = 0;
+        free(wk->cells);
+        free(wk->cell_rep);
+        wk->cells = malloc(sizeof(int) * (cap ? cap : 1));
+        wk->cell_rep = malloc(sizeof(int) * (cap ? cap : 1));
+        if (!wk->cells || !wk->cell_rep) return VW_E_NOMEM;
+        wk->step_cursor = 0;
+    }
+    for (int c = 0; c < w->ncells; c++)
+        for (int r = 0; r <= w->cells[c].nreps; r++) {
+            int g = r ? w->cells[c].reps[r - 1].worker : w->cell_worker[c];
+            if (vw__worker_process(w, g) != w->rank) continue;
+            vw__worker *wk = &w->workers[g - w->rank * w->nworkers];
+            wk->cells[wk->ncells] = c;
+            wk->cell_rep[wk->ncells++] = r;
+        }
+    return VW_OK;
+}
+
 /* Sets up cells -> workers and the per-worker cell lists for the current mapping. */
 static vw_status map_cells(vw_world *w, const int *cell_worker)
 {
@@ -68,21 +94,7 @@ static vw_status map_cells(vw_world *w, const int *cell_worker)
         w->cell_worker[c] = g;
         w->cells[c].worker = g;
     }
-    for (int i = 0; i < w->nworkers; i++) {
-        vw__worker *wk = &w->workers[i];
-        wk->ncells = 0;
-        free(wk->cells);
-        wk->cells = malloc(sizeof(int) * (size_t)(w->ncells ? w->ncells : 1));
-        if (!wk->cells) return VW_E_NOMEM;
-        wk->step_cursor = 0;
-    }
-    for (int c = 0; c < w->ncells; c++) {
-        int g = w->cell_worker[c];
-        if (vw__worker_process(w, g) != w->rank) continue;
-        vw__worker *wk = &w->workers[g - w->rank * w->nworkers];
-        wk->cells[wk->ncells++] = c;
-    }
-    return VW_OK;
+    return assign_units(w);
 }
 
 static vw_status alloc_cells(vw_world *w)
@@ -104,12 +116,21 @@ static vw_status alloc_cells(vw_world *w)
     return VW_OK;
 }
 
+static void free_replica(vw_world *w, vw__replica *r)
+{
+    if (r->built && w->m->cell_free) w->m->cell_free(r->state, w->user);
+    free(r->counters);
+}
+
 static void free_cells(vw_world *w)
 {
     if (!w->cells) return;
     for (int c = 0; c < w->ncells; c++) {
         vw__cell *cl = &w->cells[c];
         if (cl->built && w->m->cell_free) w->m->cell_free(cl->state, w->user);
+        for (int r = 0; r < cl->nreps; r++) free_replica(w, &cl->reps[r]);
+        free(cl->reps);
+        free(cl->rr);
         free(cl->objs);
         free(cl->counters);
     }
@@ -197,6 +218,7 @@ void vw_world_free(vw_world *w)
             free(wk->out);
             free(wk->tr_proc);
             free(wk->cells);
+            free(wk->cell_rep);
             while (wk->head) {
                 vw__packet *p = wk->head;
                 wk->head = p->next;
@@ -254,6 +276,7 @@ static vw_status place_object(vw_world *w, size_t id)
     for (int i = 0; i < n && st == VW_OK; i++) {
         st = cell_add_object(&w->cells[cells[i]], id);
         w->cells[cells[i]].dirty = 1;
+        w->cells[cells[i]].version++; /* its copies rebuild too */
     }
     free(cells);
     return st;
@@ -297,6 +320,7 @@ vw_status vw_world_update_object(vw_world *w, size_t id, const void *object)
                 memmove(&c->objs[k], &c->objs[k + 1], (c->nobjs - k - 1) * sizeof *c->objs);
                 c->nobjs--;
                 c->dirty = 1;
+                c->version++;
                 break;
             }
     }
@@ -403,6 +427,86 @@ vw_status vw_world_redecompose(vw_world *w, const vw_decomp *d, const int *cell_
     return st;
 }
 
+/* ---- duplicated cells --------------------------------------------------------------- */
+
+int vw__replica_total(const vw_world *w)
+{
+    int n = 0;
+    for (int c = 0; c < w->ncells; c++) n += w->cells[c].nreps;
+    return n;
+}
+
+int vw__cell_rep_of(const vw_world *w, int cell, int worker)
+{
+    const vw__cell *c = &w->cells[cell];
+    if (c->worker == worker) return 0;
+    for (int r = 0; r < c->nreps; r++)
+        if (c->reps[r].worker == worker) return r + 1;
+    return -1;
+}
+
+vw_status vw_world_set_replicas(vw_world *w, int cell, const int *workers, int n)
+{
+    if (!w || cell < 0 || cell >= w->ncells || n < 0 || (n && !workers)) return VW_E_INVAL;
+    vw__cell *c = &w->cells[cell];
+    if (n) {
+        int independent = 0;
+        for (int k = 0; k < w->m->nkinds; k++) independent |= (w->m->kinds[k].flags & VW_MSG_INDEPENDENT) != 0;
+        if (!independent)
+            return vw__world_error(w, VW_E_INVAL, "module '%s' has no independent message kind, "
+                                   "so its cells cannot be duplicated", w->m->name);
+    }
+    for (int i = 0; i < n; i++) {
+        int bad = workers[i] < 0 || workers[i] >= w->gworkers || workers[i] == c->worker;
+        for (int j = 0; j < i; j++) bad |= workers[j] == workers[i];
+        if (bad)
+            return vw__world_error(w, VW_E_INVAL, "cell %d cannot have a copy on worker %d", cell,
+                                   workers[i]);
+    }
+    vw__replica *nr = calloc((size_t)(n ? n : 1), sizeof *nr);
+    if (!nr) return VW_E_NOMEM;
+    size_t nc = (size_t)(w->m->ncounters > 0 ? w->m->ncounters : 1);
+    vw_status st = VW_OK;
+    for (int i = 0; i < n && st == VW_OK; i++) {
+        nr[i].worker = workers[i];
+        nr[i].counters = calloc(nc, sizeof(int64_t));
+        if (!nr[i].counters) st = VW_E_NOMEM;
+    }
+    unsigned *rr = n ? calloc((size_t)w->nworkers, sizeof *rr) : NULL;
+    if (n && !rr) st = VW_E_NOMEM;
+    if (st != VW_OK) {
+        for (int i = 0; i < n; i++) free(nr[i].counters);
+        free(nr);
+        return st;
+    }
+    for (int i = 0; i < n; i++)
+        for (int r = 0; r < c->nreps; r++)
+            if (c->reps[r].worker == workers[i]) {
+                /* A copy that stays on its worker keeps its state and figures. */
+                free(nr[i].counters);
+                nr[i] = c->reps[r];
+                c->reps[r].built = 0;
+                c->reps[r].counters = NULL;
+            }
+    for (int r = 0; r < c->nreps; r++) free_replica(w, &c->reps[r]);
+    free(c->reps);
+    free(c->rr);
+    c->rr = rr;
+    c->reps = n ? nr : NULL;
+    c->nreps = n;
+    if (!n) free(nr);
+    w->committed = 0;
+    return assign_units(w);
+}
+
+int vw_world_replicas(const vw_world *w, int cell, int *out, int max)
+{
+    if (!w || cell < 0 || cell >= w->ncells) return 0;
+    const vw__cell *c = &w->cells[cell];
+    for (int r = 0; r < c->nreps && r < max && out; r++) out[r] = c->reps[r].worker;
+    return c->nreps;
+}
+
 /* ---- facts and measurements --------------------------------------------------------- */
 
 int vw_world_process(const vw_world *w) { return w->rank; }
@@ -429,6 +533,19 @@ vw_status vw_world_cell_stats(const vw_world *w, int cell, vw_cell_stats *out)
         out->load = vw__cell_load((vw_world *)w, cell);
     else if (w->m->load && w->nprocs > 1)
         out->load = c->load; /* the hosting process's figure at the last run's end */
+    /* A duplicated cell's figures are the sums over its master and copies. */
+    out->replicas = c->nreps;
+    for (int r = 0; r < c->nreps; r++) {
+        const vw__replica *rp = &c->reps[r];
+        out->messages_in += rp->messages_in;
+        out->busy_s += rp->busy_s;
+        if (!w->m->load)
+            out->load += rp->busy_s;
+        else if (rp->built && vw__worker_process(w, rp->worker) == w->rank)
+            out->load += vw__replica_load((vw_world *)w, cell, r + 1);
+        else
+            out->load += rp->load;
+    }
     return VW_OK;
 }
 
@@ -436,15 +553,33 @@ double vw_world_worker_busy(const vw_world *w, int g)
 {
     if (g < 0 || g >= w->gworkers) return 0;
     double s = 0;
-    for (int c = 0; c < w->ncells; c++)
+    for (int c = 0; c < w->ncells; c++) {
         if (w->cells[c].worker == g) s += w->cells[c].busy_s;
+        for (int r = 0; r < w->cells[c].nreps; r++)
+            if (w->cells[c].reps[r].worker == g) s += w->cells[c].reps[r].busy_s;
+    }
     return s;
 }
 
 int64_t vw_world_cell_counter(const vw_world *w, int cell, int idx)
 {
     if (cell < 0 || cell >= w->ncells || idx < 0 || idx >= w->m->ncounters) return 0;
-    return w->cells[cell].counters[idx];
+    int64_t s = w->cells[cell].counters[idx];
+    for (int r = 0; r < w->cells[cell].nreps; r++) s += w->cells[cell].reps[r].counters[idx];
+    return s;
+}
+
+int64_t vw_world_worker_counter(const vw_world *w, int g, int idx)
+{
+    if (!w || idx < 0 || idx >= w->m->ncounters) return 0;
+    int64_t s = 0;
+    for (int c = 0; c < w->ncells; c++) {
+        const vw__cell *cl = &w->cells[c];
+        if (cl->worker == g) s += cl->counters[idx];
+        for (int r = 0; r < cl->nreps; r++)
+            if (cl->reps[r].worker == g) s += cl->reps[r].counters[idx];
+    }
+    return s;
 }
 
 int64_t vw_world_counter(const vw_world *w, int idx)
@@ -471,6 +606,12 @@ void vw_world_reset_stats(vw_world *w)
         w->cells[c].busy_s = 0;
         w->cells[c].messages_in = 0;
         memset(w->cells[c].counters, 0, sizeof(int64_t) * (size_t)(w->m->ncounters > 0 ? w->m->ncounters : 1));
+        for (int r = 0; r < w->cells[c].nreps; r++) {
+            vw__replica *rp = &w->cells[c].reps[r];
+            rp->busy_s = 0;
+            rp->messages_in = 0;
+            memset(rp->counters, 0, sizeof(int64_t) * (size_t)(w->m->ncounters > 0 ? w->m->ncounters : 1));
+        }
     }
     for (int i = 0; i < w->nworkers; i++) {
         vw__worker *wk = &w->workers[i];

@@ -10,7 +10,10 @@
  *    and gives it back only when the processes have agreed on global quiescence, so
  *    local quiescence alone never ends a run;
  *  - a cell's measurements (messages_in, busy_s, counters) are written only by the
- *    process hosting it; after every run the other processes receive copies.
+ *    process hosting it; after every run the other processes receive copies;
+ *  - a duplicated cell's copies (vw__replica) follow the same rules each: one worker
+ *    touches a copy's state and figures, and a worker hosts at most one copy of a cell
+ *    (the master counts as one), so (cell, worker) names the copy a message is for.
  */
 #ifndef VW_WORLD_INTERNAL_H
 #define VW_WORLD_INTERNAL_H
@@ -39,6 +42,20 @@ typedef struct vw__packet {
     unsigned char data[];
 } vw__packet;
 
+/* A copy of a duplicated cell on another worker (balance strategy "duplicate"): its
+   own module state built from the cell's objects, and its own figures, which add up
+   with the master's to the cell's. */
+typedef struct vw__replica {
+    int worker;              /* global worker id, never the master's */
+    void *state;
+    int built;
+    unsigned built_version;  /* the cell's version it was built from */
+    uint64_t messages_in;
+    double busy_s;
+    int64_t *counters;       /* module counters, ncounters */
+    double load;             /* load() of the hosting process at the last run's end */
+} vw__replica;
+
 typedef struct vw__cell {
     int worker;              /* global worker id */
     void *state;             /* the module's cell state */
@@ -49,6 +66,12 @@ typedef struct vw__cell {
     double busy_s;
     int64_t *counters;       /* module counters, ncounters */
     double load;             /* load() of the hosting process at the last run's end */
+    unsigned version;        /* bumped whenever the cell's objects change (copies rebuild) */
+    vw__replica *reps;       /* copies besides the master, nreps of them */
+    int nreps;
+    unsigned *rr;            /* duplicated cells: per local worker, the next copy to send to
+                                (one counter per sender and cell, so each cell's copies get
+                                equal shares whatever else the sender sends) */
 } vw__cell;
 
 typedef struct vw__worker {
@@ -61,7 +84,8 @@ typedef struct vw__worker {
     int busy;
     atomic_size_t outstanding; /* bytes this worker sent that are not yet handled */
     vw__packet **out;          /* open packet per destination: [0..G) workers, [G] output */
-    int *cells, ncells;        /* the cells this worker hosts */
+    int *cells, ncells;        /* the cells this worker hosts (masters and copies) */
+    int *cell_rep;             /* per entry of cells: 0 = the master, r = copy reps[r-1] */
     int step_cursor;
     uint64_t rng;              /* stress switch */
     double busy_s;
@@ -139,6 +163,12 @@ vw_status vw__world_error(vw_world *w, vw_status st, const char *fmt, ...)
     __attribute__((format(printf, 3, 4)));
 int vw__worker_process(const vw_world *w, int global_worker);
 vw_status vw__world_build_cell(vw_world *w, int cell, vw__worker *wk);
+vw_status vw__world_build_replica(vw_world *w, int cell, int rep, vw__worker *wk);
+/* Which copy of cell this global worker hosts: 0 = the master, r >= 1 = reps[r-1],
+   -1 = none. */
+int vw__cell_rep_of(const vw_world *w, int cell, int worker);
+/* Copies over all cells. */
+int vw__replica_total(const vw_world *w);
 
 /* runtime.c */
 vw_status vw__runtime_run(vw_world *w);
@@ -152,6 +182,8 @@ void vw__run_output(vw_world *w, const vw__packet *p);
 void vw__uncount(vw_world *w);
 uint64_t vw__rng_next(uint64_t *s);
 double vw__cell_load(vw_world *w, int cell);
+/* load() of copy rep (>= 1) of cell, hosted by this process. */
+double vw__replica_load(vw_world *w, int cell, int rep);
 /* Fills w->wstats from this process's workers (the other processes' entries zero). */
 void vw__stats_local(vw_world *w);
 uint64_t vw__peak_rss(void);

@@ -364,12 +364,15 @@ static vw_status tp_run(vw_world *w)
 /* ---- after a run: every process gets the whole job's figures -------------------------- */
 
 /* A cell's figures are written only by its host, the others hold zeros or a copy from
-   the last sync, so a sum where only the host contributes gives the host's figures. */
+   the last sync, so a sum where only the host contributes gives the host's figures.
+   The copies of duplicated cells follow the cells, as rows of their own (every process
+   knows the same copies, so the layout agrees), each contributed by its own host. */
 static vw_status tp_sync(vw_world *w)
 {
     mpi_tp *t = tp_of(w);
     int nc = w->m->ncounters;
-    size_t ni = (size_t)w->ncells * (size_t)(1 + nc), nd = (size_t)w->ncells * 2;
+    size_t nu = (size_t)w->ncells + (size_t)vw__replica_total(w); /* cells, then copies */
+    size_t ni = nu * (size_t)(1 + nc), nd = nu * 2;
     size_t nw = (size_t)w->gworkers;
     int64_t *iv = calloc(ni + 6 * nw, sizeof *iv);
     double *dv = calloc(nd + nw, sizeof *dv);
@@ -387,6 +390,17 @@ static vw_status tp_sync(vw_world *w)
         dv[2 * c] = cl->busy_s;
         dv[2 * c + 1] = w->m->load && cl->built ? vw__cell_load(w, c) : cl->busy_s;
     }
+    size_t u = (size_t)w->ncells;
+    for (int c = 0; c < w->ncells; c++)
+        for (int r = 0; r < w->cells[c].nreps; r++, u++) {
+            vw__replica *rp = &w->cells[c].reps[r];
+            if (vw__worker_process(w, rp->worker) != w->rank) continue;
+            int64_t *row = iv + u * (size_t)(1 + nc);
+            row[0] = (int64_t)rp->messages_in;
+            for (int k = 0; k < nc; k++) row[1 + k] = rp->counters[k];
+            dv[2 * u] = rp->busy_s;
+            dv[2 * u + 1] = w->m->load && rp->built ? vw__replica_load(w, c, r + 1) : rp->busy_s;
+        }
     int64_t *wv = iv + ni;
     for (int i = 0; i < w->nworkers; i++) {
         const vw__worker_stats *s = &w->wstats[w->workers[i].global];
@@ -409,6 +423,16 @@ static vw_status tp_sync(vw_world *w)
         cl->busy_s = dv[2 * c];
         cl->load = dv[2 * c + 1];
     }
+    u = (size_t)w->ncells;
+    for (int c = 0; c < w->ncells; c++)
+        for (int r = 0; r < w->cells[c].nreps; r++, u++) {
+            vw__replica *rp = &w->cells[c].reps[r];
+            const int64_t *row = iv + u * (size_t)(1 + nc);
+            rp->messages_in = (uint64_t)row[0];
+            for (int k = 0; k < nc; k++) rp->counters[k] = row[1 + k];
+            rp->busy_s = dv[2 * u];
+            rp->load = dv[2 * u + 1];
+        }
     for (size_t g = 0; g < nw; g++) {
         vw__worker_stats *s = &w->wstats[g];
         const int64_t *row = wv + 6 * g;

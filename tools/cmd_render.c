@@ -36,13 +36,15 @@ static void help(void)
            "  --stats FILE     write the stats JSON\n"
            "  --overlay FILE   write a PNG of the image with the walls drawn and each cell's\n"
            "                   pixels tinted by its measured load (green light .. red heavy)\n"
-           "  --balance S      none|tensor|rotate|staggered|divide: a sparse pre-pass measures\n"
-           "                   where the work lies, the balancer moves the walls, then the\n"
-           "                   full render (the image does not change)\n"
+           "  --balance S      none|tensor|rotate|staggered|divide|duplicate: a sparse pre-pass\n"
+           "                   measures where the work lies, the balancer moves the walls (or,\n"
+           "                   duplicate, copies overloaded cells to idle workers, which share\n"
+           "                   their rays), then the full render (the image does not change)\n"
            "  --balance-load M busy (measured time, default) | segments (counted ray-cell\n"
            "                   visits: deterministic) | model (objects + pixels + messages)\n"
            "  --balance-iters N  pre-pass / balance rounds (default 2)\n"
-           "  --prepass N      pre-pass traces every N-th row and column (default 8)\n"
+           "  --prepass N      pre-pass traces every N-th row and column (default: about 256\n"
+           "                   eye rays per cell, N between 1 and 8)\n"
            "  --map K          block (default) | greedy (by load) | weighted (by --speeds)\n"
            "  --speeds LIST    relative speed of every worker, like 1,1,2,4\n"
            "  --slow W:K[,..]  worker W does its work K times slower (emulates a slow machine)\n"
@@ -111,7 +113,9 @@ static char *with_balance_json(char *rt, rt_job *job, vw_world *w, const vw_traf
              "\"load_model\": \"%s\", \"rounds\": %d, \"imbalance_before\": %.6g, "
              "\"imbalance_predicted\": %.6g, \"imbalance_after\": %.6g, "
              "\"imbalance_work\": %.6g, \"migrated_objects\": %llu, \"bytes_moved\": %llu, "
-             "\"max_neighbours\": %d, \"prepass_s\": %.6f, \"balance_s\": %.6f},\n"
+             "\"max_neighbours\": %d, \"prepass_s\": %.6f, \"balance_s\": %.6f, "
+             "\"prepass_stride\": %d, \"reverted\": %d, \"imbalance_measured\": %.6g, "
+             "\"duplicates\": %d},\n"
              "  \"traffic\": {\"messages\": %llu, \"bytes\": %llu, \"worker_messages\": %llu, "
              "\"worker_bytes\": %llu, \"process_messages\": %llu, \"process_bytes\": %llu, "
              "\"machine_messages\": %llu, \"machine_bytes\": %llu, \"share_worker\": %.6g, "
@@ -121,7 +125,8 @@ static char *with_balance_json(char *rt, rt_job *job, vw_world *w, const vw_traf
              bi->rep.imbalance_before, bi->rep.imbalance_predicted, vw_world_imbalance(w),
              rt_job_work_imbalance(job, speeds), (unsigned long long)bi->migrated,
              (unsigned long long)bi->bytes, vw_decomp_max_neighbours(vw_world_decomp(w)),
-             bi->prepass_s, vw_world_time(w, "balance"), (unsigned long long)tr->msgs,
+             bi->prepass_s, vw_world_time(w, "balance"), bi->stride, bi->reverted, bi->measured,
+             bi->rep.duplicates, (unsigned long long)tr->msgs,
              (unsigned long long)tr->bytes, (unsigned long long)tr->msgs_worker,
              (unsigned long long)tr->bytes_worker, (unsigned long long)tr->msgs_process,
              (unsigned long long)tr->bytes_process, (unsigned long long)tr->msgs_machine,
@@ -144,7 +149,7 @@ int vw_cmd_render(int argc, char **argv)
     vw_balance_strategy strategy = VW_BALANCE_NONE;
     vw_map_kind map = VW_MAP_BLOCK;
     int map_given = 0, by_worker = 0;
-    long iters = 2, prepass = 8;
+    long iters = 2, prepass = 0; /* 0: rt_prepass_stride() */
     vw_load_spec lspec;
     vw_load_spec_init(&lspec);
     for (int i = 1; i < argc; i++) {
@@ -174,9 +179,9 @@ int vw_cmd_render(int argc, char **argv)
             if (!(overlay = vw_cli_value(CMD, argc, argv, &i))) return VW_EXIT_USAGE;
         } else if (!strcmp(a, "--balance")) {
             if (!(v = vw_cli_value(CMD, argc, argv, &i))) return VW_EXIT_USAGE;
-            if (vw_balance_strategy_parse(v, &strategy) != VW_OK || strategy == VW_BALANCE_DUPLICATE) {
+            if (vw_balance_strategy_parse(v, &strategy) != VW_OK) {
                 vw_cli_error(CMD, "--balance: bad value '%s' (expected none, tensor, rotate, "
-                                  "staggered or divide)", v);
+                                  "staggered, divide or duplicate)", v);
                 return VW_EXIT_USAGE;
             }
         } else if (!strcmp(a, "--balance-load")) {

@@ -3,6 +3,7 @@
  * reset for the full render. The image cannot change: the pixel sums are exact integers
  * and every ray's first hit is the same for every decomposition (raytrace.h).
  */
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -18,18 +19,18 @@ static double now(void)
 
 double rt_job_work_imbalance(const rt_job *j, const double *speeds)
 {
+    /* Per worker, so the copies of duplicated cells count where they ran. */
     vw_world *w = rt_job_world((rt_job *)j);
-    int nc = vw_decomp_cell_count(vw_world_decomp(w));
-    double *load = malloc(sizeof(double) * (size_t)nc);
-    int *map = malloc(sizeof(int) * (size_t)nc);
+    int gw = vw_world_workers(w) * vw_world_processes(w);
+    double *load = malloc(sizeof(double) * (size_t)gw);
+    int *map = malloc(sizeof(int) * (size_t)gw);
     double lam = 0;
     if (load && map) {
-        for (int c = 0; c < nc; c++) {
-            load[c] = (double)vw_world_cell_counter(w, c, RT_C_SEGMENTS);
-            map[c] = vw_world_cell_worker(w, c);
+        for (int g = 0; g < gw; g++) {
+            load[g] = (double)vw_world_worker_counter(w, g, RT_C_SEGMENTS);
+            map[g] = g;
         }
-        lam = vw_balance_imbalance(load, map, nc, vw_world_workers(w) * vw_world_processes(w),
-                                   speeds);
+        lam = vw_balance_imbalance(load, map, gw, gw, speeds);
     }
     free(load);
     free(map);
@@ -51,18 +52,101 @@ vw_status rt_job_map(rt_job *j, vw_map_kind kind, const double *load, const doub
     return st;
 }
 
-/* Rebuilds the cells in place (same walls, same workers: nothing migrates), for cells
-   that were last built for the pre-pass's sparse pixels. */
+/* Rebuilds the cells in place (same walls, same workers, same copies of duplicated
+   cells: nothing migrates), for cells that were last built for the pre-pass's sparse
+   pixels. */
 static vw_status rebuild(vw_world *w)
 {
     const vw_decomp *d = vw_world_decomp(w);
-    int nc = vw_decomp_cell_count(d);
+    int nc = vw_decomp_cell_count(d), gw = vw_world_workers(w) * vw_world_processes(w);
     int *cw = malloc(sizeof(int) * (size_t)nc);
-    if (!cw) return VW_E_NOMEM;
-    for (int c = 0; c < nc; c++) cw[c] = vw_world_cell_worker(w, c);
-    vw_status st = vw_world_redecompose(w, d, cw);
-    free(cw);
+    int *nrep = calloc((size_t)nc, sizeof *nrep);
+    int *reps = malloc(sizeof(int) * (size_t)nc * (size_t)gw);
+    if (!cw || !nrep || !reps) {
+        free(cw), free(nrep), free(reps);
+        return VW_E_NOMEM;
+    }
+    for (int c = 0; c < nc; c++) {
+        cw[c] = vw_world_cell_worker(w, c);
+        nrep[c] = vw_world_replicas(w, c, reps + (size_t)c * gw, gw);
+    }
+    vw_status st = vw_world_redecompose(w, d, cw); /* (drops the copies) */
+    for (int c = 0; c < nc && st == VW_OK; c++)
+        if (nrep[c]) st = vw_world_set_replicas(w, c, reps + (size_t)c * gw, nrep[c]);
+    free(cw), free(nrep), free(reps);
     return st;
+}
+
+/* A layout to come back to: walls, mapping and copies of duplicated cells. */
+typedef struct layout {
+    vw_decomp *d;
+    int *cw, *nrep, *reps;
+    int gw;
+} layout;
+
+static void layout_free(layout *l)
+{
+    vw_decomp_free(l->d);
+    free(l->cw), free(l->nrep), free(l->reps);
+    memset(l, 0, sizeof *l);
+}
+
+static vw_status layout_save(vw_world *w, layout *l)
+{
+    layout_free(l);
+    int nc = vw_decomp_cell_count(vw_world_decomp(w));
+    l->gw = vw_world_workers(w) * vw_world_processes(w);
+    l->cw = malloc(sizeof(int) * (size_t)nc);
+    l->nrep = malloc(sizeof(int) * (size_t)nc);
+    l->reps = malloc(sizeof(int) * (size_t)nc * (size_t)l->gw);
+    if (!l->cw || !l->nrep || !l->reps) return VW_E_NOMEM;
+    for (int c = 0; c < nc; c++) {
+        l->cw[c] = vw_world_cell_worker(w, c);
+        l->nrep[c] = vw_world_replicas(w, c, l->reps + (size_t)c * l->gw, l->gw);
+    }
+    return vw_decomp_clone(vw_world_decomp(w), &l->d);
+}
+
+static vw_status layout_restore(vw_world *w, const layout *l)
+{
+    vw_status st = vw_world_redecompose(w, l->d, l->cw);
+    int nc = vw_decomp_cell_count(l->d);
+    for (int c = 0; c < nc && st == VW_OK; c++)
+        if (l->nrep[c]) st = vw_world_set_replicas(w, c, l->reps + (size_t)c * l->gw, l->nrep[c]);
+    return st;
+}
+
+/* lambda of the last run's loads per worker (copies of duplicated cells where they ran). */
+static double measured_lambda(vw_world *w, const vw_load_spec *ls, const double *cell_load,
+                              const double *speeds)
+{
+    int gw = vw_world_workers(w) * vw_world_processes(w);
+    int nc = vw_decomp_cell_count(vw_world_decomp(w));
+    double *t = calloc((size_t)gw, sizeof *t);
+    int *id = malloc(sizeof(int) * (size_t)gw);
+    double lam = 0;
+    if (t && id) {
+        for (int g = 0; g < gw; g++) id[g] = g;
+        if (ls->model == VW_LOAD_COUNTER)
+            for (int g = 0; g < gw; g++) t[g] = (double)vw_world_worker_counter(w, g, ls->counter);
+        else if (ls->model == VW_LOAD_BUSY)
+            for (int g = 0; g < gw; g++) t[g] = vw_world_worker_busy(w, g);
+        else
+            for (int c = 0; c < nc; c++) t[vw_world_cell_worker(w, c)] += cell_load[c];
+        lam = vw_balance_imbalance(t, id, gw, gw, speeds);
+    }
+    free(t), free(id);
+    return lam;
+}
+
+int rt_prepass_stride(int width, int height, int cells)
+{
+    /* At least RT_PREPASS_RAYS eye rays per cell on average: a cell's measured load is a
+       sum over its sampled rays, so its relative error falls like 1/sqrt(rays); with a
+       fixed stride, 64 cells of a 256x256 image would see 16 rays each. */
+    double want = (double)RT_PREPASS_RAYS * (cells > 0 ? cells : 1);
+    int s = (int)floor(sqrt((double)width * height / want));
+    return s < 1 ? 1 : s > 8 ? 8 : s;
 }
 
 vw_status rt_job_balance(rt_job *j, const rt_balance *b, rt_balance_result *bi, char *err,
@@ -75,9 +159,19 @@ vw_status rt_job_balance(rt_job *j, const rt_balance *b, rt_balance_result *bi, 
     double *load = malloc(sizeof(double) * VW_MAX_CELLS);
     vw_status st = load ? vw_load_field_create(&f) : VW_E_NOMEM;
     int stale = 0; /* cells are built for the sparse pre-pass */
-    rt_job_set_sample(j, b->stride);
+    const rt_shared *sh = rt_job_shared(j);
+    int stride = b->stride > 0 ? b->stride
+                               : rt_prepass_stride(sh->view.width, sh->view.height,
+                                                   vw_decomp_cell_count(vw_world_decomp(w)));
+    rt_job_set_sample(j, stride);
+    bi->stride = stride;
     int rounds = b->rounds > 0 ? b->rounds : 1;
-    for (int r = 0; st == VW_OK && r < rounds; r++) {
+    /* Every balance is checked by the next pre-pass: the best measured layout so far is
+       kept, and a balance the measurement refutes (lambda no lower than before) is undone
+       and ends the rounds. So with R rounds there are R + 1 pre-passes. */
+    layout best = {0};
+    double best_lam = 0;
+    for (int r = 0; st == VW_OK && r <= rounds; r++) {
         double t0 = now();
         st = rt_job_reset(j);
         /* Cells built before the sample was set (the caller's commit) must be rebuilt. */
@@ -89,9 +183,26 @@ vw_status rt_job_balance(rt_job *j, const rt_balance *b, rt_balance_result *bi, 
         bi->prepass_s += now() - t0;
         const vw_decomp *d = vw_world_decomp(w);
         st = vw_balance_cell_loads(w, &b->load, load);
-        if (st == VW_OK)
-            st = r == 0 ? vw_load_field_add_cells(f, d, load, 4)
-                        : vw_load_field_calibrate(f, d, load, 4);
+        if (st != VW_OK) {
+            snprintf(err, errlen, "the load field: %s", vw_status_message(st));
+            break;
+        }
+        double lam = measured_lambda(w, &b->load, load, b->speeds);
+        if (r > 0 && b->strategy != VW_BALANCE_NONE && !(lam < best_lam)) {
+            /* Refuted: back to the best layout measured (its cells are built for the
+               pre-pass as the others, so stale stays). */
+            st = layout_restore(w, &best);
+            bi->reverted++;
+            break;
+        }
+        if (b->strategy != VW_BALANCE_NONE) {
+            best_lam = lam;
+            bi->measured = lam;
+            st = layout_save(w, &best);
+            if (st != VW_OK) break;
+        }
+        if (r == rounds) break;
+        st = r == 0 ? vw_load_field_add_cells(f, d, load, 4) : vw_load_field_calibrate(f, d, load, 4);
         if (st != VW_OK) {
             snprintf(err, errlen, "the load field: %s", vw_status_message(st));
             break;
@@ -120,8 +231,9 @@ vw_status rt_job_balance(rt_job *j, const rt_balance *b, rt_balance_result *bi, 
         bi->migrated += rep.migrated_objects;
         bi->bytes += rep.bytes_moved;
         bi->rounds++;
-        if (rep.applied) stale = 0;
+        if (!rep.applied) break; /* nothing changed: measuring again would tell nothing */
     }
+    layout_free(&best);
     rt_job_set_sample(j, 1);
     if (st == VW_OK && stale) st = rebuild(w);
     if (st == VW_OK) st = rt_job_reset(j);

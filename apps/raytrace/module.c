@@ -153,7 +153,9 @@ static void spawn(vw_ctx *ctx, rt_cell *c, rt_ray *r)
     }
     r->t0 = s.t0;
     r->t1 = s.t1;
-    if (s.cell == vw_ctx_cell(ctx))
+    /* The master of a duplicated cell shares the eye rays it creates: sent to itself,
+       they go to the master and its copies in turn (rays are independent messages). */
+    if (s.cell == vw_ctx_cell(ctx) && !(r->kind == RT_EYE && vw_ctx_replicas(ctx) > 0))
         trace(ctx, c, r);
     else
         vw_send_cell(ctx, s.cell, RT_K_RAY, r);
@@ -435,7 +437,9 @@ static int step(vw_ctx *ctx, void *state)
         c->frame = c->sh->frame;
         c->next = 0;
     }
-    if (c->next < c->npixels) {
+    /* Eye rays are the master's work: a copy of a duplicated cell gets its share as
+       messages, and only flushes here. */
+    if (c->next < c->npixels && vw_ctx_replica(ctx) == 0) {
         const rt_view *v = &c->sh->view;
         size_t end = c->next + RT_BATCH < c->npixels ? c->next + RT_BATCH : c->npixels;
         vw_count(ctx, RT_C_PIXELS, (int64_t)(end - c->next));
@@ -473,7 +477,9 @@ static void object_bounds(const void *object, vw_box *out, void *user)
 }
 
 static const vw_msg_kind kinds[] = {
-    {"ray", sizeof(rt_ray), handle_ray, NULL},
+    /* A ray reads only its cell's objects and the shared lights: any copy of a
+       duplicated cell traces it alike. */
+    {"ray", sizeof(rt_ray), handle_ray, NULL, VW_MSG_INDEPENDENT},
     {"pixels", sizeof(rt_package), NULL, output_pixels},
 };
 

@@ -174,20 +174,31 @@ typedef struct rt_balance {
     const double *speeds;     /* per global worker, or NULL */
     vw_load_spec load;        /* what a cell's load is */
     int rounds;               /* pre-pass / balance rounds (>= 1) */
-    int stride;               /* the pre-pass traces every stride-th row and column */
+    int stride;               /* the pre-pass traces every stride-th row and column;
+                                 0: rt_prepass_stride() */
 } rt_balance;
+
+/* Eye rays per cell the automatic pre-pass aims at. */
+#define RT_PREPASS_RAYS 256
+/* The pre-pass stride for an image and a cell count: about RT_PREPASS_RAYS eye rays per
+   cell, between 1 (every pixel) and 8. */
+int rt_prepass_stride(int width, int height, int cells);
 
 typedef struct rt_balance_result {
     vw_balance_report rep;    /* the first round's "before", the last round's prediction */
     uint64_t migrated, bytes; /* over all rounds */
     int rounds;
     double prepass_s;
+    int stride;               /* the pre-pass stride used */
+    int reverted;             /* 1: the last balance was refuted by its pre-pass, undone */
+    double measured;          /* lambda the pre-pass measured on the layout kept */
 } rt_balance_result;
 
 /* Single image: a cheap sparse pre-pass measures where the work lies, the balancer
    builds the load field and moves the walls (repeated b->rounds times, each pre-pass
-   re-calibrating the field on the new layout); then the job is reset for the full
-   render (commit + run). Strategy none with map greedy/weighted maps by the measured
+   re-calibrating the field on the new layout, and each balance checked by the next
+   pre-pass: one that does not lower the measured lambda is undone and ends the rounds);
+   then the job is reset for the full render (commit + run). Strategy none with map greedy/weighted maps by the measured
    loads instead. Collective under MPI. */
 vw_status rt_job_balance(rt_job *j, const rt_balance *b, rt_balance_result *out, char *err,
                          size_t errlen);

@@ -7,6 +7,7 @@
 #include "vwalls/map.h"
 
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -58,6 +59,86 @@ vw_status vw_balance_decompose(const vw_decomp *current, const vw_load_field *f,
     return VW_E_INVAL;
 }
 
+/* lambda of per-cell loads on the world's current mapping, each duplicated cell's load
+   shared equally by its master and copies (as the runtime shares its rays). */
+static double units_lambda(const vw_world *w, const double *load, const double *speeds)
+{
+    double *t = calloc((size_t)w->gworkers, sizeof *t);
+    if (!t) return 0;
+    for (int c = 0; c < w->ncells; c++) {
+        const vw__cell *cl = &w->cells[c];
+        double share = load[c] / (cl->nreps + 1);
+        t[cl->worker] += share;
+        for (int r = 0; r < cl->nreps; r++) t[cl->reps[r].worker] += share;
+    }
+    double max = 0, sum = 0;
+    for (int g = 0; g < w->gworkers; g++) {
+        double x = speeds ? t[g] / speeds[g] : t[g];
+        sum += x;
+        if (x > max) max = x;
+    }
+    free(t);
+    return sum > 0 ? max / (sum / w->gworkers) : 1.0;
+}
+
+/* Duplication: the walls stay, overloaded cells get copies on underloaded workers (the
+   plan replaces any copies from an earlier round). Objects that move are the
+   duplicated cells' objects a receiving worker did not hold yet. */
+static vw_status balance_duplicate(vw_world *w, const double *load, const vw_balance_params *p,
+                                   const vw_balance_apply *a, vw_balance_report *r)
+{
+    int max_extra = p->max_extra > 0 ? p->max_extra : 4 * w->gworkers;
+    int *pc = malloc(sizeof(int) * (size_t)max_extra), *pw = malloc(sizeof(int) * (size_t)max_extra);
+    int *list = malloc(sizeof(int) * (size_t)w->gworkers);
+    int np = 0;
+    vw_status st = pc && pw && list ? VW_OK : VW_E_NOMEM;
+    int independent = 0;
+    for (int k = 0; k < w->m->nkinds; k++) independent |= (w->m->kinds[k].flags & VW_MSG_INDEPENDENT) != 0;
+    r->imbalance_before = units_lambda(w, load, p->speeds);
+    r->imbalance_predicted = r->imbalance_before;
+    r->cells = w->ncells;
+    r->max_neighbours = vw_decomp_max_neighbours(w->decomp);
+    if (st == VW_OK && independent)
+        st = vw__balance_duplicate_plan(load, w->cell_worker, w->ncells, w->gworkers, p->speeds,
+                                        p->tolerance, max_extra, pc, pw, &np,
+                                        &r->imbalance_predicted);
+    int pays = st == VW_OK && independent && r->imbalance_predicted < r->imbalance_before;
+    if (pays && a && a->last_compute_s > 0)
+        pays = (1.0 - r->imbalance_predicted / r->imbalance_before) * a->last_compute_s > a->rebuild_s;
+    if (!pays) r->imbalance_predicted = r->imbalance_before;
+    /* (object, worker) pairs held before, to count what the copies move. */
+    size_t gw = (size_t)w->gworkers;
+    unsigned char *held = pays ? calloc(w->nobjects ? w->nobjects * gw : 1, 1) : NULL;
+    if (pays && !held) st = VW_E_NOMEM;
+    for (int c = 0; pays && st == VW_OK && c < w->ncells; c++) {
+        const vw__cell *cl = &w->cells[c];
+        for (int u = 0; u <= cl->nreps; u++) {
+            size_t g = (size_t)(u ? cl->reps[u - 1].worker : cl->worker);
+            for (size_t i = 0; i < cl->nobjs; i++) held[cl->objs[i] * gw + g] = 1;
+        }
+    }
+    for (int c = 0; pays && st == VW_OK && c < w->ncells; c++) {
+        int n = 0;
+        for (int i = 0; i < np; i++)
+            if (pc[i] == c) list[n++] = pw[i];
+        if (n == 0 && w->cells[c].nreps == 0) continue;
+        st = vw_world_set_replicas(w, c, list, n);
+        const vw__cell *cl = &w->cells[c];
+        for (int k = 0; st == VW_OK && k < n; k++)
+            for (size_t i = 0; i < cl->nobjs; i++) {
+                unsigned char *h = &held[cl->objs[i] * gw + (size_t)list[k]];
+                if (!*h) r->migrated_objects++;
+                *h = 1;
+            }
+        r->duplicates += n;
+    }
+    free(held);
+    r->bytes_moved = r->migrated_objects * (uint64_t)w->m->object_size;
+    r->applied = pays && st == VW_OK;
+    free(pc), free(pw), free(list);
+    return st;
+}
+
 vw_status vw_balance_world(vw_world *w, const vw_load_field *f, const vw_balance_params *p,
                            const vw_balance_apply *a, vw_balance_report *rep)
 {
@@ -79,7 +160,12 @@ vw_status vw_balance_world(vw_world *w, const vw_load_field *f, const vw_balance
     vw_status st = load && map ? VW_OK : VW_E_NOMEM;
     if (st == VW_OK) {
         vw_load_field_cell_loads(f, w->decomp, load);
-        r.imbalance_before = vw_balance_imbalance(load, w->cell_worker, w->ncells, w->gworkers, speeds);
+        /* With duplicated cells, their copies carry their share (units_lambda). */
+        r.imbalance_before = units_lambda(w, load, speeds);
+        if (p->strategy == VW_BALANCE_DUPLICATE) {
+            st = balance_duplicate(w, load, &pp, a, &r);
+            goto done;
+        }
         st = vw_balance_decompose(w->decomp, f, &pp, &nd, map);
     }
     int nc = nd ? vw_decomp_cell_count(nd) : 0;
@@ -111,6 +197,7 @@ vw_status vw_balance_world(vw_world *w, const vw_load_field *f, const vw_balance
             r.imbalance_predicted = r.imbalance_before;
         }
     }
+done:
     vw_decomp_free(nd);
     free(load);
     free(map);

@@ -25,15 +25,18 @@ vw_status vw_balance_cell_loads(const vw_world *w, const vw_load_spec *s, double
     if (s->model == VW_LOAD_COUNTER && (s->counter < 0 || s->counter >= w->m->ncounters))
         return VW_E_INVAL;
     for (int c = 0; c < w->ncells; c++) {
-        const vw__cell *cl = &w->cells[c];
+        /* A duplicated cell's load is the sum over its master and copies. */
+        vw_cell_stats cs;
+        vw_world_cell_stats(w, c, &cs);
+        int64_t counter = s->counter >= 0 && s->counter < w->m->ncounters
+                              ? vw_world_cell_counter(w, c, s->counter)
+                              : 0;
         switch (s->model) {
-        case VW_LOAD_BUSY: out[c] = cl->busy_s; break;
-        case VW_LOAD_COUNTER: out[c] = (double)cl->counters[s->counter]; break;
+        case VW_LOAD_BUSY: out[c] = cs.busy_s; break;
+        case VW_LOAD_COUNTER: out[c] = (double)counter; break;
         case VW_LOAD_MODEL:
-            out[c] = s->w_objects * (double)cl->nobjs + s->w_messages * (double)cl->messages_in +
-                     (s->counter >= 0 && s->counter < w->m->ncounters
-                          ? s->w_pixels * (double)cl->counters[s->counter]
-                          : 0.0);
+            out[c] = s->w_objects * (double)cs.objects + s->w_messages * (double)cs.messages_in +
+                     s->w_pixels * (double)counter;
             break;
         default: return VW_E_INVAL;
         }

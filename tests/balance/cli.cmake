@@ -23,7 +23,8 @@ endfunction()
 set(common --size 80x60 --quiet)
 render("" ${VWALLS} render ${SCENE} -o ${WORK}/ref.png ${common})
 foreach(case "tensor;block;2x2x2;2" "rotate;block;2x4;2" "staggered;greedy;2x2x2;3"
-             "divide;block;2x2;2" "none;greedy;4x4x1;2" "staggered;weighted;4x2x2;2")
+             "divide;block;2x2;2" "none;greedy;4x4x1;2" "staggered;weighted;4x2x2;2"
+             "duplicate;block;2x2x2;3")
   list(GET case 0 bal)
   list(GET case 1 map)
   list(GET case 2 cells)

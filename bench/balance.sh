@@ -3,8 +3,9 @@
 # (max/mean) and efficiency 1/lambda of the counted work (ray-cell visits, one worker per
 # cell: deterministic) and of busy time (2 workers), for uniform, 50% and 100% clustered
 # 1000-sphere scenes and an oblique line of spheres, at 8, 16 and 64 cells; speedup of
-# the compute phase over no balancing with 2 workers; and a picture of the walls before
-# and after for the clustered scene. Usage: bench/balance.sh [OUTDIR] (default
+# the compute phase over no balancing with 2 workers; a cluster moving over 20 frames
+# (vwalls animate, rebalanced between frames); and a picture of the walls before and
+# after for the clustered scene. Usage: bench/balance.sh [OUTDIR] (default
 # bench/out/balance); VW_BUILD_DIR picks the build; SIZE=WxH (default 256x256).
 set -euo pipefail
 source "$(dirname "${BASH_SOURCE[0]}")/lib.sh"
@@ -41,7 +42,7 @@ for scene in uniform cluster50 cluster100 oblique; do
   for cells in 8 16 64; do
     L=$(layout $cells)
     base=""
-    for s in none tensor rotate staggered divide; do
+    for s in none tensor rotate staggered divide duplicate; do
       # Deterministic: one worker per cell, loads = counted ray-cell visits.
       "$VWALLS" render "$OUT/$scene.nff" -o "$OUT/img.png" --size "$SIZE" --cells "$L" \
         --workers "$cells" --balance "$s" --balance-load segments --quiet \
@@ -63,6 +64,42 @@ for scene in uniform cluster50 cluster100 oblique; do
     done
   done
 done
+
+# A moving cluster over 20 frames (vwalls animate): 600 spheres spread over the box and a
+# cluster of 400 that travels along x from one side to the other; between frames the
+# balancer runs on the last frame's counted work when lambda (busy time) exceeds 1.1.
+# 8 cells, 8 workers on 2 cores: the per-frame lambda is busy time, so it is noisy.
+awk 'BEGIN {
+  print "v\nfrom 0.5 -2.2 0.9\nat 0.5 0.5 0.5\nup 0 0 1\nangle 35\nhither 0.01\nresolution 160 160";
+  print "b 0.1 0.1 0.1\nl 2 -3 3\nl -1 -2 2\nf 0.8 0.8 0.8 0.8 0.2 10 0 1";
+  srand(11);
+  for (i = 0; i < 600; i++) printf "s %.4f %.4f %.4f 0.012\n", rand(), rand(), rand();
+  for (i = 0; i < 400; i++) {
+    do { x = 2 * rand() - 1; y = 2 * rand() - 1; z = 2 * rand() - 1 } while (x*x + y*y + z*z > 1);
+    printf "s %.4f %.4f %.4f 0.012\n", 0.12 + 0.1 * x, 0.5 + 0.1 * y, 0.5 + 0.1 * z;
+  }
+}' > "$OUT/moving.nff"
+{ echo "check off"; echo "frame"
+  for f in $(seq 1 19); do
+    for i in $(seq 600 999); do echo "move $i 0.04 0 0"; done
+    echo "frame"
+  done; } > "$OUT/moving.edits"
+MOVING="$OUT/moving.md"
+{ echo "| moving cluster, 20 frames, 2x2x2, 8 workers | λ busy mean | λ busy max | λ busy last 10 mean | rebalances |"
+  echo "|---|---|---|---|---|"; } > "$MOVING"
+for s in none tensor staggered divide; do
+  mkdir -p "$OUT/frames"
+  "$VWALLS" animate "$OUT/moving.nff" "$OUT/moving.edits" -o "$OUT/frames/$s-%04d.png" --cells 2x2x2 \
+    --workers 8 --balance "$s" --quiet --stats "$OUT/anim.json"
+  python3 - "$OUT/anim.json" "$s" >> "$MOVING" <<'PY'
+import json, sys
+fr = json.load(open(sys.argv[1]))["animation"]["per_frame"]
+lam = [f["lambda"] for f in fr]
+print("| %s | %.3f | %.3f | %.3f | %d |" % (sys.argv[2], sum(lam) / len(lam), max(lam),
+      sum(lam[10:]) / len(lam[10:]), sum(f["balanced"] for f in fr)))
+PY
+done
+cat "$MOVING"
 
 # Walls before and after for the 50% clustered scene (8 cells, staggered), and the
 # mapping of 16 cells onto 2 workers.

@@ -24,7 +24,8 @@ enum { RT_EYE = 0, RT_REFLECT = 1, RT_REFRACT = 2, RT_SHADOW = 3 };
 typedef struct rt_ray {
     double org[3], dir[3]; /* original, for the ray's whole life; dir is unit length */
     double t0, t1;         /* the segment in the cell that receives the ray */
-    double tmax;           /* end of the ray: INFINITY, or the light's distance */
+    double tmax;           /* end of the ray (INFINITY, or the light's distance); from
+                              spawn() on, clipped to the world box (vw_decomp_clip) */
     double weight[3];      /* shadow ray: the contribution added if unoccluded */
     int32_t pixel, depth, kind, pad;
 } rt_ray;
@@ -146,8 +147,12 @@ static void spawn(vw_ctx *ctx, rt_cell *c, rt_ray *r)
         atomic_fetch_add(&c->sh->rays, c->rays_pending);
         c->rays_pending = 0;
     }
+    /* Clipped once here, the ray's interval needs no clipping at any wall it crosses. */
+    const vw_decomp *d = vw_ctx_decomp(ctx);
+    double t0 = 0.0;
     vw_segment s;
-    if (!vw_decomp_first_segment(vw_ctx_decomp(ctx), r->org, r->dir, 0.0, r->tmax, &s)) {
+    if (!vw_decomp_clip(d, r->org, r->dir, &t0, &r->tmax) ||
+        !vw_decomp_next_segment(d, r->org, r->dir, t0, r->tmax, &s)) {
         finish_free(ctx, c, r);
         return;
     }
@@ -324,7 +329,7 @@ static void trace(vw_ctx *ctx, rt_cell *c, rt_ray *r)
         }
         vw_segment s;
         /* s.t1 > r->t1: the walk must make progress, or a ray could circle forever. */
-        if (r->t1 < r->tmax && vw_decomp_first_segment(d, r->org, r->dir, r->t1, r->tmax, &s) &&
+        if (r->t1 < r->tmax && vw_decomp_next_segment(d, r->org, r->dir, r->t1, r->tmax, &s) &&
             s.t1 > r->t1) {
             r->t0 = s.t0;
             r->t1 = s.t1;

@@ -95,6 +95,16 @@ VW_API int vw_decomp_walk(const vw_decomp *d, const double o[3], const double di
 /* The first segment of that walk; returns 0 when the ray misses the world. */
 VW_API int vw_decomp_first_segment(const vw_decomp *d, const double o[3], const double dir[3],
                                    double t0, double t1, vw_segment *out);
+/* A walk in two halves, for a ray that crosses many walls: vw_decomp_clip narrows
+   [*t0, *t1] to the world box (returns 0 when nothing is left), and on a clipped
+   interval, or one that starts at the t1 of one of its segments and ends where the
+   clipped one does, vw_decomp_next_segment gives the same segment as
+   vw_decomp_first_segment, bit for bit, without clipping again: that saves most of
+   the cost of a wall crossing. Returns 0 when t0 >= t1. */
+VW_API int vw_decomp_clip(const vw_decomp *d, const double o[3], const double dir[3],
+                          double *t0, double *t1);
+VW_API int vw_decomp_next_segment(const vw_decomp *d, const double o[3], const double dir[3],
+                                  double t0, double t1, vw_segment *out);
 
 /* Faces: 0 -x, 1 +x, 2 -y, 3 +y, 4 -z, 5 +z (in frame coordinates). */
 #define VW_FACE_AXIS(f) ((f) >> 1)

@@ -390,10 +390,105 @@ static int first_fn(const vw_segment *s, void *user)
     return 0;
 }
 
+static void ray_to_frame(const vw_decomp *d, const double o[3], const double dir[3],
+                         double q[3], double v[3])
+{
+    if (d->has_frame) {
+        vw_decomp_to_frame(d, o, q);
+        vw_decomp_to_frame(d, dir, v);
+    } else {
+        q[0] = o[0], q[1] = o[1], q[2] = o[2];
+        v[0] = dir[0], v[1] = dir[1], v[2] = dir[2];
+    }
+}
+
+/* The walk's own clip (vw_decomp_walk), in frame coordinates. */
+static int clip(const vw_decomp *d, const double q[3], const double v[3], double *t0p,
+                double *t1p)
+{
+    double t0 = *t0p, t1 = *t1p;
+    for (int a = 0; a < 3; a++) {
+        if (v[a] == 0) {
+            if (q[a] < d->world.lo[a] || q[a] > d->world.hi[a]) return 0;
+            continue;
+        }
+        double ta = (d->world.lo[a] - q[a]) / v[a], tb = (d->world.hi[a] - q[a]) / v[a];
+        if (ta > tb) {
+            double t = ta;
+            ta = tb;
+            tb = t;
+        }
+        if (ta > t0) t0 = ta;
+        if (tb < t1) t1 = tb;
+    }
+    *t0p = t0;
+    *t1p = t1;
+    return t0 < t1;
+}
+
+/* The first segment is the first leaf of the walk, and the walk reaches it by one
+   descent: at a node the near child is taken whenever t0 < ts, and a subtree entered
+   with t0 < t1 always yields a segment, so the recursion never backtracks. This loop
+   makes that descent with the walk's own arithmetic (the same (split - o[a]) / d[a],
+   the same min/max), so it returns the walk's first segment bit for bit, at a fraction
+   of its cost: it runs for every wall a ray crosses. Only a NaN can make the descent
+   fail (both comparisons false); the walk itself then decides. [t0, t1] is clipped. */
+static int descend(const vw_decomp *d, const double o[3], const double dir[3],
+                   const double q[3], const double v[3], double t0, double t1, vw_segment *out)
+{
+    const double t0_in = t0, t1_in = t1;
+    const vw_kd_node *nodes = d->nodes, *n = &nodes[0];
+    while (n->axis >= 0) {
+        int a = n->axis;
+        if (v[a] == 0) {
+            n = &nodes[q[a] < n->split ? n->left : n->right];
+            continue;
+        }
+        double ts = (n->split - q[a]) / v[a];
+        if (t0 < ts) {
+            n = &nodes[v[a] > 0 ? n->left : n->right];
+            t1 = t1 < ts ? t1 : ts;
+        } else if (ts < t1) {
+            n = &nodes[v[a] > 0 ? n->right : n->left];
+            t0 = t0 > ts ? t0 : ts;
+        } else {
+            return vw_decomp_walk(d, o, dir, t0_in, t1_in, first_fn, out) > 0;
+        }
+    }
+    if (!(t0 < t1)) return vw_decomp_walk(d, o, dir, t0_in, t1_in, first_fn, out) > 0;
+    out->cell = n->cell;
+    out->t0 = t0;
+    out->t1 = t1;
+    return 1;
+}
+
 int vw_decomp_first_segment(const vw_decomp *d, const double o[3], const double dir[3],
                             double t0, double t1, vw_segment *out)
 {
-    return vw_decomp_walk(d, o, dir, t0, t1, first_fn, out) > 0;
+    double q[3], v[3];
+    ray_to_frame(d, o, dir, q, v);
+    if (!clip(d, q, v, &t0, &t1)) return 0;
+    return descend(d, o, dir, q, v, t0, t1, out);
+}
+
+int vw_decomp_clip(const vw_decomp *d, const double o[3], const double dir[3], double *t0,
+                   double *t1)
+{
+    double q[3], v[3];
+    ray_to_frame(d, o, dir, q, v);
+    return clip(d, q, v, t0, t1);
+}
+
+/* A clipped interval stays clipped when restarted at a segment's exit: the clip would
+   raise t0 to the world entry, which every segment's t0 already exceeds, and lower t1
+   to the same world exit it lowered it to before. So skipping it changes nothing. */
+int vw_decomp_next_segment(const vw_decomp *d, const double o[3], const double dir[3],
+                           double t0, double t1, vw_segment *out)
+{
+    if (!(t0 < t1)) return 0;
+    double q[3], v[3];
+    ray_to_frame(d, o, dir, q, v);
+    return descend(d, o, dir, q, v, t0, t1, out);
 }
 
 /* ---- overlap queries, neighbours, front-to-back ------------------------------------ */

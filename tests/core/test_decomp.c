@@ -123,6 +123,25 @@ static void check_decomp(const vw_decomp *d)
         if (i % 7 == 0) dir[i % 3] = 0; /* axis-parallel components */
         walk_a.n = 0;
         vw_decomp_walk(d, o, dir, 0, INFINITY, collect, &walk_a);
+        {
+            vw_segment f;
+            int got = vw_decomp_first_segment(d, o, dir, 0, INFINITY, &f);
+            CHECK_EQ_INT(got, walk_a.n > 0);
+            if (got) CHECK(f.cell == walk_a.s[0].cell && f.t0 == walk_a.s[0].t0 &&
+                           f.t1 == walk_a.s[0].t1);
+        }
+        /* Clip once, then step from exit to exit without clipping: the same walk. */
+        double c0 = 0, c1 = INFINITY;
+        int clipped = vw_decomp_clip(d, o, dir, &c0, &c1);
+        CHECK_EQ_INT(clipped, walk_a.n > 0);
+        for (int s = 0; clipped && s <= walk_a.n; s++) {
+            vw_segment f;
+            int got = vw_decomp_next_segment(d, o, dir, s ? walk_a.s[s - 1].t1 : c0, c1, &f);
+            CHECK_EQ_INT(got, s < walk_a.n);
+            if (got)
+                CHECK(f.cell == walk_a.s[s].cell && f.t0 == walk_a.s[s].t0 &&
+                      f.t1 == walk_a.s[s].t1);
+        }
         vw_decomp_to_frame(d, o, qo);
         vw_decomp_to_frame(d, dir, qd);
         for (int s = 0; s < walk_a.n; s++) {
@@ -136,6 +155,12 @@ static void check_decomp(const vw_decomp *d)
                 CHECK_EQ_INT(walk_b.s[k].cell, walk_a.s[s + k].cell);
                 CHECK(walk_b.s[k].t1 == walk_a.s[s + k].t1);
             }
+            /* The first-segment fast path is the walk's first segment, bit for bit. */
+            vw_segment f;
+            CHECK(vw_decomp_first_segment(d, o, dir, walk_a.s[s].t0, INFINITY, &f));
+            CHECK_EQ_INT(f.cell, walk_a.s[s].cell);
+            CHECK(memcmp(&f.t0, &walk_a.s[s].t0, sizeof f.t0) == 0);
+            CHECK(memcmp(&f.t1, &walk_a.s[s].t1, sizeof f.t1) == 0);
         }
         /* Every cell the ray really crosses is in the walk, and only those. */
         for (int c = 0; c < n; c++) {

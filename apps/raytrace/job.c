@@ -13,7 +13,9 @@ struct rt_job {
     rt_shared sh;
     vw_decomp *decomp;
     vw_world *world;
-    int *owner;          /* output process: cell of each pixel's eye ray, -1 = misses */
+    int *owner;          /* cell of each pixel's eye ray, -1 = misses (every process:
+                            cell_build reads it, see rt_shared.owner) */
+    vw_decomp *owner_decomp; /* the decomposition owner[] was computed on */
     int64_t primary;     /* pixels with an owner */
     int ran;
 };
@@ -27,15 +29,28 @@ void rt_job_free(rt_job *j)
     free(j->sh.lights);
     free(j->sh.accum);
     free(j->owner);
+    vw_decomp_free(j->owner_decomp);
     free(j);
 }
 
-/* Output process: the cell owning each pixel's eye ray, by the same walk every cell
-   does in cell_build (on the world's current decomposition), so owners agree with them. */
-static void owners(rt_job *j)
+/* The cell owning each pixel's eye ray, by the walk cell_build would do (on the
+   world's current decomposition). Computed once per process and decomposition, before
+   the cells are built: each cell then picks its pixels from the map instead of walking
+   every candidate pixel itself (with the eye beside or inside the world box, every
+   cell would walk every pixel). Kept until the walls move. */
+static vw_status owners(rt_job *j)
 {
     const vw_decomp *d = vw_world_decomp(j->world);
+    if (j->owner_decomp && vw_decomp_equal(j->owner_decomp, d)) return VW_OK;
     int w = j->sh.view.width, h = j->sh.view.height;
+    j->sh.owner = NULL;
+    j->sh.owner_decomp = NULL;
+    vw_decomp_free(j->owner_decomp);
+    j->owner_decomp = NULL;
+    if (!j->owner) {
+        j->owner = malloc((size_t)w * (size_t)h * sizeof *j->owner);
+        if (!j->owner) return VW_E_NOMEM;
+    }
     j->primary = 0;
     for (int y = 0; y < h; y++)
         for (int x = 0; x < w; x++) {
@@ -46,6 +61,11 @@ static void owners(rt_job *j)
             j->owner[(size_t)y * w + x] = hitw ? seg.cell : -1;
             j->primary += hitw;
         }
+    vw_status st = vw_decomp_clone(d, &j->owner_decomp);
+    if (st != VW_OK) return st;
+    j->sh.owner = j->owner;
+    j->sh.owner_decomp = j->owner_decomp;
+    return VW_OK;
 }
 
 vw_status rt_job_create(const vw_scene *s, const rt_params *p, rt_job **out, char *err,
@@ -172,12 +192,10 @@ vw_status rt_job_create(const vw_scene *s, const rt_params *p, rt_job **out, cha
     }
 
     if (vw_world_is_output(j->world)) {
-        size_t np = (size_t)w * (size_t)h;
-        sh->accum = calloc(np, sizeof *sh->accum);
-        j->owner = malloc(np * sizeof *j->owner);
-        if (!sh->accum || !j->owner) goto nomem;
-        owners(j);
+        sh->accum = calloc((size_t)w * (size_t)h, sizeof *sh->accum);
+        if (!sh->accum) goto nomem;
     }
+    if ((st = owners(j)) != VW_OK) goto fail;
     *out = j;
     return VW_OK;
 nomem:
@@ -190,7 +208,12 @@ fail:
 
 vw_status rt_job_commit(rt_job *j, char *err, size_t errlen)
 {
-    vw_status st = vw_world_commit(j->world);
+    vw_status st = owners(j); /* the walls may have moved since the last commit */
+    if (st != VW_OK) {
+        snprintf(err, errlen, "%s", vw_status_message(st));
+        return st;
+    }
+    st = vw_world_commit(j->world);
     if (st != VW_OK) snprintf(err, errlen, "building the cells: %s", vw_world_errmsg(j->world));
     return st;
 }
@@ -221,10 +244,10 @@ void rt_job_set_sample(rt_job *j, int stride) { j->sh.sample = stride > 1 ? stri
 
 vw_status rt_job_reset(rt_job *j)
 {
-    if (j->sh.accum) {
+    if (j->sh.accum)
         memset(j->sh.accum, 0, sizeof *j->sh.accum * (size_t)j->sh.view.width * j->sh.view.height);
-        owners(j);
-    }
+    vw_status st = owners(j);
+    if (st != VW_OK) return st;
     atomic_store(&j->sh.pixels_done, 0);
     atomic_store(&j->sh.entries, 0);
     atomic_store(&j->sh.rays, 0);

@@ -362,6 +362,24 @@ static vw_status primary_pixels(vw_ctx *ctx, rt_cell *c)
     vw_box b = vw_ctx_cell_box(ctx);
     const double *F = vw_decomp_frame(d);
     int x0 = 0, y0 = 0, x1 = v->width - 1, y1 = v->height - 1;
+    size_t cap = 0;
+    int sample = c->sh->sample > 1 ? c->sh->sample : 1; /* the balancer's pre-pass */
+    const int *owner = c->sh->owner;
+    if (owner && vw_decomp_equal(c->sh->owner_decomp, d)) {
+        /* The job's map, made by the same walk once per process: no walk here. */
+        for (int y = 0; y < v->height; y += sample)
+            for (int x = 0; x < v->width; x += sample) {
+                if (owner[(size_t)y * v->width + x] != me) continue;
+                if (c->npixels == cap) {
+                    cap = cap ? 2 * cap : 256;
+                    int *np = realloc(c->pixels, cap * sizeof *np);
+                    if (!np) return VW_E_NOMEM;
+                    c->pixels = np;
+                }
+                c->pixels[c->npixels++] = y * v->width + x;
+            }
+        return VW_OK;
+    }
     double lo[2] = {INFINITY, INFINITY}, hi[2] = {-INFINITY, -INFINITY};
     int all_front = 1;
     for (int i = 0; i < 8 && all_front; i++) {
@@ -387,8 +405,6 @@ static vw_status primary_pixels(vw_ctx *ctx, rt_cell *c)
         x1 = (int)fmin(v->width - 1, ceil(hi[0]) + 1);
         y1 = (int)fmin(v->height - 1, ceil(hi[1]) + 1);
     }
-    size_t cap = 0;
-    int sample = c->sh->sample > 1 ? c->sh->sample : 1; /* the balancer's pre-pass */
     for (int y = y0; y <= y1; y++) {
         if (y % sample) continue;
         for (int x = x0; x <= x1; x++) {

@@ -96,6 +96,11 @@ typedef struct rt_shared {
     void *device;    /* RTCDevice, one per process, shared by every cell */
     int sample;      /* primary pixels: every sample-th row and column only (the load
                         balancer's cheap pre-pass); 0 or 1 = every pixel */
+    /* The cell of each pixel's eye ray (-1: misses the world) on decomposition
+       owner_decomp; cell_build uses it when that is the world's decomposition, and
+       walks the pixels itself otherwise. NULL when not computed. */
+    const int *owner;
+    const vw_decomp *owner_decomp;
     /* Output process only: */
     int64_t (*accum)[3];        /* width*height fixed-point sums */
     /* The counters below are written while every worker reads the fields above for

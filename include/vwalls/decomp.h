@@ -57,6 +57,10 @@ VW_API vw_status vw_decomp_create_grid_walls(const vw_box *world, const int dims
 VW_API vw_status vw_decomp_create_kd(const vw_box *world, const vw_kd_node *nodes, int nnodes,
                                      const double *frame, vw_decomp_kind kind, vw_decomp **out);
 VW_API vw_status vw_decomp_clone(const vw_decomp *d, vw_decomp **out);
+/* 1 when a and b have the same world box, frame and kd-tree (walls and cell ids): every
+   query then answers the same on both, bit for bit. Lets a caller keep results computed
+   on one decomposition (who owns which eye ray) until the walls move. */
+VW_API int vw_decomp_equal(const vw_decomp *a, const vw_decomp *b);
 VW_API void vw_decomp_free(vw_decomp *d);
 
 VW_API vw_decomp_kind vw_decomp_get_kind(const vw_decomp *d);

@@ -226,6 +226,23 @@ vw_status vw_decomp_clone(const vw_decomp *d, vw_decomp **out)
     return st;
 }
 
+int vw_decomp_equal(const vw_decomp *a, const vw_decomp *b)
+{
+    if (!a || !b) return a == b;
+    /* Doubles compared as bits: -0.0 and 0.0 could round a walk differently. */
+    if (a->nnodes != b->nnodes || a->has_frame != b->has_frame) return 0;
+    if (memcmp(&a->world, &b->world, sizeof a->world) != 0) return 0;
+    if (a->has_frame && memcmp(a->frame, b->frame, sizeof a->frame) != 0) return 0;
+    for (int i = 0; i < a->nnodes; i++) {
+        const vw_kd_node *p = &a->nodes[i], *q = &b->nodes[i];
+        if (p->axis != q->axis || p->left != q->left || p->right != q->right ||
+            p->cell != q->cell ||
+            (p->axis >= 0 && memcmp(&p->split, &q->split, sizeof p->split) != 0))
+            return 0;
+    }
+    return 1;
+}
+
 void vw_decomp_free(vw_decomp *d)
 {
     if (!d) return;

@@ -189,7 +189,7 @@ int vw_cmd_radiosity(int argc, char **argv)
             if (vw_cli_double(CMD, a, v, 1e-6, 100, &o.subdivide)) return VW_EXIT_USAGE;
         } else if (!strcmp(a, "--max-level")) {
             VALUE();
-            if (vw_cli_int(CMD, a, v, 0, 12, &lv)) return VW_EXIT_USAGE;
+            if (vw_cli_int(CMD, a, v, 0, RAD_MAX_LEVEL, &lv)) return VW_EXIT_USAGE;
             o.max_level = (int)lv;
         } else if (!strcmp(a, "--max-shots")) {
             VALUE();

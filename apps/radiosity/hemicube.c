@@ -197,6 +197,24 @@ void rad_hemicube_raster(const rad_hemicube *h, const double (*hv)[3], int nv, c
     }
 }
 
+int rad_hemicube_pixel(const rad_hemicube *h, const double x[3], double *depth)
+{
+    const int R = h->res;
+    const double n = R / 2.0;
+    double ax = fabs(x[0]), ay = fabs(x[1]), a, s, t;
+    int f;
+    if (!(x[2] > 0)) return -1;
+    if (x[2] >= ax && x[2] >= ay) f = 0, a = x[2], s = x[0] / a, t = x[1] / a;
+    else if (ax >= ay) f = x[0] > 0 ? 1 : 2, a = ax, s = x[1] / a, t = x[2] / a;
+    else f = x[1] > 0 ? 3 : 4, a = ay, s = x[0] / a, t = x[2] / a;
+    int rows = f == 0 ? R : R / 2;
+    int i = (int)floor((s + 1) * n), j = (int)floor((f == 0 ? t + 1 : t) * n);
+    i = i < 0 ? 0 : i > R - 1 ? R - 1 : i;
+    j = j < 0 ? 0 : j > rows - 1 ? rows - 1 : j;
+    *depth = a;
+    return (f == 0 ? 0 : R * R + (f - 1) * R * R / 2) + j * R + i;
+}
+
 void rad_hemicube_orientation(const double n[3], uint64_t seed, double u[3])
 {
     double t[3] = {1, 0, 0};

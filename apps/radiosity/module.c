@@ -39,6 +39,7 @@ typedef struct rad_elem {
     int32_t level, gi, gj;
     int vfirst, nv;
     int alive;
+    int root;            /* the level-0 element it descends from (itself at level 0) */
     double area;
     double B[3], incident[3];
     double won;          /* delta form factor won in the current shot */
@@ -72,6 +73,19 @@ typedef struct rad_cell {
     int *touched;
     char *pvis;          /* per patch: some vertex in front of the current shooter */
     double (*hv)[3];
+    /* Receiver detail (with --subdivide): every level-0 element e (they are el[0..nroot),
+       built before any split) owns nsub = 4^fine cells of the deepest level, at
+       [e*nsub, (e+1)*nsub), local index a*side + b for frame offsets (a, b). Each keeps
+       its centroid, area, the incident power it received and the live leaf element
+       that covers it. */
+    int fine, side, nsub, nroot;
+    double (*scc)[3], *sca, (*sci)[3], *scw;
+    int *scl;
+    /* Groups: runs of level-0 elements of one polygon, [gfirst[g], gfirst[g + 1]); a
+       shot's power per group (gpow) and the groups it touched (glist). */
+    int ngrp, *gfirst, *gpatch, *rgrp, *glist, nglist;
+    char *gtouched;
+    double (*gpow)[3];
     int round, budget;
     double thr;
     uint64_t seq;
@@ -161,6 +175,7 @@ static int add_elem(rad_cell *c, int patch, int level, int gi, int gj, const dou
     memset(e, 0, sizeof *e);
     e->patch = patch, e->level = level, e->gi = gi, e->gj = gj;
     e->vfirst = c->nvp, e->nv = poly.n, e->alive = 1, e->area = area;
+    e->root = c->nel; /* a child's is set by split_elem */
     memcpy(e->B, B, sizeof e->B);
     memcpy(c->vp + c->nvp, poly.v, sizeof(double) * 3 * (size_t)poly.n);
     c->nvp += poly.n;
@@ -169,49 +184,131 @@ static int add_elem(rad_cell *c, int patch, int level, int gi, int gj, const dou
     return c->nel - 1;
 }
 
-/* Splits element e into its four children. They inherit its radiosity, so the power
-   B*area it holds is kept exactly (up to rounding: the children tile the parent); the
-   incident power is shared by area. Later shots then resolve the detail. */
+/* The deepest-level cells of element x: rows [*a0, *a0 + *w) and columns [*b0, *b0 + *w)
+   of its root's block. */
+static void fine_range(const rad_cell *c, const rad_elem *x, int *a0, int *b0, int *w)
+{
+    const rad_elem *r = &c->el[x->root];
+    int sh = c->fine - x->level;
+    *a0 = (x->gi - (r->gi << x->level)) << sh;
+    *b0 = (x->gj - (r->gj << x->level)) << sh;
+    *w = 1 << sh;
+}
+
+/* Sums the incident power of element x's fine cells (and their area, if area). */
+static void fine_sum(const rad_cell *c, const rad_elem *x, double inc[3], double *area)
+{
+    int a0, b0, w;
+    fine_range(c, x, &a0, &b0, &w);
+    size_t base = (size_t)x->root * (size_t)c->nsub;
+    inc[0] = inc[1] = inc[2] = 0;
+    double A = 0;
+    for (int a = a0; a < a0 + w; a++)
+        for (int b = b0; b < b0 + w; b++) {
+            size_t s = base + (size_t)(a * c->side + b);
+            for (int k = 0; k < 3; k++) inc[k] += c->sci[s][k];
+            A += c->sca[s];
+        }
+    if (area) *area = A;
+}
+
+/* Splits element e into its four children. With fine cells (--subdivide) each child
+   takes exactly the incident power its fine cells received since the first shot: the
+   re-gather is free, and the children's powers sum to the parent's (up to rounding).
+   Without them (a checkpoint restored into a run without --subdivide) the children
+   inherit the parent's radiosity and share its incident power by area. Either way the
+   energy ledger is untouched: it counts power per patch and per cell, never per
+   element. */
 static void split_elem(rad_cell *c, int e)
 {
     rad_elem par = c->el[e];
     c->el[e].alive = 0;
+    const rad_piece *pc = &c->patches[par.patch].pc;
     for (int a = 0; a < 2; a++)
         for (int b = 0; b < 2; b++) {
             int k = add_elem(c, par.patch, par.level + 1, 2 * par.gi + a, 2 * par.gj + b, par.B);
-            if (k >= 0)
-                for (int ch = 0; ch < 3; ch++) c->el[k].incident[ch] = par.incident[ch] * c->el[k].area / par.area;
+            if (k < 0) continue;
+            rad_elem *x = &c->el[k];
+            x->root = par.root;
+            if (!c->fine) {
+                for (int ch = 0; ch < 3; ch++) x->incident[ch] = par.incident[ch] * x->area / par.area;
+                continue;
+            }
+            fine_sum(c, x, x->incident, NULL);
+            for (int ch = 0; ch < 3; ch++) x->B[ch] = pc->emit[ch] + pc->rho[ch] * x->incident[ch] / x->area;
+            int a0, b0, w;
+            fine_range(c, x, &a0, &b0, &w);
+            for (int i = a0; i < a0 + w; i++)
+                for (int j = b0; j < b0 + w; j++) c->scl[(size_t)x->root * (size_t)c->nsub + (size_t)(i * c->side + j)] = k;
         }
 }
 
-/* Adaptive subdivision: an element is split when its radiosity differs from a
-   neighbour's (same polygon, same or coarser level, in this cell) by more than rel
-   times their mean and more than floor. Decided for all first, then split. */
+/* Luminance of the reflected radiosity of x's quadrant (qa, qb) from its fine cells;
+   *area gets the quadrant's area. */
+static double quadrant_y(const rad_cell *c, const rad_elem *x, int qa, int qb, double *area)
+{
+    int a0, b0, w;
+    fine_range(c, x, &a0, &b0, &w);
+    const rad_piece *pc = &c->patches[x->patch].pc;
+    size_t base = (size_t)x->root * (size_t)c->nsub;
+    double inc[3] = {0, 0, 0}, A = 0;
+    w /= 2;
+    for (int a = a0 + qa * w; a < a0 + (qa + 1) * w; a++)
+        for (int b = b0 + qb * w; b < b0 + (qb + 1) * w; b++) {
+            size_t s = base + (size_t)(a * c->side + b);
+            for (int k = 0; k < 3; k++) inc[k] += c->sci[s][k];
+            A += c->sca[s];
+        }
+    *area = A;
+    return A > 0 ? (pc->rho[0] * inc[0] + pc->rho[1] * inc[1] + pc->rho[2] * inc[2]) / (3 * A) : 0;
+}
+
+/* Adaptive subdivision, decided for all elements first, then split. A live element is
+   split (never an emitter, never below the fine level) when
+    - its own four quadrants, known exactly from its fine cells, differ by more than
+      rel times its mean and more than floor: there is detail inside it (a shadow edge);
+      this is not fooled by hemicube aliasing, since the fine cells only share out the
+      power the element's pixels won, by point form factors and visibility;
+    - or it differs by as much from a neighbour (same polygon, same or coarser level, in
+      this cell, across pieces too): an edge on the element boundary. The level-0
+      values carry the hemicube's noise, so this test asks twice the contrast.
+   Splitting adds no noise: the children's values are exact sums of fine cells. */
 static void subdivide(vw_ctx *ctx, rad_cell *c, double rel, double floor_, int max_level)
 {
     int n = c->nel, nsplit = 0;
+    if (max_level > c->fine) max_level = c->fine;
+    if (max_level <= 0) return;
     char *mark = xrealloc(NULL, (size_t)(n ? n : 1));
     memset(mark, 0, (size_t)(n ? n : 1));
     static const int dx[4] = {1, -1, 0, 0}, dy[4] = {0, 0, 1, -1};
     for (int e = 0; e < n; e++) {
         rad_elem *x = &c->el[e];
-        if (!x->alive) continue;
-        int32_t poly = c->patches[x->patch].pc.poly;
+        const rad_piece *pc = &c->patches[x->patch].pc;
+        if (!x->alive || x->level >= max_level || rad_sum3(pc->emit) > 0) continue;
+        double lo = INFINITY, hi = -INFINITY, sy = 0, sa = 0;
+        for (int q = 0; q < 4; q++) {
+            double A, y = quadrant_y(c, x, q >> 1, q & 1, &A);
+            if (!(A > 0.05 * x->area / 4)) continue; /* a sliver left by clipping */
+            lo = fmin(lo, y), hi = fmax(hi, y);
+            sy += y * A, sa += A;
+        }
+        double mean = sa > 0 ? sy / sa : 0;
+        if (hi - lo > rel * mean && hi - lo > floor_) {
+            mark[e] = 1;
+            continue;
+        }
         double Ya = rad_sum3(x->B) / 3;
-        for (int k = 0; k < 4; k++) {
+        for (int k = 0; k < 4 && !mark[e]; k++) {
             int o = -1;
             for (int l = x->level; l >= 0 && o < 0; l--) {
                 int sh = x->level - l;
                 int gi = (x->gi + dx[k]) >> sh, gj = (x->gj + dy[k]) >> sh;
-                o = ht_find(c, poly, -1, l, gi, gj, 0);
+                o = ht_find(c, pc->poly, -1, l, gi, gj, 0);
                 if (o >= 0 && !c->el[o].alive) o = -2; /* finer ones compare with x */
             }
             if (o < 0) continue;
             double Yb = rad_sum3(c->el[o].B) / 3, diff = fabs(Ya - Yb);
-            if (diff > rel * 0.5 * (Ya + Yb) && diff > floor_) {
-                if (x->level < max_level) mark[e] = 1;
-                if (c->el[o].level < max_level) mark[o] = 1;
-            }
+            if (diff > 2 * rel * 0.5 * (Ya + Yb) && diff > floor_) mark[e] = 1;
         }
     }
     for (int e = 0; e < n; e++)
@@ -278,6 +375,54 @@ static vw_status cell_build(vw_ctx *ctx, const void *objects, size_t n, void **s
         for (int i = lo[0]; i <= hi[0]; i++)
             for (int j = lo[1]; j <= hi[1]; j++) add_elem(c, p, 0, i, j, c->patches[p].pc.emit);
     }
+    if (S->opt.subdivide > 0 && S->opt.max_level > 0) {
+        c->fine = S->opt.max_level < RAD_MAX_LEVEL ? S->opt.max_level : RAD_MAX_LEVEL;
+        c->side = 1 << c->fine;
+        c->nsub = c->side * c->side;
+        c->nroot = c->nel;
+        size_t nf = (size_t)c->nroot * (size_t)c->nsub;
+        c->scc = xrealloc(NULL, sizeof *c->scc * (nf ? nf : 1));
+        c->sca = xrealloc(NULL, sizeof *c->sca * (nf ? nf : 1));
+        c->sci = calloc(nf ? nf : 1, sizeof *c->sci);
+        c->scl = xrealloc(NULL, sizeof *c->scl * (nf ? nf : 1));
+        if (!c->sci) abort();
+        /* Roots of one polygon are consecutive (patches come in mesh order, polygon by
+           polygon); a polygon seen twice would only make two groups. */
+        c->gfirst = xrealloc(NULL, sizeof(int) * (size_t)(c->nroot + 1));
+        c->rgrp = xrealloc(NULL, sizeof(int) * (size_t)(c->nroot ? c->nroot : 1));
+        size_t maxg = 1;
+        for (int e = 0; e < c->nroot; e++) {
+            if (!e || c->patches[c->el[e].patch].pc.poly != c->patches[c->el[e - 1].patch].pc.poly)
+                c->gfirst[c->ngrp++] = e;
+            c->rgrp[e] = c->ngrp - 1;
+        }
+        c->gfirst[c->ngrp] = c->nroot;
+        /* Their patches: [gpatch[g], gpatch[g + 1]). */
+        c->gpatch = xrealloc(NULL, sizeof(int) * (size_t)(c->ngrp + 1));
+        for (int g = 0; g < c->ngrp; g++) c->gpatch[g] = c->el[c->gfirst[g]].patch;
+        c->gpatch[c->ngrp] = c->npatches;
+        for (int g = 0; g < c->ngrp; g++)
+            if ((size_t)(c->gfirst[g + 1] - c->gfirst[g]) > maxg) maxg = (size_t)(c->gfirst[g + 1] - c->gfirst[g]);
+        c->scw = xrealloc(NULL, sizeof *c->scw * 2 * maxg * (size_t)c->nsub);
+        c->glist = xrealloc(NULL, sizeof(int) * (size_t)(c->ngrp ? c->ngrp : 1));
+        c->gtouched = calloc((size_t)(c->ngrp ? c->ngrp : 1), 1);
+        c->gpow = calloc((size_t)(c->ngrp ? c->ngrp : 1), sizeof *c->gpow);
+        if (!c->gtouched || !c->gpow) abort();
+        for (int e = 0; e < c->nroot; e++) {
+            const rad_elem *x = &c->el[e];
+            for (int a = 0; a < c->side; a++)
+                for (int b = 0; b < c->side; b++) {
+                    size_t k = (size_t)e * (size_t)c->nsub + (size_t)(a * c->side + b);
+                    rad_poly poly;
+                    c->sca[k] = 0;
+                    c->scl[k] = e;
+                    memset(c->scc[k], 0, sizeof c->scc[k]);
+                    if (rad_elem_polygon(&c->patches[x->patch].pc, c->fine, (x->gi << c->fine) + a,
+                                         (x->gj << c->fine) + b, &poly) >= 3)
+                        c->sca[k] = rad_poly_area(&poly, NULL, c->scc[k]);
+                }
+        }
+    }
     int maxnb = vw_decomp_max_neighbours(d);
     for (int f = 0; f < 6; f++) {
         int *ids = xrealloc(NULL, sizeof(int) * (size_t)(maxnb > 0 ? maxnb : 1));
@@ -303,6 +448,8 @@ static void cell_free(void *state, void *user)
     free(c->patches), free(c->el), free(c->vp), free(c->ht);
     free(c->z.depth), free(c->z.owner), free(c->z.stamp), free(c->mask), free(c->touched);
     free(c->pvis), free(c->hv);
+    free(c->scc), free(c->sca), free(c->sci), free(c->scl), free(c->scw);
+    free(c->gfirst), free(c->gpatch), free(c->rgrp), free(c->glist), free(c->gtouched), free(c->gpow);
     free(c);
 }
 
@@ -386,6 +533,137 @@ static void forward(vw_ctx *ctx, rad_cell *c, const rad_shot_hdr *h, const doubl
     free(buf);
 }
 
+/* Does segment p + t r, 0 < t < 1, pass through piece pc? */
+static int seg_hits(const rad_piece *pc, const double p[3], const double r[3])
+{
+    double dn = rad_dot(r, pc->normal), v0[3];
+    if (dn == 0) return 0;
+    rad_sub(pc->v[0], p, v0);
+    double t = rad_dot(v0, pc->normal) / dn;
+    if (!(t > 1e-9 && t < 1 - 1e-9)) return 0;
+    double x[3];
+    for (int k = 0; k < 3; k++) x[k] = p[k] + t * r[k];
+    for (int i = 0; i < pc->nv; i++) {
+        double e[3], d[3], cx[3];
+        rad_sub(pc->v[(i + 1) % pc->nv], pc->v[i], e);
+        rad_sub(x, pc->v[i], d);
+        rad_cross(e, d, cx);
+        if (rad_dot(cx, pc->normal) < 0) return 0;
+    }
+    return 1;
+}
+
+/* Is the point p + r (hemicube coordinates hv) of polygon poly visible from the shooter
+   at p in the current shot? The pixel of its direction decides for occluders of other
+   cells (set upstream: hidden). Occluders of this cell are tested exactly: every other
+   polygon owning that pixel or one of its 8 neighbours on the same face is intersected
+   piece by piece (its pieces in this cell), so visibility is per point, not per pixel,
+   wherever the occluder's pixels are within one pixel of the point's. */
+static int visible(rad_cell *c, const double p[3], const double r[3], const double hv[3], int32_t poly,
+                   const uint8_t *mask)
+{
+    const rad_hemicube *hc = &c->S->hc;
+    const int R = hc->res;
+    double dep;
+    int px = rad_hemicube_pixel(hc, hv, &dep);
+    if (px < 0) return 1;
+    if (c->z.stamp[px] != c->z.cur && (mask[px >> 3] >> (px & 7) & 1)) return 0;
+    int base, rows, rel;
+    if (px < R * R) base = 0, rows = R, rel = px;
+    else base = R * R + (px - R * R) / (R * R / 2) * (R * R / 2), rows = R / 2, rel = px - base;
+    int pi = rel % R, pj = rel / R;
+    int seen[9], nseen = 0;
+    for (int dj = -1; dj <= 1; dj++)
+        for (int di = -1; di <= 1; di++) {
+            int i = pi + di, j = pj + dj;
+            if (i < 0 || i >= R || j < 0 || j >= rows) continue;
+            int q = base + j * R + i;
+            if (c->z.stamp[q] != c->z.cur) continue;
+            int g = c->rgrp[c->el[c->z.owner[q]].root];
+            if (c->patches[c->el[c->gfirst[g]].patch].pc.poly == poly) continue;
+            int k;
+            for (k = 0; k < nseen && seen[k] != g; k++) {}
+            if (k < nseen) continue;
+            seen[nseen++] = g;
+            for (int pt = c->gpatch[g]; pt < c->gpatch[g + 1]; pt++)
+                if (seg_hits(&c->patches[pt].pc, p, r)) return 0;
+        }
+    return 1;
+}
+
+/* Shares the power gpow[g] that the level-0 elements of group g (one polygon's, in this
+   cell) won in this shot among all the group's fine cells, in proportion to area x
+   point form factor (cos cos / r^2 at the cell's centroid) x visibility, and adds each
+   share to the fine cell, the live leaf over it and its patch's unshot power.
+   Visibility of a centroid: the pixel its direction falls in is clear (visible), set
+   upstream (another cell's occluder: hidden), or won here by a piece whose plane the
+   segment from the shooter crosses before the centroid (hidden; an element of the same
+   polygon cannot hide it). If no centroid is visible the shares follow form factors
+   alone, then area.
+   Why a whole polygon: the pixels a small element wins alias (a grazing face gets 0, 1
+   or 2 pixels from shot to shot), the pixels a polygon wins do not; the point form
+   factors then place the power smoothly, and the point visibility sharply.
+   The ledger stays exact: the shares sum to what the pixels won (normalised weights;
+   rounding only), each share goes to absorbed and unshot as rho and 1 - rho, and the
+   hemicube decides, as without subdivision, how much the polygon receives. */
+static void distribute(rad_cell *c, int g, const rad_shot_hdr *h, const double (*ax)[3],
+                       const uint8_t *mask)
+{
+    int r0 = c->gfirst[g], r1 = c->gfirst[g + 1];
+    size_t base = (size_t)r0 * (size_t)c->nsub, n = (size_t)(r1 - r0) * (size_t)c->nsub;
+    double W = 0, Wff = 0, Wa = 0;
+    double *w = c->scw, *wf = c->scw + n;
+    for (int e = r0; e < r1; e++) {
+        const rad_elem *x = &c->el[e];
+        const rad_piece *pc = &c->patches[x->patch].pc;
+        for (int s = 0; s < c->nsub; s++) {
+            size_t k = (size_t)e * (size_t)c->nsub + (size_t)s, l = k - base;
+            w[l] = wf[l] = 0;
+            double A = c->sca[k];
+            if (!(A > 0)) continue;
+            Wa += A;
+            if (!c->pvis[x->patch]) continue;
+            double r[3], hv[3];
+            rad_sub(c->scc[k], h->p, r);
+            for (int i = 0; i < 3; i++) hv[i] = rad_dot(r, ax[i]);
+            double d2 = rad_dot(r, r), cr = -rad_dot(r, pc->normal);
+            if (!(hv[2] > 0) || !(cr > 0) || !(d2 > 0)) continue;
+            double ff = A * hv[2] * cr / (d2 * d2);
+            wf[l] = ff, Wff += ff;
+            if (visible(c, h->p, r, hv, pc->poly, mask)) w[l] = ff, W += ff;
+        }
+    }
+    const double *wt = W > 0 ? w : Wff > 0 ? wf : NULL;
+    double tot = W > 0 ? W : Wff > 0 ? Wff : Wa;
+    const double *P = c->gpow[g];
+    if (!(tot > 0)) {
+        /* Nothing to share by (no area at all): the power is absorbed. */
+        for (int ch = 0; ch < 3; ch++) c->absorbed[ch] += P[ch];
+        memset(c->gpow[g], 0, sizeof c->gpow[g]);
+        return;
+    }
+    for (int e = r0; e < r1; e++) {
+        const rad_elem *x = &c->el[e];
+        rad_patch *pt = &c->patches[x->patch];
+        const rad_piece *pc = &pt->pc;
+        for (int s = 0; s < c->nsub; s++) {
+            size_t k = (size_t)e * (size_t)c->nsub + (size_t)s;
+            double f = (wt ? wt[k - base] : c->sca[k]) / tot;
+            if (!(f > 0)) continue;
+            rad_elem *leaf = &c->el[c->scl[k]];
+            for (int ch = 0; ch < 3; ch++) {
+                double inc = f * P[ch], refl = pc->rho[ch] * inc;
+                c->sci[k][ch] += inc;
+                leaf->incident[ch] += inc;
+                leaf->B[ch] += refl / leaf->area;
+                pt->unshot[ch] += refl;
+                c->absorbed[ch] += inc - refl;
+            }
+        }
+    }
+    memset(c->gpow[g], 0, sizeof c->gpow[g]);
+}
+
 /* Projects this cell's elements onto the pixels still clear in mask (which it updates),
    deposits the power of the pixels won, and forwards the merged bitmap. */
 static void process_shot(vw_ctx *ctx, rad_cell *c, const rad_shot_hdr *h, uint8_t *mask, int full)
@@ -420,9 +698,13 @@ static void process_shot(vw_ctx *ctx, rad_cell *c, const rad_shot_hdr *h, uint8_
         }
         if (!c->hv) c->hv = xrealloc(NULL, sizeof(double) * 3 * RAD_MAXV);
         int64_t nr = 0;
-        for (int e = 0; e < c->nel; e++) {
+        /* With fine cells only the level-0 elements are rasterised, split or not: every
+           shot then wins the same pixels as without subdivision (no receiver smaller
+           than a pixel), and distribute() shares them out. */
+        int nrast = c->fine ? c->nroot : c->nel;
+        for (int e = 0; e < nrast; e++) {
             const rad_elem *x = &c->el[e];
-            if (!x->alive || !c->pvis[x->patch]) continue;
+            if ((!c->fine && !x->alive) || !c->pvis[x->patch]) continue;
             int front = 0;
             for (int i = 0; i < x->nv; i++) {
                 double r[3];
@@ -458,10 +740,14 @@ static void process_shot(vw_ctx *ctx, rad_cell *c, const rad_shot_hdr *h, uint8_
             double r[3];
             rad_sub(h->p, c->vp[x->vfirst], r);
             int facing = rad_dot(r, pt->pc.normal) > 0;
+            int g = c->fine && facing ? c->rgrp[c->touched[t]] : -1;
+            if (g >= 0 && !c->gtouched[g]) c->gtouched[g] = 1, c->glist[c->nglist++] = g;
             for (int k = 0; k < 3; k++) {
                 double P = x->won * h->power[k];
                 c->won[k] += P;
-                if (facing) {
+                if (g >= 0) {
+                    c->gpow[g][k] += P; /* shared out by distribute() below */
+                } else if (facing) {
                     double refl = pt->pc.rho[k] * P;
                     x->B[k] += refl / x->area;
                     x->incident[k] += P;
@@ -475,6 +761,12 @@ static void process_shot(vw_ctx *ctx, rad_cell *c, const rad_shot_hdr *h, uint8_
             back += !facing;
             x->won = 0;
         }
+        for (int i = 0; i < c->nglist; i++) {
+            int g = c->glist[i];
+            distribute(c, g, h, (const double(*)[3])ax, mask);
+            c->gtouched[g] = 0;
+        }
+        c->nglist = 0;
         if (back) vw_count(ctx, RAD_C_BACK_HITS, back);
         full = 1;
         for (size_t b = 0; b < S->bitmap_bytes && full; b++) {
@@ -658,8 +950,22 @@ static void on_restore_elem(vw_ctx *ctx, void *state, const void *msg)
     for (;;) {
         int e = ht_find(c, r->poly, r->piece, r->level, r->gi, r->gj, 1);
         if (e >= 0) {
-            memcpy(c->el[e].B, r->B, sizeof r->B);
-            memcpy(c->el[e].incident, r->incident, sizeof r->incident);
+            rad_elem *x = &c->el[e];
+            memcpy(x->B, r->B, sizeof r->B);
+            memcpy(x->incident, r->incident, sizeof r->incident);
+            if (c->fine) {
+                /* A checkpoint holds leaves only: their power is spread over their fine
+                   cells by area (the detail inside a leaf is not saved). */
+                int a0, b0, w;
+                double A;
+                fine_range(c, x, &a0, &b0, &w);
+                fine_sum(c, x, (double[3]){0, 0, 0}, &A);
+                for (int a = a0; a < a0 + w; a++)
+                    for (int b = b0; b < b0 + w; b++) {
+                        size_t k = (size_t)x->root * (size_t)c->nsub + (size_t)(a * c->side + b);
+                        for (int ch = 0; ch < 3; ch++) c->sci[k][ch] = A > 0 ? r->incident[ch] * c->sca[k] / A : 0;
+                    }
+            }
             return;
         }
         /* Not there yet: split the finest live ancestor, then look again. */

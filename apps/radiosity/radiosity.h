@@ -94,6 +94,10 @@ int rad_elem_polygon(const rad_piece *pc, int level, int gi, int gj, rad_poly *o
 void rad_piece_grid(const rad_piece *pc, int lo[2], int hi[2]);
 double rad_poly_area(const rad_poly *p, double normal[3], double centroid[3]);
 
+/* Deepest subdivision level: receiver detail is accumulated on a grid of 4^level cells per
+   level-0 element from the first shot on (module.c), so it bounds that memory. */
+#define RAD_MAX_LEVEL 4
+
 /* ---- hemicube (hemicube.c) ---- */
 
 typedef struct rad_hemicube {
@@ -116,6 +120,11 @@ static inline uint64_t rad_shot_seed(int64_t piece, int64_t shot)
 {
     return (uint64_t)piece * 1000003u + (uint64_t)shot;
 }
+
+/* The pixel the direction x (hemicube coordinates, x[2] > 0) passes through, and the
+   depth of the point x along that pixel's face axis (the z-buffer's depth measure).
+   -1 when x is not in front of the shooter. */
+int rad_hemicube_pixel(const rad_hemicube *h, const double x[3], double *depth);
 
 /* Rasterises a polygon given in hemicube coordinates (x, y along the orientation, z
    along the shooter normal; origin at the shooter) into a z-buffer: pixels whose bit in

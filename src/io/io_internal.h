@@ -19,6 +19,12 @@ void vw__errf(char *err, size_t errlen, const char *fmt, ...)
 #endif
     ;
 
+/* Writes "name:line: message" into err, the form of every bad-input message of the
+   readers (NULL or errlen 0: nothing written; truncated, never overflowed). Returns
+   VW_E_INPUT so a reader can `return vw__input_error(...)`. */
+vw_status vw__input_error(char *err, size_t errlen, const char *name, int line,
+                          const char *fmt, va_list ap);
+
 /* The scene builder owns a scene under construction plus the capacities of its
    arrays. Invariants: ids are handed out densely in the order primitives are added;
    when s->normals is non-NULL it has as many entries as s->indices (capacity too),

@@ -130,16 +130,11 @@ static vw_status fail(nff *P, int line, const char *fmt, ...)
 
 static vw_status fail(nff *P, int line, const char *fmt, ...)
 {
-    if (P->err && P->errlen) {
-        int k = snprintf(P->err, P->errlen, "%s:%d: ", P->name, line);
-        if (k >= 0 && (size_t)k < P->errlen) {
-            va_list ap;
-            va_start(ap, fmt);
-            vsnprintf(P->err + k, P->errlen - (size_t)k, fmt, ap);
-            va_end(ap);
-        }
-    }
-    return VW_E_INPUT;
+    va_list ap;
+    va_start(ap, fmt);
+    vw_status st = vw__input_error(P->err, P->errlen, P->name, line, fmt, ap);
+    va_end(ap);
+    return st;
 }
 
 static vw_status fail_status(nff *P, vw_status st)

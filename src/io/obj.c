@@ -103,16 +103,11 @@ static vw_status fail(obj *O, const char *fmt, ...)
 
 static vw_status fail(obj *O, const char *fmt, ...)
 {
-    if (O->err && O->errlen) {
-        int k = snprintf(O->err, O->errlen, "%s:%d: ", O->name, O->line);
-        if (k >= 0 && (size_t)k < O->errlen) {
-            va_list ap;
-            va_start(ap, fmt);
-            vsnprintf(O->err + k, O->errlen - (size_t)k, fmt, ap);
-            va_end(ap);
-        }
-    }
-    return VW_E_INPUT;
+    va_list ap;
+    va_start(ap, fmt);
+    vw_status st = vw__input_error(O->err, O->errlen, O->name, O->line, fmt, ap);
+    va_end(ap);
+    return st;
 }
 
 static vw_status fail_status(obj *O, vw_status st)

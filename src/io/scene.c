@@ -20,6 +20,16 @@ void vw__errf(char *err, size_t errlen, const char *fmt, ...)
     va_end(ap);
 }
 
+vw_status vw__input_error(char *err, size_t errlen, const char *name, int line,
+                          const char *fmt, va_list ap)
+{
+    if (err && errlen) {
+        int k = snprintf(err, errlen, "%s:%d: ", name, line);
+        if (k >= 0 && (size_t)k < errlen) vsnprintf(err + k, errlen - (size_t)k, fmt, ap);
+    }
+    return VW_E_INPUT;
+}
+
 /* ---- builder ---------------------------------------------------------------- */
 
 /* Grows *p to hold at least need elements. Capacities double, so n appends cost

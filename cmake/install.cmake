@@ -81,6 +81,7 @@ install(FILES ${PROJECT_SOURCE_DIR}/docs/man/vwalls.1 DESTINATION ${CMAKE_INSTAL
 
 # The examples and the tutorial, to read and to build against the installed library.
 install(FILES ${PROJECT_SOURCE_DIR}/examples/pairs.c ${PROJECT_SOURCE_DIR}/examples/pairs.h
+              ${PROJECT_SOURCE_DIR}/examples/sphere_bins.h
               ${PROJECT_SOURCE_DIR}/examples/components.c ${PROJECT_SOURCE_DIR}/examples/components.h
         DESTINATION ${CMAKE_INSTALL_DOCDIR}/examples)
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/docs/tutorial DESTINATION ${CMAKE_INSTALL_DOCDIR})

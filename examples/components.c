@@ -12,9 +12,10 @@
  */
 #include "components.h"
 
-#include <math.h>
 #include <stdlib.h>
 #include <time.h>
+
+#include "sphere_bins.h"
 
 enum { MSG_LABEL, MSG_REPORT, MSG_RESULT, NKINDS };   /* message kinds */
 
@@ -37,9 +38,7 @@ typedef struct ex_params {
 } ex_params;
 
 typedef struct ex_cell {
-    ex_sphere *own;       /* spheres whose centre lies in this cell, sorted by bin key */
-    uint64_t *key;
-    size_t nown;
+    ex_bins bins;         /* the spheres this cell owns (sphere_bins.h) */
     size_t *parent;       /* union-find over own spheres, fully compressed after build */
     int64_t *label;       /* meaningful at roots: smallest id known to be connected */
     /* Boundary spheres grouped by root: bsph[bstart[r] .. bstart[r+1]) are the own
@@ -54,50 +53,6 @@ typedef struct ex_cell {
     int started;
 } ex_cell;
 
-/* ---- neighbour search: the same sorted bins as pairs.c ---- */
-
-/* Bins of spacing h = 2*rmax: two touching spheres lie in adjacent bins. Sorted by key,
-   z fastest, the bins (x+dx, y+dy, z-1..z+1) are one run of the array. */
-static uint64_t bin_key(const double c[3], double h, int dx, int dy, int dz)
-{
-    uint64_t k = 0;
-    for (int a = 0; a < 3; a++) {
-        int64_t i = (int64_t)floor(c[a] / h) + 1 + (a == 0 ? dx : a == 1 ? dy : dz);
-        k = (k << 21) | (uint64_t)(i < 0 ? 0 : i);
-    }
-    return k;
-}
-
-static size_t lower_bound(const ex_cell *ec, uint64_t key)
-{
-    size_t lo = 0, hi = ec->nown;
-    while (lo < hi) {
-        size_t mid = (lo + hi) / 2;
-        if (ec->key[mid] < key) lo = mid + 1; else hi = mid;
-    }
-    return lo;
-}
-
-static int touching(const ex_sphere *a, const ex_sphere *b)
-{
-    double d2 = 0;
-    for (int k = 0; k < 3; k++) d2 += (a->c[k] - b->c[k]) * (a->c[k] - b->c[k]);
-    return d2 <= (a->r + b->r) * (a->r + b->r);
-}
-
-/* Calls fn(ec, j, arg) for every own sphere j that touches q. */
-static void for_touching(ex_cell *ec, const ex_sphere *q, double h,
-                         void (*fn)(ex_cell *ec, size_t j, void *arg), void *arg)
-{
-    for (int dx = -1; dx <= 1; dx++)
-        for (int dy = -1; dy <= 1; dy++) {
-            uint64_t last = bin_key(q->c, h, dx, dy, 1);
-            for (size_t j = lower_bound(ec, bin_key(q->c, h, dx, dy, -1));
-                 j < ec->nown && ec->key[j] <= last; j++)
-                if (touching(&ec->own[j], q)) fn(ec, j, arg);
-        }
-}
-
 /* ---- union-find over the own spheres (built once) ---- */
 
 static size_t find(size_t *parent, size_t i)
@@ -106,10 +61,17 @@ static size_t find(size_t *parent, size_t i)
     return i;
 }
 
-static void join(ex_cell *ec, size_t j, void *arg)
+typedef struct ex_join {
+    ex_cell *ec;
+    size_t i;
+} ex_join;
+
+/* Sphere j touches sphere i: one component. */
+static void join(size_t j, void *arg)
 {
-    size_t a = find(ec->parent, *(const size_t *)arg), b = find(ec->parent, j);
-    if (a != b) ec->parent[a > b ? a : b] = a < b ? a : b;
+    const ex_join *jn = arg;
+    size_t a = find(jn->ec->parent, jn->i), b = find(jn->ec->parent, j);
+    if (a != b) jn->ec->parent[a > b ? a : b] = a < b ? a : b;
 }
 
 /* ---- the module ---- */
@@ -126,15 +88,10 @@ static void cell_free(void *state, void *user)
     ex_cell *ec = state;
     (void)user;
     if (!ec) return;
-    free(ec->own), free(ec->key), free(ec->parent), free(ec->label), free(ec->bstart);
+    ex_bins_free(&ec->bins);
+    free(ec->parent), free(ec->label), free(ec->bstart);
     free(ec->bsph), free(ec->dstart), free(ec->dest), free(ec->dirty), free(ec->stack);
     free(ec);
-}
-
-static int cmp_u64(const void *a, const void *b)
-{
-    uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
-    return (x > y) - (x < y);
 }
 
 /* Own spheres, local components, and who must hear about each boundary sphere. */
@@ -146,11 +103,8 @@ static vw_status cell_build(vw_ctx *ctx, const void *objects, size_t n, void **s
     const int self = vw_ctx_cell(ctx), ncells = vw_decomp_cell_count(d);
     const size_t m1 = n ? n : 1;
     ex_cell *ec = calloc(1, sizeof *ec);
-    uint64_t (*tmp)[2] = malloc(sizeof *tmp * m1);   /* (key, index) to sort */
     int *cells = malloc(sizeof(int) * (size_t)ncells);
-    if (!ec || !tmp || !cells) goto nomem;
-    ec->own = malloc(sizeof *ec->own * m1);
-    ec->key = malloc(sizeof *ec->key * m1);
+    if (!ec || !cells || ex_bins_build(&ec->bins, ctx, objects, n, h) != VW_OK) goto nomem;
     ec->parent = malloc(sizeof *ec->parent * m1);
     ec->label = malloc(sizeof *ec->label * m1);
     ec->bstart = calloc(m1 + 1, sizeof *ec->bstart);
@@ -158,29 +112,25 @@ static vw_status cell_build(vw_ctx *ctx, const void *objects, size_t n, void **s
     ec->dstart = calloc(m1 + 1, sizeof *ec->dstart);
     ec->dirty = calloc(m1, 1);
     ec->stack = malloc(sizeof *ec->stack * m1);
-    if (!ec->own || !ec->key || !ec->parent || !ec->label || !ec->bstart || !ec->bsph ||
+    if (!ec->parent || !ec->label || !ec->bstart || !ec->bsph ||
         !ec->dstart || !ec->dirty || !ec->stack)
         goto nomem;
 
-    const ex_sphere *s = objects;
-    static const double dir[3] = {1, 1, 1};     /* a centre on a wall goes to the + side */
-    size_t m = 0;
-    for (size_t i = 0; i < n; i++)
-        if (vw_decomp_locate(d, s[i].c, dir) == self)
-            tmp[m][0] = bin_key(s[i].c, h, 0, 0, 0), tmp[m++][1] = i;
-    qsort(tmp, m, sizeof *tmp, cmp_u64);
-    for (size_t i = 0; i < m; i++) ec->key[i] = tmp[i][0], ec->own[i] = s[tmp[i][1]];
-    ec->nown = m;
+    const ex_sphere *own = ec->bins.own;
+    const size_t m = ec->bins.n;
 
     /* Local components. */
     for (size_t i = 0; i < m; i++) ec->parent[i] = i;
-    for (size_t i = 0; i < m; i++) for_touching(ec, &ec->own[i], h, join, &i);
+    for (size_t i = 0; i < m; i++) {
+        ex_join jn = {ec, i};
+        ex_bins_for_touching(&ec->bins, &own[i], join, &jn);
+    }
     for (size_t i = 0; i < m; i++) ec->label[i] = INT64_MAX;
     int64_t local = 0;
     for (size_t i = 0; i < m; i++) {
         size_t r = ec->parent[i] = find(ec->parent, i);
         local += r == i;
-        if (ec->own[i].id < ec->label[r]) ec->label[r] = ec->own[i].id;
+        if (own[i].id < ec->label[r]) ec->label[r] = own[i].id;
     }
     vw_count(ctx, EX_COMPONENTS_CNT_LOCAL, local);
 
@@ -191,8 +141,8 @@ static vw_status cell_build(vw_ctx *ctx, const void *objects, size_t n, void **s
     for (size_t i = 0; i < m; i++) {
         vw_box reach;
         for (int k = 0; k < 3; k++) {
-            reach.lo[k] = ec->own[i].c[k] - ec->own[i].r - pp->rmax;
-            reach.hi[k] = ec->own[i].c[k] + ec->own[i].r + pp->rmax;
+            reach.lo[k] = own[i].c[k] - own[i].r - pp->rmax;
+            reach.hi[k] = own[i].c[k] + own[i].r + pp->rmax;
         }
         int nc = vw_decomp_cells_overlapping(d, &reach, 0, cells, ncells);
         for (int k = 0; k < nc; k++) {
@@ -215,11 +165,11 @@ static vw_status cell_build(vw_ctx *ctx, const void *objects, size_t n, void **s
     for (size_t i = 0; i < m; i++)
         if (ec->dstart[i + 1] > ec->dstart[i]) ec->bsph[ec->stack[ec->parent[i]]++] = i;
 
-    free(tmp), free(cells);
+    free(cells);
     *state = ec;
     return VW_OK;
 nomem:
-    free(tmp), free(cells);
+    free(cells);
     cell_free(ec, NULL);
     return VW_E_NOMEM;
 }
@@ -236,7 +186,7 @@ static int step(vw_ctx *ctx, void *state)
     ex_cell *ec = state;
     if (!ec->started) {     /* first call: every boundary sphere's initial label goes out */
         ec->started = 1;
-        for (size_t r = 0; r < ec->nown; r++)
+        for (size_t r = 0; r < ec->bins.n; r++)
             if (ec->bstart[r + 1] > ec->bstart[r]) mark_dirty(ec, r);
     }
     if (!ec->nstack) return 0;
@@ -245,7 +195,7 @@ static int step(vw_ctx *ctx, void *state)
         ec->dirty[r] = 0;
         for (size_t b = ec->bstart[r]; b < ec->bstart[r + 1]; b++) {
             size_t i = ec->bsph[b];
-            ex_label_msg msg = {ec->own[i], ec->label[r]};
+            ex_label_msg msg = {ec->bins.own[i], ec->label[r]};
             for (size_t k = ec->dstart[i]; k < ec->dstart[i + 1]; k++)
                 vw_send_cell(ctx, ec->dest[k], MSG_LABEL, &msg);
             vw_count(ctx, EX_COMPONENTS_CNT_LABEL_MSGS, (int64_t)(ec->dstart[i + 1] - ec->dstart[i]));
@@ -256,12 +206,14 @@ static int step(vw_ctx *ctx, void *state)
 
 typedef struct ex_lower {
     vw_ctx *ctx;
+    ex_cell *ec;
     int64_t label;
 } ex_lower;
 
-static void lower(ex_cell *ec, size_t j, void *arg)
+static void lower(size_t j, void *arg)
 {
     const ex_lower *lw = arg;
+    ex_cell *ec = lw->ec;
     size_t r = ec->parent[j];
     if (lw->label < ec->label[r]) {
         ec->label[r] = lw->label;
@@ -275,9 +227,8 @@ static void lower(ex_cell *ec, size_t j, void *arg)
 static void on_label(vw_ctx *ctx, void *state, const void *msg)
 {
     const ex_label_msg *lm = msg;
-    const ex_params *pp = vw_ctx_user(ctx);
-    ex_lower lw = {ctx, lm->label};
-    for_touching(state, &lm->s, 2 * pp->rmax, lower, &lw);
+    ex_lower lw = {ctx, state, lm->label};
+    ex_bins_for_touching(&lw.ec->bins, &lm->s, lower, &lw);
 }
 
 /* Second run: labels are final; every cell reports its spheres to the output process. */
@@ -285,8 +236,8 @@ static void on_report(vw_ctx *ctx, void *state, const void *msg)
 {
     const ex_cell *ec = state;
     (void)msg;
-    for (size_t i = 0; i < ec->nown; i++) {
-        ex_result_msg res = {ec->own[i].id, ec->label[ec->parent[i]]};
+    for (size_t i = 0; i < ec->bins.n; i++) {
+        ex_result_msg res = {ec->bins.own[i].id, ec->label[ec->parent[i]]};
         vw_send_output(ctx, MSG_RESULT, &res);
         if (res.label == res.id) vw_count(ctx, EX_COMPONENTS_CNT_COMPONENTS, 1);
     }
@@ -373,7 +324,7 @@ int64_t ex_components_reference(const ex_sphere *s, size_t n, int64_t *labels)
     for (size_t i = 0; i < n; i++) parent[i] = i;
     for (size_t i = 0; i < n; i++)
         for (size_t j = i + 1; j < n; j++)
-            if (touching(&s[i], &s[j])) {
+            if (ex_touching(&s[i], &s[j])) {
                 size_t a = find(parent, i), b = find(parent, j);
                 if (a != b) parent[a > b ? a : b] = a < b ? a : b;
             }

@@ -8,9 +8,10 @@
  */
 #include "pairs.h"
 
-#include <math.h>
 #include <stdlib.h>
 #include <time.h>
+
+#include "sphere_bins.h"
 
 enum { MSG_GHOST, NKINDS };                 /* message kinds */
 enum { CNT_PAIRS, CNT_GHOSTS, NCOUNTERS };  /* counters */
@@ -20,61 +21,29 @@ typedef struct pairs_params {
 } pairs_params;
 
 typedef struct pairs_cell {
-    ex_sphere *own;                         /* spheres whose centre lies in this cell, */
-    uint64_t *key;                          /* sorted by bin key */
-    size_t nown;
+    ex_bins bins;                           /* the spheres this cell owns */
     int ghosts_sent;
 } pairs_cell;
 
-static int touching(const ex_sphere *a, const ex_sphere *b)
-{
-    double d2 = 0;
-    for (int k = 0; k < 3; k++) d2 += (a->c[k] - b->c[k]) * (a->c[k] - b->c[k]);
-    return d2 <= (a->r + b->r) * (a->r + b->r);
-}
+typedef struct near_count {
+    const ex_bins *bins;
+    const ex_sphere *q;
+    int64_t n;
+} near_count;
 
-/* Spheres are binned on a grid of spacing h = 2*rmax (two touching spheres lie in
-   adjacent bins) and sorted by bin key, z fastest: the 3 bins (x+dx, y+dy, z-1..z+1)
-   are one run of the sorted array. Work per query is O(log n), whatever the layout. */
-static uint64_t bin_key(const double c[3], double h, int dx, int dy, int dz)
+static void count_one(size_t j, void *arg)
 {
-    uint64_t k = 0;
-    for (int a = 0; a < 3; a++) {
-        int64_t i = (int64_t)floor(c[a] / h) + 1 + (a == 0 ? dx : a == 1 ? dy : dz);
-        k = (k << 21) | (uint64_t)(i < 0 ? 0 : i);
-    }
-    return k;
-}
-
-static size_t lower_bound(const pairs_cell *pc, uint64_t key)
-{
-    size_t lo = 0, hi = pc->nown;
-    while (lo < hi) {
-        size_t mid = (lo + hi) / 2;
-        if (pc->key[mid] < key) lo = mid + 1; else hi = mid;
-    }
-    return lo;
+    near_count *nc = arg;
+    nc->n += nc->bins->own[j].id < nc->q->id;
 }
 
 /* Own spheres with a smaller id than q that touch q. Summed over all own spheres it
    counts each local pair once; for a ghost q it counts the pairs this cell owns. */
-static int64_t count_near(const pairs_cell *pc, const ex_sphere *q, double h)
+static int64_t count_near(const ex_bins *bins, const ex_sphere *q)
 {
-    int64_t n = 0;
-    for (int dx = -1; dx <= 1; dx++)
-        for (int dy = -1; dy <= 1; dy++) {
-            uint64_t last = bin_key(q->c, h, dx, dy, 1);
-            for (size_t j = lower_bound(pc, bin_key(q->c, h, dx, dy, -1));
-                 j < pc->nown && pc->key[j] <= last; j++)
-                n += pc->own[j].id < q->id && touching(&pc->own[j], q);
-        }
-    return n;
-}
-
-static int cmp_u64(const void *a, const void *b)
-{
-    uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
-    return (x > y) - (x < y);
+    near_count nc = {bins, q, 0};
+    ex_bins_for_touching(bins, q, count_one, &nc);
+    return nc.n;
 }
 
 static void sphere_bounds(const void *obj, vw_box *out, void *user)
@@ -88,24 +57,11 @@ static vw_status cell_build(vw_ctx *ctx, const void *objects, size_t n, void **s
 {
     const double h = 2 * ((const pairs_params *)vw_ctx_user(ctx))->rmax;
     pairs_cell *pc = calloc(1, sizeof *pc);
-    uint64_t (*tmp)[2] = malloc(sizeof *tmp * (n ? n : 1)); /* (key, index) to sort */
-    if (pc) pc->own = malloc(sizeof(ex_sphere) * (n ? n : 1));
-    if (pc) pc->key = malloc(sizeof(uint64_t) * (n ? n : 1));
-    if (!pc || !pc->own || !pc->key || !tmp) {
-        if (pc) free(pc->own), free(pc->key);
-        free(pc), free(tmp);
+    if (!pc) return VW_E_NOMEM;
+    if (ex_bins_build(&pc->bins, ctx, objects, n, h) != VW_OK) {
+        free(pc);
         return VW_E_NOMEM;
     }
-    const ex_sphere *s = objects;
-    static const double dir[3] = {1, 1, 1};     /* a centre on a wall goes to the + side */
-    size_t m = 0;
-    for (size_t i = 0; i < n; i++)             /* near a wall, a centre lands in two cells */
-        if (vw_decomp_locate(vw_ctx_decomp(ctx), s[i].c, dir) == vw_ctx_cell(ctx))
-            tmp[m][0] = bin_key(s[i].c, h, 0, 0, 0), tmp[m++][1] = i;
-    qsort(tmp, m, sizeof *tmp, cmp_u64);
-    for (size_t i = 0; i < m; i++) pc->key[i] = tmp[i][0], pc->own[i] = s[tmp[i][1]];
-    pc->nown = m;
-    free(tmp);
     *state = pc;
     return VW_OK;
 }
@@ -114,7 +70,7 @@ static void cell_free(void *state, void *user)
 {
     pairs_cell *pc = state;
     (void)user;
-    if (pc) free(pc->own), free(pc->key);
+    if (pc) ex_bins_free(&pc->bins);
     free(pc);
 }
 
@@ -126,12 +82,12 @@ static int step(vw_ctx *ctx, void *state)
     pc->ghosts_sent = 1;
     const pairs_params *pp = vw_ctx_user(ctx);
     int64_t local = 0;
-    for (size_t i = 0; i < pc->nown; i++) local += count_near(pc, &pc->own[i], 2 * pp->rmax);
+    for (size_t i = 0; i < pc->bins.n; i++) local += count_near(&pc->bins, &pc->bins.own[i]);
     vw_count(ctx, CNT_PAIRS, local);
     int *cells = malloc(sizeof(int) * (size_t)vw_decomp_cell_count(vw_ctx_decomp(ctx)));
     if (!cells) abort();
-    for (size_t i = 0; i < pc->nown; i++) {
-        const ex_sphere *s = &pc->own[i];
+    for (size_t i = 0; i < pc->bins.n; i++) {
+        const ex_sphere *s = &pc->bins.own[i];
         vw_box reach;
         for (int k = 0; k < 3; k++) {
             reach.lo[k] = s->c[k] - s->r - pp->rmax;
@@ -152,9 +108,7 @@ static int step(vw_ctx *ctx, void *state)
 static void on_ghost(vw_ctx *ctx, void *state, const void *msg)
 {
     const pairs_cell *pc = state;
-    const ex_sphere *g = msg;
-    const pairs_params *pp = vw_ctx_user(ctx);
-    vw_count(ctx, CNT_PAIRS, count_near(pc, g, 2 * pp->rmax));
+    vw_count(ctx, CNT_PAIRS, count_near(&pc->bins, msg));
 }
 
 static const vw_msg_kind kinds[NKINDS] = {
@@ -228,6 +182,6 @@ int64_t ex_pairs_brute(const ex_sphere *s, size_t n)
 {
     int64_t c = 0;
     for (size_t i = 0; i < n; i++)
-        for (size_t j = i + 1; j < n; j++) c += touching(&s[i], &s[j]);
+        for (size_t j = i + 1; j < n; j++) c += ex_touching(&s[i], &s[j]);
     return c;
 }

@@ -197,7 +197,7 @@ void rad_hemicube_raster(const rad_hemicube *h, const double (*hv)[3], int nv, c
     }
 }
 
-int rad_hemicube_pixel(const rad_hemicube *h, const double x[3], double *depth)
+int rad_hemicube_pixel(const rad_hemicube *h, const double x[3], double fxy[2])
 {
     const int R = h->res;
     const double n = R / 2.0;
@@ -208,11 +208,23 @@ int rad_hemicube_pixel(const rad_hemicube *h, const double x[3], double *depth)
     else if (ax >= ay) f = x[0] > 0 ? 1 : 2, a = ax, s = x[1] / a, t = x[2] / a;
     else f = x[1] > 0 ? 3 : 4, a = ay, s = x[0] / a, t = x[2] / a;
     int rows = f == 0 ? R : R / 2;
-    int i = (int)floor((s + 1) * n), j = (int)floor((f == 0 ? t + 1 : t) * n);
+    fxy[0] = (s + 1) * n, fxy[1] = (f == 0 ? t + 1 : t) * n;
+    int i = (int)floor(fxy[0]), j = (int)floor(fxy[1]);
     i = i < 0 ? 0 : i > R - 1 ? R - 1 : i;
     j = j < 0 ? 0 : j > rows - 1 ? rows - 1 : j;
-    *depth = a;
     return (f == 0 ? 0 : R * R + (f - 1) * R * R / 2) + j * R + i;
+}
+
+void rad_hemicube_pixel_dir(const rad_hemicube *h, int px, double d[3])
+{
+    const int R = h->res;
+    const double n = R / 2.0;
+    if (px < R * R) {
+        face_dir(0, -1 + (px % R + 0.5) / n, -1 + (px / R + 0.5) / n, d);
+        return;
+    }
+    int f = 1 + (px - R * R) / (R * R / 2), rel = (px - R * R) % (R * R / 2);
+    face_dir(f, -1 + (rel % R + 0.5) / n, (rel / R + 0.5) / n, d);
 }
 
 void rad_hemicube_orientation(const double n[3], uint64_t seed, double u[3])

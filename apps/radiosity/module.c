@@ -28,6 +28,8 @@ const char *const rad_counter_names[RAD_NCOUNTERS] = {
     "element_splits", "back_face_hits",
 };
 
+enum { RAD_PX_CLEAR = -1, RAD_PX_UPSTREAM = -2 };
+
 typedef struct rad_patch {
     rad_piece pc;
     double unshot[3];
@@ -84,6 +86,9 @@ typedef struct rad_cell {
     /* Groups: runs of level-0 elements of one polygon, [gfirst[g], gfirst[g + 1]); a
        shot's power per group (gpow) and the groups it touched (glist). */
     int ngrp, *gfirst, *gpatch, *rgrp, *glist, nglist;
+    int32_t *gpoly;      /* each group's polygon */
+    vw_box box;          /* this cell's box (decomposition frame) */
+    int *pcls;           /* per pixel in the current shot: group, RAD_PX_UPSTREAM or _CLEAR */
     char *gtouched;
     double (*gpow)[3];
     int round, budget;
@@ -359,6 +364,7 @@ static vw_status cell_build(vw_ctx *ctx, const void *objects, size_t n, void **s
     if (!c) return VW_E_NOMEM;
     c->S = S;
     c->cell = vw_ctx_cell(ctx);
+    c->box = vw_ctx_cell_box(ctx);
     const rad_piece *pcs = objects;
     c->patches = xrealloc(NULL, sizeof *c->patches * (n ? n : 1));
     for (size_t i = 0; i < n; i++) {
@@ -401,6 +407,9 @@ static vw_status cell_build(vw_ctx *ctx, const void *objects, size_t n, void **s
         c->gpatch = xrealloc(NULL, sizeof(int) * (size_t)(c->ngrp + 1));
         for (int g = 0; g < c->ngrp; g++) c->gpatch[g] = c->el[c->gfirst[g]].patch;
         c->gpatch[c->ngrp] = c->npatches;
+        c->gpoly = xrealloc(NULL, sizeof(int32_t) * (size_t)(c->ngrp ? c->ngrp : 1));
+        for (int g = 0; g < c->ngrp; g++) c->gpoly[g] = c->patches[c->gpatch[g]].pc.poly;
+        c->pcls = xrealloc(NULL, sizeof(int) * (size_t)S->hc.npix);
         for (int g = 0; g < c->ngrp; g++)
             if ((size_t)(c->gfirst[g + 1] - c->gfirst[g]) > maxg) maxg = (size_t)(c->gfirst[g + 1] - c->gfirst[g]);
         c->scw = xrealloc(NULL, sizeof *c->scw * 2 * maxg * (size_t)c->nsub);
@@ -449,7 +458,7 @@ static void cell_free(void *state, void *user)
     free(c->z.depth), free(c->z.owner), free(c->z.stamp), free(c->mask), free(c->touched);
     free(c->pvis), free(c->hv);
     free(c->scc), free(c->sca), free(c->sci), free(c->scl), free(c->scw);
-    free(c->gfirst), free(c->gpatch), free(c->rgrp), free(c->glist), free(c->gtouched), free(c->gpow);
+    free(c->gfirst), free(c->gpatch), free(c->gpoly), free(c->pcls), free(c->rgrp), free(c->glist), free(c->gtouched), free(c->gpow);
     free(c);
 }
 
@@ -553,40 +562,102 @@ static int seg_hits(const rad_piece *pc, const double p[3], const double r[3])
     return 1;
 }
 
-/* Is the point p + r (hemicube coordinates hv) of polygon poly visible from the shooter
-   at p in the current shot? The pixel of its direction decides for occluders of other
-   cells (set upstream: hidden). Occluders of this cell are tested exactly: every other
-   polygon owning that pixel or one of its 8 neighbours on the same face is intersected
-   piece by piece (its pieces in this cell), so visibility is per point, not per pixel,
-   wherever the occluder's pixels are within one pixel of the point's. */
-static int visible(rad_cell *c, const double p[3], const double r[3], const double hv[3], int32_t poly,
-                   const uint8_t *mask)
+/* How visible the point p + r (hemicube coordinates hv) of group g is from the shooter
+   at p in the current shot, in [0, 1]. Occluders of this cell are tested exactly: every
+   other polygon owning the point's pixel or one of its 8 neighbours on that face is
+   intersected piece by piece (its pieces in this cell), so this visibility is per point,
+   not per pixel. Occluders of other cells are known only as the bits set upstream: they
+   are filtered bilinearly between pixel centres, so their edges become a ramp one pixel
+   wide rather than a step on the pixel grid that shows as blotches on grazing faces. */
+static double visible(rad_cell *c, const double p[3], const double r[3], const double hv[3],
+                      const double (*ax)[3], int g)
 {
     const rad_hemicube *hc = &c->S->hc;
     const int R = hc->res;
-    double dep;
-    int px = rad_hemicube_pixel(hc, hv, &dep);
+    double fxy[2];
+    int px = rad_hemicube_pixel(hc, hv, fxy);
     if (px < 0) return 1;
-    if (c->z.stamp[px] != c->z.cur && (mask[px >> 3] >> (px & 7) & 1)) return 0;
-    int base, rows, rel;
-    if (px < R * R) base = 0, rows = R, rel = px;
-    else base = R * R + (px - R * R) / (R * R / 2) * (R * R / 2), rows = R / 2, rel = px - base;
-    int pi = rel % R, pj = rel / R;
+    int base, rows;
+    if (px < R * R) base = 0, rows = R;
+    else base = R * R + (px - R * R) / (R * R / 2) * (R * R / 2), rows = R / 2;
+    int pi = (px - base) % R, pj = (px - base) / R;
     int seen[9], nseen = 0;
     for (int dj = -1; dj <= 1; dj++)
         for (int di = -1; di <= 1; di++) {
             int i = pi + di, j = pj + dj;
             if (i < 0 || i >= R || j < 0 || j >= rows) continue;
-            int q = base + j * R + i;
-            if (c->z.stamp[q] != c->z.cur) continue;
-            int g = c->rgrp[c->el[c->z.owner[q]].root];
-            if (c->patches[c->el[c->gfirst[g]].patch].pc.poly == poly) continue;
+            int o = c->pcls[base + j * R + i];
+            if (o < 0 || o == g || c->gpoly[o] == c->gpoly[g]) continue;
             int k;
-            for (k = 0; k < nseen && seen[k] != g; k++) {}
+            for (k = 0; k < nseen && seen[k] != o; k++) {}
             if (k < nseen) continue;
-            seen[nseen++] = g;
-            for (int pt = c->gpatch[g]; pt < c->gpatch[g + 1]; pt++)
+            seen[nseen++] = o;
+            for (int pt = c->gpatch[o]; pt < c->gpatch[o + 1]; pt++)
                 if (seg_hits(&c->patches[pt].pc, p, r)) return 0;
+        }
+    double cx = fxy[0] - 0.5, cy = fxy[1] - 0.5, blocked = 0, known = 0;
+    int i0 = (int)floor(cx), j0 = (int)floor(cy);
+    double fx = cx - i0, fy = cy - j0;
+    const rad_piece *own = &c->patches[c->gpatch[g]].pc;
+    for (int k = 0; k < 4; k++) {
+        int i = i0 + (k & 1), j = j0 + (k >> 1);
+        i = i < 0 ? 0 : i > R - 1 ? R - 1 : i;
+        j = j < 0 ? 0 : j > rows - 1 ? rows - 1 : j;
+        double wk = (k & 1 ? fx : 1 - fx) * (k >> 1 ? fy : 1 - fy);
+        if (c->pcls[base + j * R + i] != RAD_PX_UPSTREAM) {
+            known += wk;
+            continue;
+        }
+        /* A pixel set upstream hides this polygon only if its ray meets the polygon's
+           plane inside this cell: beyond the cell it may be the polygon's own
+           continuation, set by the cell that holds it, which hides nothing. */
+        double d[3], dw[3], v0[3], x[3], fr[3];
+        rad_hemicube_pixel_dir(hc, base + j * R + i, d);
+        for (int a = 0; a < 3; a++) dw[a] = d[0] * ax[0][a] + d[1] * ax[1][a] + d[2] * ax[2][a];
+        double dn = rad_dot(dw, own->normal);
+        rad_sub(own->v[0], p, v0);
+        double t = dn != 0 ? rad_dot(v0, own->normal) / dn : -1;
+        if (!(t > 0)) continue;
+        for (int a = 0; a < 3; a++) x[a] = p[a] + t * dw[a];
+        vw_decomp_to_frame(c->S->d, x, fr);
+        if (fr[0] < c->box.lo[0] || fr[0] > c->box.hi[0] || fr[1] < c->box.lo[1] || fr[1] > c->box.hi[1] ||
+            fr[2] < c->box.lo[2] || fr[2] > c->box.hi[2])
+            continue;
+        known += wk, blocked += wk;
+    }
+    return known > 0 ? 1 - blocked / known : 1;
+}
+
+/* Is level-0 element e wholly clear of occluders in the current shot? True when its
+   vertices project onto one face and every pixel of their bounding box, widened by
+   visible()'s one-pixel reach, holds its own polygon or nothing: then visible() would
+   return 1 for each of its fine cells, and is skipped (most elements, most shots). */
+static int unobstructed(rad_cell *c, int e, const double p[3], const double (*ax)[3], int g)
+{
+    const rad_hemicube *hc = &c->S->hc;
+    const int R = hc->res;
+    const rad_elem *x = &c->el[e];
+    int face = -1, i0 = R, i1 = -1, j0 = R, j1 = -1;
+    for (int v = 0; v < x->nv; v++) {
+        double r[3], hv[3], fxy[2];
+        rad_sub(c->vp[x->vfirst + v], p, r);
+        for (int k = 0; k < 3; k++) hv[k] = rad_dot(r, ax[k]);
+        int px = rad_hemicube_pixel(hc, hv, fxy);
+        if (px < 0) return 0;
+        int f = px < R * R ? 0 : 1 + (px - R * R) / (R * R / 2);
+        if (face >= 0 && f != face) return 0;
+        face = f;
+        int i = (int)floor(fxy[0]), j = (int)floor(fxy[1]);
+        i0 = i < i0 ? i : i0, i1 = i > i1 ? i : i1, j0 = j < j0 ? j : j0, j1 = j > j1 ? j : j1;
+    }
+    int rows = face == 0 ? R : R / 2, base = face == 0 ? 0 : R * R + (face - 1) * (R * R / 2);
+    i0 = i0 - 1 < 0 ? 0 : i0 - 1, j0 = j0 - 1 < 0 ? 0 : j0 - 1;
+    i1 = i1 + 1 > R - 1 ? R - 1 : i1 + 1, j1 = j1 + 1 > rows - 1 ? rows - 1 : j1 + 1;
+    if ((i1 - i0 + 1) * (j1 - j0 + 1) > 1024) return 0;
+    for (int j = j0; j <= j1; j++)
+        for (int i = i0; i <= i1; i++) {
+            int o = c->pcls[base + j * R + i];
+            if (o == RAD_PX_UPSTREAM || (o >= 0 && o != g && c->gpoly[o] != c->gpoly[g])) return 0;
         }
     return 1;
 }
@@ -606,8 +677,7 @@ static int visible(rad_cell *c, const double p[3], const double r[3], const doub
    The ledger stays exact: the shares sum to what the pixels won (normalised weights;
    rounding only), each share goes to absorbed and unshot as rho and 1 - rho, and the
    hemicube decides, as without subdivision, how much the polygon receives. */
-static void distribute(rad_cell *c, int g, const rad_shot_hdr *h, const double (*ax)[3],
-                       const uint8_t *mask)
+static void distribute(rad_cell *c, int g, const rad_shot_hdr *h, const double (*ax)[3])
 {
     int r0 = c->gfirst[g], r1 = c->gfirst[g + 1];
     size_t base = (size_t)r0 * (size_t)c->nsub, n = (size_t)(r1 - r0) * (size_t)c->nsub;
@@ -616,6 +686,7 @@ static void distribute(rad_cell *c, int g, const rad_shot_hdr *h, const double (
     for (int e = r0; e < r1; e++) {
         const rad_elem *x = &c->el[e];
         const rad_piece *pc = &c->patches[x->patch].pc;
+        int pure = c->pvis[x->patch] && unobstructed(c, e, h->p, ax, g);
         for (int s = 0; s < c->nsub; s++) {
             size_t k = (size_t)e * (size_t)c->nsub + (size_t)s, l = k - base;
             w[l] = wf[l] = 0;
@@ -630,7 +701,8 @@ static void distribute(rad_cell *c, int g, const rad_shot_hdr *h, const double (
             if (!(hv[2] > 0) || !(cr > 0) || !(d2 > 0)) continue;
             double ff = A * hv[2] * cr / (d2 * d2);
             wf[l] = ff, Wff += ff;
-            if (visible(c, h->p, r, hv, pc->poly, mask)) w[l] = ff, W += ff;
+            double vis = pure ? 1 : visible(c, h->p, r, hv, ax, g);
+            if (vis > 0) w[l] = ff * vis, W += ff * vis;
         }
     }
     const double *wt = W > 0 ? w : Wff > 0 ? wf : NULL;
@@ -761,9 +833,15 @@ static void process_shot(vw_ctx *ctx, rad_cell *c, const rad_shot_hdr *h, uint8_
             back += !facing;
             x->won = 0;
         }
+        if (c->nglist) {
+            /* Who holds each pixel, for visible(): a group of this cell, upstream, clear. */
+            for (int px = 0; px < hc->npix; px++)
+                c->pcls[px] = c->z.stamp[px] == c->z.cur ? c->rgrp[c->el[c->z.owner[px]].root]
+                              : mask[px >> 3] >> (px & 7) & 1 ? RAD_PX_UPSTREAM : RAD_PX_CLEAR;
+        }
         for (int i = 0; i < c->nglist; i++) {
             int g = c->glist[i];
-            distribute(c, g, h, (const double(*)[3])ax, mask);
+            distribute(c, g, h, (const double(*)[3])ax);
             c->gtouched[g] = 0;
         }
         c->nglist = 0;

@@ -125,6 +125,80 @@ static int cmp_double(const void *a, const void *b)
     return x < y ? -1 : x > y;
 }
 
+/* The slots at the vertex key of point x in polygon poly: [*lo, *hi) of keys, found
+   with a tolerance of one quantum per axis (x comes from interpolation, not clipping). */
+static int find_key(const vkey *keys, size_t ns, int32_t poly, const double x[3], double quant, size_t *lo,
+                    size_t *hi)
+{
+    vkey k;
+    k.poly = poly;
+    int64_t q0[3];
+    for (int a = 0; a < 3; a++) q0[a] = (int64_t)llround(x[a] / quant);
+    for (int d = 0; d < 27; d++) {
+        for (int a = 0; a < 3; a++) k.q[a] = q0[a] + (d / (a == 0 ? 1 : a == 1 ? 3 : 9)) % 3 - 1;
+        size_t l = 0, h = ns;
+        while (l < h) {
+            size_t mid = (l + h) / 2;
+            if (cmp_vkey(&keys[mid], &k) < 0) l = mid + 1;
+            else h = mid;
+        }
+        if (l < ns && cmp_vkey(&keys[l], &k) == 0) {
+            size_t r = l;
+            while (r < ns && cmp_vkey(&keys[r], &k) == 0) r++;
+            *lo = l, *hi = r;
+            return 1;
+        }
+    }
+    return 0;
+}
+
+/* After subdivision a fine element's corner can lie inside the edge of a coarser
+   neighbour (a T-junction). Averaging alone leaves a crack in the shading there: the
+   coarse element interpolates its edge between its two corners, the fine ones use the
+   T-vertex's own value. So every vertex inside the edge of a coarser element of the same
+   polygon takes the value interpolated along that edge; elements are visited coarse to
+   fine, so a T-vertex on an edge whose corner is itself a T-vertex follows the coarser
+   edge too. Only edges along the polygon's grid (u or v constant) can hold T-vertices.
+   Display only: the radiosities in the results are untouched. */
+static void fix_t_junctions(const rad_mesh *m, const rad_elem_result *e, size_t n, const shaded *sh,
+                            const vkey *keys, size_t ns, double quant, double (*lin)[3])
+{
+    int32_t maxl = 0;
+    for (size_t i = 0; i < n; i++) maxl = e[i].level > maxl ? e[i].level : maxl;
+    if (maxl == 0) return;
+    /* The finest have no finer neighbours. */
+    for (int32_t lev = 0; lev < maxl; lev++)
+    for (size_t i = 0; i < n; i++) {
+        if (e[i].level != lev) continue;
+        const rad_piece *pc = &m->pieces[e[i].piece];
+        if (rad_sum3(pc->emit) > 0) continue;
+        double hf = pc->elem / (double)(1 << maxl);
+        int nv = sh->nv[i];
+        for (int v = 0; v < nv; v++) {
+            size_t sa = sh->first[i] + (size_t)v, sb = sh->first[i] + (size_t)((v + 1) % nv);
+            const double *A = sh->v[sa], *B = sh->v[sb];
+            double da[3], db[3];
+            rad_sub(A, pc->origin, da);
+            rad_sub(B, pc->origin, db);
+            double ua = rad_dot(da, pc->uax) / hf, va = rad_dot(da, pc->vax) / hf;
+            double ub = rad_dot(db, pc->uax) / hf, vb = rad_dot(db, pc->vax) / hf;
+            double ta, tb;
+            if (fabs(va - vb) < 1e-6) ta = ua, tb = ub;
+            else if (fabs(ua - ub) < 1e-6) ta = va, tb = vb;
+            else continue;
+            double lo = fmin(ta, tb), hi = fmax(ta, tb);
+            for (double g = floor(lo + 1e-6) + 1; g < hi - 1e-6; g += 1) {
+                double t = (g - ta) / (tb - ta), x[3];
+                for (int k = 0; k < 3; k++) x[k] = A[k] + t * (B[k] - A[k]);
+                size_t l, h;
+                if (!find_key(keys, ns, e[i].poly, x, quant, &l, &h)) continue;
+                for (size_t c = l; c < h; c++)
+                    for (int k = 0; k < 3; k++) lin[keys[c].slot][k] = (1 - t) * lin[sa][k] + t * lin[sb][k];
+            }
+        }
+    }
+}
+
 static int shade(const rad_mesh *m, const rad_elem_result *e, size_t n, const double amb[3], shaded *out)
 {
     memset(out, 0, sizeof *out);
@@ -186,6 +260,11 @@ static int shade(const rad_mesh *m, const rad_elem_result *e, size_t n, const do
             owner[s] = i;
         }
     qsort(keys, ns, sizeof *keys, cmp_vkey);
+    double (*lin)[3] = malloc(sizeof *lin * (ns ? ns : 1));
+    if (!lin) {
+        free(keys), free(owner);
+        goto oom;
+    }
     for (size_t a = 0; a < ns;) {
         size_t b = a;
         double acc[3] = {0, 0, 0}, w = 0;
@@ -198,15 +277,18 @@ static int shade(const rad_mesh *m, const rad_elem_result *e, size_t n, const do
         for (size_t c = a; c < b; c++) {
             size_t i = owner[keys[c].slot];
             const rad_piece *pc = &m->pieces[e[i].piece];
-            for (int k = 0; k < 3; k++) {
-                /* Emitters keep their own colour (a light is not blurred into its frame). */
-                double x = rad_sum3(pc->emit) > 0 ? rad[i][k] : acc[k] / w;
-                x = fmin(fmax(x * expo, 0), 1);
-                out->col[keys[c].slot][k] = (float)pow(x, 1 / 2.2);
-            }
+            /* Emitters keep their own colour (a light is not blurred into its frame). */
+            for (int k = 0; k < 3; k++) lin[keys[c].slot][k] = rad_sum3(pc->emit) > 0 ? rad[i][k] : acc[k] / w;
         }
         a = b;
     }
+    fix_t_junctions(m, e, n, out, keys, ns, quant, lin);
+    for (size_t sl = 0; sl < ns; sl++)
+        for (int k = 0; k < 3; k++) {
+            double x = fmin(fmax(lin[sl][k] * expo, 0), 1);
+            out->col[sl][k] = (float)pow(x, 1 / 2.2);
+        }
+    free(lin);
     free(keys), free(owner), free(rad);
     return 0;
 oom:

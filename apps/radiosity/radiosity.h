@@ -121,10 +121,12 @@ static inline uint64_t rad_shot_seed(int64_t piece, int64_t shot)
     return (uint64_t)piece * 1000003u + (uint64_t)shot;
 }
 
-/* The pixel the direction x (hemicube coordinates, x[2] > 0) passes through, and the
-   depth of the point x along that pixel's face axis (the z-buffer's depth measure).
+/* The pixel the direction x (hemicube coordinates, x[2] > 0) passes through, and its
+   position on that pixel's face in pixel units (pixel (i, j) covers [i, i+1) x [j, j+1)).
    -1 when x is not in front of the shooter. */
-int rad_hemicube_pixel(const rad_hemicube *h, const double x[3], double *depth);
+int rad_hemicube_pixel(const rad_hemicube *h, const double x[3], double fxy[2]);
+/* The direction (hemicube coordinates) through the centre of pixel px. */
+void rad_hemicube_pixel_dir(const rad_hemicube *h, int px, double d[3]);
 
 /* Rasterises a polygon given in hemicube coordinates (x, y along the orientation, z
    along the shooter normal; origin at the shooter) into a z-buffer: pixels whose bit in

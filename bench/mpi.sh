@@ -8,7 +8,7 @@
 # usage: bench/mpi.sh [BUILD_DIR] [SPHERES] [CELLS] [REPEAT]
 set -eu
 repo=$(cd "$(dirname "$0")/.." && pwd)
-build=${1:-$repo/build-mpi}
+build=${1:-${VW_BUILD_DIR:-$repo/build}}
 n=${2:-400000}
 cells=${3:-4x4x4}
 repeat=${4:-3}

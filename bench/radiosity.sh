@@ -7,7 +7,7 @@
 # area-weighted relative RMS over polygons against it (GS=0 skips it).
 # Not run by ctest: timings belong here, never in tests.
 set -eu
-B=${1:-$(dirname "$0")/../build-rad}
+B=${1:-${VW_BUILD_DIR:-$(dirname "$0")/../build}}
 O=${2:-/tmp/vwalls-bench-radiosity}
 V=$B/vwalls
 mkdir -p "$O"

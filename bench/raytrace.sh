@@ -8,7 +8,7 @@
 # Whole processes are timed with date +%s.%N (best of REPEAT runs).
 # usage: bench/raytrace.sh [BUILD_DIR] [SIZE] [REPEAT]     (e.g. bench/raytrace.sh build 512 3)
 set -euo pipefail
-B=${1:-build}
+B=${1:-${VW_BUILD_DIR:-build}}
 SIZE=${2:-512}
 REPEAT=${3:-3}
 HERE=$(cd "$(dirname "$0")" && pwd)

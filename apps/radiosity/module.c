@@ -195,8 +195,9 @@ static void fine_range(const rad_cell *c, const rad_elem *x, int *a0, int *b0, i
 {
     const rad_elem *r = &c->el[x->root];
     int sh = c->fine - x->level;
-    *a0 = (x->gi - (r->gi << x->level)) << sh;
-    *b0 = (x->gj - (r->gj << x->level)) << sh;
+    /* Grid indices may be negative: multiply, do not shift. */
+    *a0 = (x->gi - r->gi * (1 << x->level)) * (1 << sh);
+    *b0 = (x->gj - r->gj * (1 << x->level)) * (1 << sh);
     *w = 1 << sh;
 }
 
@@ -426,8 +427,8 @@ static vw_status cell_build(vw_ctx *ctx, const void *objects, size_t n, void **s
                     c->sca[k] = 0;
                     c->scl[k] = e;
                     memset(c->scc[k], 0, sizeof c->scc[k]);
-                    if (rad_elem_polygon(&c->patches[x->patch].pc, c->fine, (x->gi << c->fine) + a,
-                                         (x->gj << c->fine) + b, &poly) >= 3)
+                    if (rad_elem_polygon(&c->patches[x->patch].pc, c->fine, x->gi * c->side + a,
+                                         x->gj * c->side + b, &poly) >= 3)
                         c->sca[k] = rad_poly_area(&poly, NULL, c->scc[k]);
                 }
         }

@@ -167,33 +167,34 @@ static void fix_t_junctions(const rad_mesh *m, const rad_elem_result *e, size_t 
     for (size_t i = 0; i < n; i++) maxl = e[i].level > maxl ? e[i].level : maxl;
     if (maxl == 0) return;
     /* The finest have no finer neighbours. */
-    for (int32_t lev = 0; lev < maxl; lev++)
-    for (size_t i = 0; i < n; i++) {
-        if (e[i].level != lev) continue;
-        const rad_piece *pc = &m->pieces[e[i].piece];
-        if (rad_sum3(pc->emit) > 0) continue;
-        double hf = pc->elem / (double)(1 << maxl);
-        int nv = sh->nv[i];
-        for (int v = 0; v < nv; v++) {
-            size_t sa = sh->first[i] + (size_t)v, sb = sh->first[i] + (size_t)((v + 1) % nv);
-            const double *A = sh->v[sa], *B = sh->v[sb];
-            double da[3], db[3];
-            rad_sub(A, pc->origin, da);
-            rad_sub(B, pc->origin, db);
-            double ua = rad_dot(da, pc->uax) / hf, va = rad_dot(da, pc->vax) / hf;
-            double ub = rad_dot(db, pc->uax) / hf, vb = rad_dot(db, pc->vax) / hf;
-            double ta, tb;
-            if (fabs(va - vb) < 1e-6) ta = ua, tb = ub;
-            else if (fabs(ua - ub) < 1e-6) ta = va, tb = vb;
-            else continue;
-            double lo = fmin(ta, tb), hi = fmax(ta, tb);
-            for (double g = floor(lo + 1e-6) + 1; g < hi - 1e-6; g += 1) {
-                double t = (g - ta) / (tb - ta), x[3];
-                for (int k = 0; k < 3; k++) x[k] = A[k] + t * (B[k] - A[k]);
-                size_t l, h;
-                if (!find_key(keys, ns, e[i].poly, x, quant, &l, &h)) continue;
-                for (size_t c = l; c < h; c++)
-                    for (int k = 0; k < 3; k++) lin[keys[c].slot][k] = (1 - t) * lin[sa][k] + t * lin[sb][k];
+    for (int32_t lev = 0; lev < maxl; lev++) {
+        for (size_t i = 0; i < n; i++) {
+            if (e[i].level != lev) continue;
+            const rad_piece *pc = &m->pieces[e[i].piece];
+            if (rad_sum3(pc->emit) > 0) continue;
+            double hf = pc->elem / (double)(1 << maxl);
+            int nv = sh->nv[i];
+            for (int v = 0; v < nv; v++) {
+                size_t sa = sh->first[i] + (size_t)v, sb = sh->first[i] + (size_t)((v + 1) % nv);
+                const double *A = sh->v[sa], *B = sh->v[sb];
+                double da[3], db[3];
+                rad_sub(A, pc->origin, da);
+                rad_sub(B, pc->origin, db);
+                double ua = rad_dot(da, pc->uax) / hf, va = rad_dot(da, pc->vax) / hf;
+                double ub = rad_dot(db, pc->uax) / hf, vb = rad_dot(db, pc->vax) / hf;
+                double ta, tb;
+                if (fabs(va - vb) < 1e-6) ta = ua, tb = ub;
+                else if (fabs(ua - ub) < 1e-6) ta = va, tb = vb;
+                else continue;
+                double lo = fmin(ta, tb), hi = fmax(ta, tb);
+                for (double g = floor(lo + 1e-6) + 1; g < hi - 1e-6; g += 1) {
+                    double t = (g - ta) / (tb - ta), x[3];
+                    for (int k = 0; k < 3; k++) x[k] = A[k] + t * (B[k] - A[k]);
+                    size_t l, h;
+                    if (!find_key(keys, ns, e[i].poly, x, quant, &l, &h)) continue;
+                    for (size_t c = l; c < h; c++)
+                        for (int k = 0; k < 3; k++) lin[keys[c].slot][k] = (1 - t) * lin[sa][k] + t * lin[sb][k];
+                }
             }
         }
     }

@@ -49,7 +49,7 @@ typedef struct rad_options {
     int per_round;          /* shots per cell per round */
     double neighbourhood;   /* > 0: a shot reaches only cells within this distance */
     double subdivide;       /* > 0: adaptive subdivision threshold (relative) */
-    int max_level;          /* deepest subdivision level */
+    int max_level;          /* deepest subdivision level (<= RAD_MAX_LEVEL) */
     int64_t max_shots;      /* > 0: stop after this many shots (not converged) */
     int max_rounds;         /* > 0: stop after this many rounds (testing a kill) */
     const char *checkpoint; /* file to write checkpoints to, or NULL */

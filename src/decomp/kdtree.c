@@ -374,13 +374,12 @@ static void walk(walk_state *w, int node, double t0, double t1)
     if (!w->stop && ts < t1) walk(w, far, t0 > ts ? t0 : ts, t1);
 }
 
-int vw_decomp_walk(const vw_decomp *d, const double o[3], const double dir[3], double t0,
-                   double t1, vw_segment_fn fn, void *user)
+/* Clips [*t0p, *t1p] to the world box (slab test), in frame coordinates; 0 when the
+   ray misses it. Every walk clips with this one function, so all agree bit for bit. */
+static int clip(const vw_decomp *d, const double q[3], const double v[3], double *t0p,
+                double *t1p)
 {
-    double q[3], v[3];
-    vw_decomp_to_frame(d, o, q);
-    vw_decomp_to_frame(d, dir, v);
-    /* Clip to the world box (slab test). */
+    double t0 = *t0p, t1 = *t1p;
     for (int a = 0; a < 3; a++) {
         if (v[a] == 0) {
             if (q[a] < d->world.lo[a] || q[a] > d->world.hi[a]) return 0;
@@ -395,7 +394,18 @@ int vw_decomp_walk(const vw_decomp *d, const double o[3], const double dir[3], d
         if (ta > t0) t0 = ta;
         if (tb < t1) t1 = tb;
     }
-    if (!(t0 < t1)) return 0;
+    *t0p = t0;
+    *t1p = t1;
+    return t0 < t1;
+}
+
+int vw_decomp_walk(const vw_decomp *d, const double o[3], const double dir[3], double t0,
+                   double t1, vw_segment_fn fn, void *user)
+{
+    double q[3], v[3];
+    vw_decomp_to_frame(d, o, q);
+    vw_decomp_to_frame(d, dir, v);
+    if (!clip(d, q, v, &t0, &t1)) return 0;
     walk_state w = {d, q, v, fn, user, 0, 0};
     walk(&w, 0, t0, t1);
     return w.count;
@@ -419,29 +429,6 @@ static void ray_to_frame(const vw_decomp *d, const double o[3], const double dir
     }
 }
 
-/* The walk's own clip (vw_decomp_walk), in frame coordinates. */
-static int clip(const vw_decomp *d, const double q[3], const double v[3], double *t0p,
-                double *t1p)
-{
-    double t0 = *t0p, t1 = *t1p;
-    for (int a = 0; a < 3; a++) {
-        if (v[a] == 0) {
-            if (q[a] < d->world.lo[a] || q[a] > d->world.hi[a]) return 0;
-            continue;
-        }
-        double ta = (d->world.lo[a] - q[a]) / v[a], tb = (d->world.hi[a] - q[a]) / v[a];
-        if (ta > tb) {
-            double t = ta;
-            ta = tb;
-            tb = t;
-        }
-        if (ta > t0) t0 = ta;
-        if (tb < t1) t1 = tb;
-    }
-    *t0p = t0;
-    *t1p = t1;
-    return t0 < t1;
-}
 
 /* The first segment is the first leaf of the walk, and the walk reaches it by one
    descent: at a node the near child is taken whenever t0 < ts, and a subtree entered

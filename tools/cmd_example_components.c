@@ -4,9 +4,9 @@
  */
 #include <stdio.h>
 #include <stdlib.h>
-#include <string.h>
 
 #include "cli.h"
+#include "example_opts.h"
 #include "commands.h"
 #include "components.h"
 
@@ -44,41 +44,14 @@ static int64_t largest(const int64_t *labels, size_t n)
 
 int vw_cmd_example_components(int argc, char **argv)
 {
-    long n = 10000, seed = 1, workers = 0;
-    double rmax = 0.035;
-    int dims[3] = {2, 2, 2}, check = 0, quiet = 0;
-    const char *stats = NULL;
-    for (int i = 1; i < argc; i++) {
-        const char *a = argv[i], *v;
-        if (!strcmp(a, "--help") || !strcmp(a, "-h")) {
-            help();
-            return VW_EXIT_OK;
-        } else if (!strcmp(a, "--check")) {
-            check = 1;
-        } else if (!strcmp(a, "--quiet")) {
-            quiet = 1;
-        } else if (!strcmp(a, "--spheres")) {
-            if (!(v = vw_cli_value(CMD, argc, argv, &i)) || vw_cli_int(CMD, a, v, 0, 100000000, &n))
-                return VW_EXIT_USAGE;
-        } else if (!strcmp(a, "--seed")) {
-            if (!(v = vw_cli_value(CMD, argc, argv, &i)) || vw_cli_int(CMD, a, v, 0, 0x7fffffffL, &seed))
-                return VW_EXIT_USAGE;
-        } else if (!strcmp(a, "--workers")) {
-            if (!(v = vw_cli_value(CMD, argc, argv, &i)) || vw_cli_int(CMD, a, v, 1, 1024, &workers))
-                return VW_EXIT_USAGE;
-        } else if (!strcmp(a, "--radius")) {
-            if (!(v = vw_cli_value(CMD, argc, argv, &i)) || vw_cli_double(CMD, a, v, 1e-6, 0.25, &rmax))
-                return VW_EXIT_USAGE;
-        } else if (!strcmp(a, "--cells")) {
-            if (!(v = vw_cli_value(CMD, argc, argv, &i)) || vw_cli_layout(CMD, a, v, dims))
-                return VW_EXIT_USAGE;
-        } else if (!strcmp(a, "--stats")) {
-            if (!(stats = vw_cli_value(CMD, argc, argv, &i))) return VW_EXIT_USAGE;
-        } else {
-            vw_cli_error(CMD, "unknown option '%s' (try --help)", a);
-            return VW_EXIT_USAGE;
-        }
-    }
+    vw_example_opts o = {.spheres = 10000, .seed = 1, .workers = 0, .radius = 0.035,
+                         .dims = {2, 2, 2}};
+    int rc0 = vw_example_opts_parse(CMD, argc, argv, &o, help);
+    if (rc0 >= 0) return rc0;
+    long n = o.spheres, seed = o.seed, workers = o.workers;
+    double rmax = o.radius;
+    int *dims = o.dims, check = o.check, quiet = o.quiet;
+    const char *stats = o.stats;
     size_t ns = (size_t)(n ? n : 1);
     ex_sphere *s = malloc(sizeof *s * ns);
     int64_t *labels = malloc(sizeof *labels * ns), *ref = check ? malloc(sizeof *ref * ns) : NULL;

@@ -6,10 +6,8 @@
 set -eu
 repo=$(cd "$(dirname "$0")/.." && pwd)
 build=${1:-$repo/build-mpich}
-if [ ! -x /usr/bin/mpicc.mpich ] || [ ! -x /usr/bin/mpiexec.mpich ]; then
-    echo "mpich-test.sh: installing libmpich-dev and mpich"
-    DEBIAN_FRONTEND=noninteractive apt-get install -y -q libmpich-dev mpich >/dev/null
-fi
+# The same idempotent installer as ./run (apt-get update first when anything is missing).
+"$repo/scripts/setup.sh" build mpich
 # Keep the system default MPI whatever its priority was (installing MPICH may switch
 # the Debian alternatives to it); this script only points CMake at MPICH's wrappers.
 cmake -S "$repo" -B "$build" -DVW_WERROR=ON \

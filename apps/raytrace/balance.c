@@ -166,13 +166,35 @@ vw_status rt_job_balance(rt_job *j, const rt_balance *b, rt_balance_result *bi, 
     rt_job_set_sample(j, stride);
     bi->stride = stride;
     int rounds = b->rounds > 0 ? b->rounds : 1;
+    /* Divide: one more round that duplicates the cells still too heavy (division
+       stops at whole cells and its pieces are predicted from a coarse field). Rotate:
+       two more rounds, so the walls of the new frame are tuned on measurements taken
+       in it (the first ones come from a field measured in the old frame). */
+    int xdup = b->strategy == VW_BALANCE_DIVIDE ? 1 : 0;
+    rounds += xdup + (b->strategy == VW_BALANCE_ROTATE ? 2 : 0);
     /* Every balance is checked by the next pre-pass: the best measured layout so far is
-       kept, and a balance the measurement refutes (lambda no lower than before) is undone
-       and ends the rounds. So with R rounds there are R + 1 pre-passes. */
+       kept and restored at the end, so a balance the measurement refutes (lambda no
+       lower than the best) is undone. So with R rounds there are R + 1 pre-passes. */
     layout best = {0};
     double best_lam = 0;
     for (int r = 0; st == VW_OK && r <= rounds; r++) {
         double t0 = now();
+        if (b->stride <= 0 && r > 0) {
+            /* About RT_PREPASS_RAYS eye rays for every cell of the layout measured now:
+               divide makes more (and smaller) cells, duplication shares cells between
+               workers; a stride chosen for the first layout would sample them coarsely. */
+            const vw_decomp *dn = vw_world_decomp(w);
+            int units = 0, nc = vw_decomp_cell_count(dn);
+            for (int c = 0; c < nc; c++) units += 1 + vw_world_replicas(w, c, NULL, 0);
+            int s2 = rt_prepass_stride(sh->view.width, sh->view.height, units);
+            if (s2 < stride) {
+                stride = s2;
+                rt_job_set_sample(j, stride);
+                bi->stride = stride;
+                if (st == VW_OK) st = rebuild(w);
+            }
+        }
+        if (st != VW_OK) break;
         st = rt_job_reset(j);
         /* Cells built before the sample was set (the caller's commit) must be rebuilt. */
         if (st == VW_OK && r == 0) st = rebuild(w);
@@ -188,14 +210,18 @@ vw_status rt_job_balance(rt_job *j, const rt_balance *b, rt_balance_result *bi, 
             break;
         }
         double lam = measured_lambda(w, &b->load, load, b->speeds);
-        if (r > 0 && b->strategy != VW_BALANCE_NONE && !(lam < best_lam)) {
-            /* Refuted: back to the best layout measured (its cells are built for the
-               pre-pass as the others, so stale stays). */
+        /* Refuted (lambda no lower than the best measured): the field still learns
+           from this measurement and the next round balances on from here; the best
+           layout measured is restored when the rounds end. */
+        int refuted = r > 0 && b->strategy != VW_BALANCE_NONE && !(lam < best_lam);
+        if (refuted && r == rounds) {
+            /* Back to the best layout measured (its cells are built for the pre-pass as
+               the others, so stale stays). */
             st = layout_restore(w, &best);
             bi->reverted++;
             break;
         }
-        if (b->strategy != VW_BALANCE_NONE) {
+        if (!refuted && b->strategy != VW_BALANCE_NONE) {
             best_lam = lam;
             bi->measured = lam;
             st = layout_save(w, &best);
@@ -217,6 +243,18 @@ vw_status rt_job_balance(rt_job *j, const rt_balance *b, rt_balance_result *bi, 
         vw_balance_params bp;
         vw_balance_params_init(&bp);
         bp.strategy = b->strategy;
+        if (xdup && r == rounds - 1) {
+            /* Duplicate on the best divided layout, unless it is balanced enough. */
+            if (refuted) {
+                st = layout_restore(w, &best);
+                bi->reverted++;
+                refuted = 0;
+                if (st != VW_OK || !(best_lam > 1.0 + bp.tolerance)) break;
+            } else if (!(lam > 1.0 + bp.tolerance)) {
+                break;
+            }
+            bp.strategy = VW_BALANCE_DUPLICATE;
+        }
         bp.speeds = b->speeds;
         vw_balance_apply ap = {(int)b->map, b->speeds, 0, 0};
         vw_balance_report rep;
@@ -231,7 +269,13 @@ vw_status rt_job_balance(rt_job *j, const rt_balance *b, rt_balance_result *bi, 
         bi->migrated += rep.migrated_objects;
         bi->bytes += rep.bytes_moved;
         bi->rounds++;
-        if (!rep.applied) break; /* nothing changed: measuring again would tell nothing */
+        if (!rep.applied) { /* nothing changed: measuring again would tell nothing */
+            if (refuted) {
+                st = layout_restore(w, &best);
+                bi->reverted++;
+            }
+            break;
+        }
     }
     layout_free(&best);
     rt_job_set_sample(j, 1);

@@ -102,6 +102,19 @@ static void jacobi3(double A[3][3], double V[3][3], double ev[3])
     for (int i = 0; i < 3; i++) ev[i] = A[i][i];
 }
 
+/* max / mean of the field's loads on d's cells (one cell per worker). */
+static double cells_lambda(const vw_load_field *f, const vw_decomp *d, double *ld)
+{
+    int nc = vw_decomp_cell_count(d);
+    vw_load_field_cell_loads(f, d, ld);
+    double max = 0, sum = 0;
+    for (int c = 0; c < nc; c++) {
+        sum += ld[c];
+        if (ld[c] > max) max = ld[c];
+    }
+    return sum > 0 ? max / (sum / nc) : 1.0;
+}
+
 vw_status vw__balance_rotate(const vw_decomp *cur, const vw_load_field *f,
                              const vw_balance_params *p, const int dims[3], vw_decomp **out)
 {
@@ -171,25 +184,68 @@ vw_status vw__balance_rotate(const vw_decomp *cur, const vw_load_field *f,
                 axes[i] = axes[j];
                 axes[j] = t;
             }
-    double F[9];
-    for (int i = 0; i < 3; i++)
-        for (int k = 0; k < 3; k++) F[3 * axes[i] + k] = V[k][order[i]];
-    /* 4. The world box in the new frame: bounds of the rotated old world box. */
+    /* 4. Candidates: the principal axes onto the frame axes (the principal axis onto
+       the axis with most cells first), turned about the principal axis in steps of 15
+       degrees (when the load is round about its axis the fit fixes no second axis),
+       and the unrotated frame. The one whose tensor walls give the lowest predicted
+       max/mean cell load wins, so rotation never predicts worse than tensor. */
+    double best_lam = INFINITY;
+    vw_decomp *best = NULL;
+    vw_status st = vw__balance_tensor(cur, f, p, dims, &best);
+    if (st != VW_OK) return st;
+    double *ld = malloc(sizeof(double) * VW_MAX_CELLS);
+    if (!ld) {
+        vw_decomp_free(best);
+        return VW_E_NOMEM;
+    }
+    best_lam = cells_lambda(f, best, ld);
     double P[8][3];
     world_corners(cur, P);
-    vw_box wb;
-    for (int a = 0; a < 3; a++) wb.lo[a] = INFINITY, wb.hi[a] = -INFINITY;
-    for (int i = 0; i < 8; i++)
-        for (int a = 0; a < 3; a++) {
-            double q = F[3 * a] * P[i][0] + F[3 * a + 1] * P[i][1] + F[3 * a + 2] * P[i][2];
-            wb.lo[a] = fmin(wb.lo[a], q);
-            wb.hi[a] = fmax(wb.hi[a], q);
+    for (int perm = 0; perm < 6 && st == VW_OK; perm++) {
+        static const int perms[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2}, {1, 2, 0}, {2, 0, 1}, {2, 1, 0}};
+        for (int step = 0; step < 12 && st == VW_OK; step++) {
+            double th = step * (M_PI / 12.0), c = cos(th), sn = sin(th);
+            double e[3][3]; /* principal axes, the 2nd and 3rd turned by th */
+            for (int k = 0; k < 3; k++) {
+                e[0][k] = V[k][order[0]];
+                e[1][k] = c * V[k][order[1]] + sn * V[k][order[2]];
+                e[2][k] = -sn * V[k][order[1]] + c * V[k][order[2]];
+            }
+            double F[9];
+            for (int i = 0; i < 3; i++)
+                for (int k = 0; k < 3; k++) F[3 * axes[perms[perm][i]] + k] = e[i][k];
+            vw_box wb;
+            for (int a = 0; a < 3; a++) wb.lo[a] = INFINITY, wb.hi[a] = -INFINITY;
+            for (int i = 0; i < 8; i++)
+                for (int a = 0; a < 3; a++) {
+                    double q = F[3 * a] * P[i][0] + F[3 * a + 1] * P[i][1] + F[3 * a + 2] * P[i][2];
+                    wb.lo[a] = fmin(wb.lo[a], q);
+                    wb.hi[a] = fmax(wb.hi[a], q);
+                }
+            /* A hair of padding: rounding in the rotation must not push a corner outside. */
+            for (int a = 0; a < 3; a++) {
+                double pad = 1e-9 * (wb.hi[a] - wb.lo[a]);
+                wb.lo[a] -= pad;
+                wb.hi[a] += pad;
+            }
+            vw_decomp *d = NULL;
+            st = tensor_in_frame(f, F, &wb, dims, p->min_width, &d);
+            if (st != VW_OK) break;
+            double lam = cells_lambda(f, d, ld);
+            if (lam < best_lam - 1e-9) {
+                vw_decomp_free(best);
+                best = d;
+                best_lam = lam;
+            } else {
+                vw_decomp_free(d);
+            }
         }
-    /* A hair of padding: rounding in the rotation must not push a corner outside. */
-    for (int a = 0; a < 3; a++) {
-        double pad = 1e-9 * (wb.hi[a] - wb.lo[a]);
-        wb.lo[a] -= pad;
-        wb.hi[a] += pad;
     }
-    return tensor_in_frame(f, F, &wb, dims, p->min_width, out);
+    free(ld);
+    if (st != VW_OK) {
+        vw_decomp_free(best);
+        return st;
+    }
+    *out = best;
+    return VW_OK;
 }

@@ -1,6 +1,7 @@
 # balance.cmake - tests of the load balancers (src/balance) and the mappers (src/map):
 # images bit-identical with every strategy and mapping, objects conserved by migration,
-# staggered reaching lambda <= 1.10 on deterministic work, rotation following the load,
+# staggered reaching lambda <= 1.10 and divide <= 1.06 (16 cells, clustered) on deterministic
+# work, rotation following the load,
 # and the mapping invariants. Deterministic work counts only: no timings are asserted.
 
 add_executable(vw_test_balance ${PROJECT_SOURCE_DIR}/tests/balance/bal_test.c)
@@ -13,10 +14,11 @@ add_test(NAME balance_identical_mixed
 add_test(NAME balance_conserve COMMAND vw_test_balance conserve)
 add_test(NAME balance_staggered8 COMMAND vw_test_balance staggered8)
 add_test(NAME balance_rotate COMMAND vw_test_balance rotate)
+add_test(NAME balance_divide16 COMMAND vw_test_balance divide16)
 add_test(NAME balance_map COMMAND vw_test_balance map)
 add_test(NAME balance_duplicate COMMAND vw_test_balance duplicate)
 set_tests_properties(balance_identical_spheres balance_identical_mixed balance_conserve
-  balance_staggered8 balance_rotate balance_map balance_duplicate PROPERTIES LABELS "balance;threads"
+  balance_staggered8 balance_divide16 balance_rotate balance_map balance_duplicate PROPERTIES LABELS "balance;threads"
   ENVIRONMENT "${VW_BAL_TSAN}")
 
 # The command line: PNG bytes equal for every --balance and --map, under the threads

@@ -139,6 +139,9 @@ static double measured_lambda(vw_world *w, const vw_load_spec *ls, const double 
     return lam;
 }
 
+/* Extra pre-pass / balance rounds for divide and rotate (see rt_job_balance). */
+#define RT_BALANCE_EXTRA 3
+
 int rt_prepass_stride(int width, int height, int cells)
 {
     /* At least RT_PREPASS_RAYS eye rays per cell on average: a cell's measured load is a
@@ -166,12 +169,13 @@ vw_status rt_job_balance(rt_job *j, const rt_balance *b, rt_balance_result *bi, 
     rt_job_set_sample(j, stride);
     bi->stride = stride;
     int rounds = b->rounds > 0 ? b->rounds : 1;
-    /* Divide: one more round that duplicates the cells still too heavy (division
-       stops at whole cells and its pieces are predicted from a coarse field). Rotate:
-       two more rounds, so the walls of the new frame are tuned on measurements taken
-       in it (the first ones come from a field measured in the old frame). */
-    int xdup = b->strategy == VW_BALANCE_DIVIDE ? 1 : 0;
-    rounds += xdup + (b->strategy == VW_BALANCE_ROTATE ? 2 : 0);
+    /* Divide and rotate get RT_BALANCE_EXTRA more rounds: their first balance is
+       predicted from a field measured on the old cells (uniform inside each), so a
+       divided piece or a rotated frame is cut from a coarse picture; the rounds after
+       it cut again from measurements on the new cells. They end early once a balance
+       predicts no gain. */
+    if (b->strategy == VW_BALANCE_DIVIDE || b->strategy == VW_BALANCE_ROTATE)
+        rounds += RT_BALANCE_EXTRA;
     /* Every balance is checked by the next pre-pass: the best measured layout so far is
        kept and restored at the end, so a balance the measurement refutes (lambda no
        lower than the best) is undone. So with R rounds there are R + 1 pre-passes. */
@@ -243,18 +247,6 @@ vw_status rt_job_balance(rt_job *j, const rt_balance *b, rt_balance_result *bi, 
         vw_balance_params bp;
         vw_balance_params_init(&bp);
         bp.strategy = b->strategy;
-        if (xdup && r == rounds - 1) {
-            /* Duplicate on the best divided layout, unless it is balanced enough. */
-            if (refuted) {
-                st = layout_restore(w, &best);
-                bi->reverted++;
-                refuted = 0;
-                if (st != VW_OK || !(best_lam > 1.0 + bp.tolerance)) break;
-            } else if (!(lam > 1.0 + bp.tolerance)) {
-                break;
-            }
-            bp.strategy = VW_BALANCE_DUPLICATE;
-        }
         bp.speeds = b->speeds;
         vw_balance_apply ap = {(int)b->map, b->speeds, 0, 0};
         vw_balance_report rep;

@@ -1,6 +1,7 @@
 /* tensor.c - the tensor balancer (the paper's "division by hyperplanes in all
  * dimensions", walls moved as whole hyperplanes) and frame rotation ("rotating the
- * scene": the principal axis of the load made axis-parallel, then tensor).
+ * scene": the principal axis of the load made axis-parallel, then tensor; of the
+ * candidate frames, and the unrotated one, the one predicting the lowest lambda wins).
  *
  * Tensor keeps a grid a grid: every cell keeps exactly one neighbour per face, because
  * a wall is moved as a whole. Per axis, the walls go where the marginal load (the load

@@ -6,6 +6,8 @@
  *                         overlap (ids, counts and checksums) through a chain of balancers
  *   staggered8            staggered reaches lambda <= 1.10 on the counted work of a
  *                         50%-clustered 1000-sphere scene with 8 cells
+ *   divide16              divide (with its extra rounds) reaches lambda <= 1.06 on the
+ *                         counted work of a 100%-clustered 1000-sphere scene, 16 cells
  *   rotate                the principal-axis frame of an oblique line of load is the line
  *   map                   every cell mapped once; block keeps a hand layout's neighbour
  *                         share; weighted gives speeds 1,1,2,4 proportional load
@@ -335,6 +337,32 @@ static int t_staggered8(void)
     return failures ? 1 : 0;
 }
 
+#define DIVIDE16_MAX 1.06
+
+/* ---- divide16: division with its extra rounds on a fully clustered scene ---------------- */
+
+static int t_divide16(void)
+{
+    vw_scene *s = load_scene("spheres:1:1");
+    int dims[3] = {4, 2, 2};
+    double lam[2];
+    for (int strat = 0; strat < 2; strat++) {
+        rt_balance b;
+        balance_spec(&b, strat ? VW_BALANCE_DIVIDE : VW_BALANCE_NONE);
+        b.stride = 0; /* the automatic stride, which follows the divided layout */
+        rt_job *j;
+        int64_t *sums = render(s, 128, 128, dims, 16, strat ? &b : NULL, &j);
+        lam[strat] = rt_job_work_imbalance(j, NULL);
+        free(sums);
+        rt_job_free(j);
+    }
+    printf("divide16: work lambda none %.3f, divide %.3f\n", lam[0], lam[1]);
+    CHECK(lam[1] <= DIVIDE16_MAX, "divide lambda %.3f > %.2f (none: %.3f)", lam[1], DIVIDE16_MAX,
+          lam[0]);
+    vw_scene_free(s);
+    return failures ? 1 : 0;
+}
+
 /* ---- rotate: the frame follows an oblique line of load --------------------------------- */
 
 static int t_rotate(void)
@@ -592,7 +620,7 @@ static int t_duplicate(void)
 int main(int argc, char **argv)
 {
     if (argc < 2) {
-        fprintf(stderr, "usage: bal_test identical|conserve|staggered8|rotate|map|duplicate [...]\n");
+        fprintf(stderr, "usage: bal_test identical|conserve|staggered8|divide16|rotate|map|duplicate [...]\n");
         return 2;
     }
     const char *cmd = argv[1];
@@ -600,6 +628,7 @@ int main(int argc, char **argv)
     if (!strcmp(cmd, "conserve")) return t_conserve();
     if (!strcmp(cmd, "staggered8")) return t_staggered8();
     if (!strcmp(cmd, "rotate")) return t_rotate();
+    if (!strcmp(cmd, "divide16")) return t_divide16();
     if (!strcmp(cmd, "map")) return t_map();
     if (!strcmp(cmd, "duplicate")) return t_duplicate();
     fprintf(stderr, "bal_test: unknown test '%s'\n", cmd);

@@ -30,7 +30,9 @@ extern "C" {
 typedef enum vw_balance_strategy {
     VW_BALANCE_NONE = 0,
     VW_BALANCE_TENSOR,    /* move whole hyperplanes, axis by axis (grid stays a grid) */
-    VW_BALANCE_ROTATE,    /* principal axis of the load -> rotated frame, then tensor */
+    VW_BALANCE_ROTATE,    /* principal axis of the load -> rotated frame, then tensor; the
+                             frame is the best predicted of the axis assignments and turns
+                             about the principal axis (15-degree steps), or none */
     VW_BALANCE_STAGGERED, /* x slabs, y cuts per slab, z cuts per column */
     VW_BALANCE_DIVIDE,    /* overloaded cells split into sub-cells for idle workers */
     VW_BALANCE_DUPLICATE  /* overloaded cells copied to idle workers (see world.h) */

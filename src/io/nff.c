@@ -222,28 +222,13 @@ static vw_status read_int(nff *P, const char *what, long lo, long hi, int *out)
     char sb[48];
     if (!lex_next(&P->lx, &t, 0))
         return fail(P, P->entity_line, "file ends in the middle of '%s'", P->entity);
-    long v = 0;
-    size_t i = 0;
-    int ok = t.n > 0 && t.n < 12;
-    int neg = 0;
-    if (ok && (t.s[0] == '-' || t.s[0] == '+')) {
-        neg = t.s[0] == '-';
-        i = 1;
-        ok = t.n > 1;
-    }
-    for (; ok && i < t.n; i++) {
-        if (t.s[i] < '0' || t.s[i] > '9')
-            ok = 0;
-        else
-            v = v * 10 + (t.s[i] - '0');
-    }
-    if (!ok) {
+    long long vv;
+    if (!vw__parse_int(t.s, t.n, 11, &vv)) {
         if (is_keyword(&t))
             return fail(P, t.line, "wrong number of values for '%s'", P->entity);
         return fail(P, t.line, "bad %s '%s' in '%s'", what, show(&t, sb), P->entity);
     }
-    if (neg)
-        v = -v;
+    long v = (long)vv;
     if (v < lo || v > hi) {
         if (P->entity[0] == 'p' && v < lo)
             return fail(P, t.line, "polygon needs at least 3 vertices");

@@ -320,24 +320,9 @@ static vw_status load_mtllib(obj *O, const char *dir, span fname)
 static vw_status resolve(obj *O, span t, const char *what, size_t count, int *out)
 {
     char sb[48];
-    long long v = 0;
-    size_t i = 0;
-    int neg = 0, ok = t.n > 0 && t.n < 16;
-    if (ok && (t.s[0] == '-' || t.s[0] == '+')) {
-        neg = t.s[0] == '-';
-        i = 1;
-        ok = t.n > 1;
-    }
-    for (; ok && i < t.n; i++) {
-        if (t.s[i] < '0' || t.s[i] > '9')
-            ok = 0;
-        else
-            v = v * 10 + (t.s[i] - '0');
-    }
-    if (!ok)
+    long long v;
+    if (!vw__parse_int(t.s, t.n, 15, &v))
         return fail(O, "bad %s index '%s'", what, show(t, sb));
-    if (neg)
-        v = -v;
     long long at = v > 0 ? v - 1 : (long long)count + v;
     if (v == 0 || at < 0 || at >= (long long)count)
         return fail(O, "%s index %lld out of range (%zu %s)", what, v, count,

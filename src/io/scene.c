@@ -20,6 +20,25 @@ void vw__errf(char *err, size_t errlen, const char *fmt, ...)
     va_end(ap);
 }
 
+int vw__parse_int(const char *s, size_t n, size_t maxlen, long long *out)
+{
+    size_t i = 0;
+    int neg = 0;
+    long long v = 0;
+    if (n == 0 || n > maxlen) return 0;
+    if (s[0] == '-' || s[0] == '+') {
+        neg = s[0] == '-';
+        if (n == 1) return 0;
+        i = 1;
+    }
+    for (; i < n; i++) {
+        if (s[i] < '0' || s[i] > '9') return 0;
+        v = v * 10 + (s[i] - '0');
+    }
+    *out = neg ? -v : v;
+    return 1;
+}
+
 vw_status vw__input_error(char *err, size_t errlen, const char *name, int line,
                           const char *fmt, va_list ap)
 {

@@ -351,6 +351,20 @@ static void handle_ray(vw_ctx *ctx, void *state, const void *msg)
 
 /* ---- cells ---------------------------------------------------------------------------- */
 
+/* Appends pixel index px to the cell's list (capacity *cap, doubling); 0 if out of memory. */
+static int add_pixel(rt_cell *c, size_t *cap, int px)
+{
+    if (c->npixels == *cap) {
+        size_t ncap = *cap ? 2 * *cap : 256;
+        int *np = realloc(c->pixels, ncap * sizeof *np);
+        if (!np) return 0;
+        c->pixels = np;
+        *cap = ncap;
+    }
+    c->pixels[c->npixels++] = px;
+    return 1;
+}
+
 /* The pixels whose eye ray enters the world in this cell: bound them by projecting the
    cell's corners, then keep the candidates whose first walk segment is this cell. Every
    pixel whose eye ray meets the world so has exactly one owner. */
@@ -370,13 +384,7 @@ static vw_status primary_pixels(vw_ctx *ctx, rt_cell *c)
         for (int y = 0; y < v->height; y += sample)
             for (int x = 0; x < v->width; x += sample) {
                 if (owner[(size_t)y * v->width + x] != me) continue;
-                if (c->npixels == cap) {
-                    cap = cap ? 2 * cap : 256;
-                    int *np = realloc(c->pixels, cap * sizeof *np);
-                    if (!np) return VW_E_NOMEM;
-                    c->pixels = np;
-                }
-                c->pixels[c->npixels++] = y * v->width + x;
+                if (!add_pixel(c, &cap, y * v->width + x)) return VW_E_NOMEM;
             }
         return VW_OK;
     }
@@ -414,13 +422,7 @@ static vw_status primary_pixels(vw_ctx *ctx, rt_cell *c)
             rt_view_ray(v, x, y, dir);
             if (!vw_decomp_first_segment(d, v->eye, dir, 0.0, INFINITY, &s) || s.cell != me)
                 continue;
-            if (c->npixels == cap) {
-                cap = cap ? 2 * cap : 256;
-                int *np = realloc(c->pixels, cap * sizeof *np);
-                if (!np) return VW_E_NOMEM;
-                c->pixels = np;
-            }
-            c->pixels[c->npixels++] = y * v->width + x;
+            if (!add_pixel(c, &cap, y * v->width + x)) return VW_E_NOMEM;
         }
     }
     return VW_OK;

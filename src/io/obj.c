@@ -223,18 +223,29 @@ static vw_status add_named_material(obj *O, span name)
     return VW_OK;
 }
 
+/* The next line of [*p, end) (without its newline) into *line, counting it in O->line;
+   0 at the end of the text. */
+static int next_line(obj *O, const char **p, const char *end, span *line)
+{
+    if (*p >= end)
+        return 0;
+    const char *eol = memchr(*p, '\n', (size_t)(end - *p));
+    if (!eol)
+        eol = end;
+    O->line++;
+    line->s = *p;
+    line->n = (size_t)(eol - *p);
+    *p = eol + (eol < end);
+    return 1;
+}
+
 static vw_status parse_mtl(obj *O, const char *text, size_t len)
 {
     const char *p = text, *end = text + len;
     vw_material *m = NULL;
     O->line = 0;
-    while (p < end) {
-        const char *eol = memchr(p, '\n', (size_t)(end - p));
-        if (!eol)
-            eol = end;
-        O->line++;
-        span line = {p, (size_t)(eol - p)}, key;
-        p = eol + (eol < end);
+    span line, key;
+    while (next_line(O, &p, end, &line)) {
         if (!next_tok(&line, &key))
             continue;
         if (span_is(key, "newmtl")) {
@@ -394,13 +405,8 @@ static vw_status parse_face(obj *O, span *line)
 static vw_status parse_obj(obj *O, const char *text, size_t len, const char *dir)
 {
     const char *p = text, *end = text + len;
-    while (p < end) {
-        const char *eol = memchr(p, '\n', (size_t)(end - p));
-        if (!eol)
-            eol = end;
-        O->line++;
-        span line = {p, (size_t)(eol - p)}, key;
-        p = eol + (eol < end);
+    span line, key;
+    while (next_line(O, &p, end, &line)) {
         if (!next_tok(&line, &key))
             continue;
         vw_status st = VW_OK;

@@ -19,6 +19,10 @@ add_test(NAME raytrace_stress_mixed COMMAND vw_test_raytrace identical ${VW_RT_M
 set(VW_RT_TSAN "TSAN_OPTIONS=suppressions=${PROJECT_SOURCE_DIR}/tests/raytrace/tsan.supp")
 set_tests_properties(raytrace_cone raytrace_analytic raytrace_identical_balls
   raytrace_identical_mixed PROPERTIES ENVIRONMENT "${VW_RT_TSAN}")
+# Threads-engine tests: ./run test-sanitizers runs them under TSan (rays handed from
+# cell to cell inline and by message, under the stress switch too).
+set_tests_properties(raytrace_cone raytrace_analytic raytrace_identical_balls
+  raytrace_identical_mixed raytrace_stress_balls raytrace_stress_mixed PROPERTIES LABELS "threads")
 set_tests_properties(raytrace_stress_balls PROPERTIES ENVIRONMENT "VW_STRESS=7;${VW_RT_TSAN}")
 set_tests_properties(raytrace_stress_mixed PROPERTIES
   ENVIRONMENT "VW_STRESS=1994;VW_STRESS_SPLIT=1;${VW_RT_TSAN}")

@@ -308,9 +308,12 @@ static void shade(vw_ctx *ctx, rt_cell *c, const rt_ray *r, const rt_hit *h)
 
 /* Search this cell's segment [t0, t1] of the ray; on a miss pass the ray on to the next
    cell of its walk (restarted at t1, which splits the interval exactly as the full walk
-   does), or end it when the walk leaves the world. */
-static void trace(vw_ctx *ctx, rt_cell *c, rt_ray *r)
+   does), or end it when the walk leaves the world. A next cell on this same worker is
+   entered inline (vw_ctx_enter): the ray goes on in this loop, with no message.
+   Returns whether it did so (the context is then another cell's). */
+static int walk_ray(vw_ctx *ctx, rt_cell *c, rt_ray *r)
 {
+    int entered = 0;
     const vw_decomp *d = vw_ctx_decomp(ctx);
     int me = vw_ctx_cell(ctx);
     for (;;) {
@@ -320,12 +323,12 @@ static void trace(vw_ctx *ctx, rt_cell *c, rt_ray *r)
         if (r->kind == RT_SHADOW) {
             if (rt_cell_geo_occluded(&c->geo, r->org, r->dir, tn, r->t1)) {
                 vw_count(ctx, RT_C_ENDED, 1);
-                return;
+                return entered;
             }
         } else if (rt_cell_geo_intersect(&c->geo, r->org, r->dir, tn, r->t1, &h)) {
             vw_count(ctx, RT_C_ENDED, 1);
             shade(ctx, c, r, &h);
-            return;
+            return entered;
         }
         vw_segment s;
         /* s.t1 > r->t1: the walk must make progress, or a ray could circle forever. */
@@ -334,12 +337,26 @@ static void trace(vw_ctx *ctx, rt_cell *c, rt_ray *r)
             r->t0 = s.t0;
             r->t1 = s.t1;
             if (s.cell == me) continue;
+            rt_cell *next = vw_ctx_enter(ctx, s.cell);
+            if (next) {
+                c = next;
+                me = s.cell;
+                entered = 1;
+                continue;
+            }
             vw_send_cell(ctx, s.cell, RT_K_RAY, r);
-            return;
+            return entered;
         }
         finish_free(ctx, c, r);
-        return;
+        return entered;
     }
+}
+
+/* The ray in this cell and on; the context is this cell's again afterwards. */
+static void trace(vw_ctx *ctx, rt_cell *c, rt_ray *r)
+{
+    int cell = vw_ctx_cell(ctx), replica = vw_ctx_replica(ctx);
+    if (walk_ray(ctx, c, r)) vw_ctx_restore(ctx, cell, replica);
 }
 
 static void handle_ray(vw_ctx *ctx, void *state, const void *msg)

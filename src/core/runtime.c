@@ -212,6 +212,68 @@ static void enqueue(vw_ctx *ctx, int slot, int dest, int cell, int kind, const v
     }
 }
 
+/* ---- the meter: busy time per cell ---------------------------------------------------- */
+
+/* Every unit (cell, or copy of a duplicated cell) is charged the time the worker spent
+   running its callbacks: the balancer's measured load. The clock is read when the
+   worker switches unit by message or step; an inline hand-off (vw_ctx_enter) only
+   notes the unit it enters, because a clock read (28 ns here) costs as much as the ray
+   segment it would time. The time since the last read is shared evenly among the units
+   noted since, and read again once VW__METER_N are noted; without hand-offs a unit is
+   charged exactly the time between its switches, as before. */
+static void meter_charge(vw__worker *wk, double now)
+{
+    vw_world *w = wk->w;
+    double dt = now - wk->mark;
+    const double *s = w->cfg.worker_slowdown;
+    if (s && s[wk->global] > 1.0) {
+        /* An emulated slower machine: spin for (k-1) times the time spent, charged too. */
+        double until = now + dt * (s[wk->global] - 1.0);
+        while ((now = vw__now()) < until) {
+        }
+        dt = now - wk->mark;
+    }
+    wk->busy_s += dt;
+    double share = wk->nmetered > 1 ? dt / wk->nmetered : dt;
+    for (int i = 0; i < wk->nmetered; i++) {
+        int cell = wk->metered[i].cell, rep = wk->metered[i].rep;
+        if (cell < 0) continue;
+        if (rep) w->cells[cell].reps[rep - 1].busy_s += share;
+        else w->cells[cell].busy_s += share;
+    }
+    wk->mark = now;
+    wk->nmetered = 0;
+}
+
+/* The worker starts running unit (cell, rep): what ran before is charged. */
+static void meter_switch(vw__worker *wk, int cell, int rep)
+{
+    meter_charge(wk, vw__now());
+    wk->metered[0].cell = cell;
+    wk->metered[0].rep = rep;
+    wk->nmetered = 1;
+}
+
+/* Starts the meter on unit (cell, rep), the time before uncharged (inbox, idle). */
+static void meter_start(vw__worker *wk, int cell, int rep)
+{
+    wk->mark = vw__now();
+    wk->metered[0].cell = cell;
+    wk->metered[0].rep = rep;
+    wk->nmetered = 1;
+}
+
+static void meter_stop(vw__worker *wk) { meter_charge(wk, vw__now()); }
+
+/* An inline hand-off to unit (cell, rep): noted, timed with the next clock read. */
+static void meter_note(vw__worker *wk, int cell, int rep)
+{
+    if (wk->nmetered == VW__METER_N) meter_charge(wk, vw__now());
+    wk->metered[wk->nmetered].cell = cell;
+    wk->metered[wk->nmetered].rep = rep;
+    wk->nmetered++;
+}
+
 /* ---- the module's side: vw_ctx ------------------------------------------------------ */
 
 int vw_ctx_cell(const vw_ctx *ctx) { return ctx->cell; }
@@ -224,6 +286,40 @@ int vw_ctx_replica(const vw_ctx *ctx) { return ctx->rep; }
 int vw_ctx_replicas(const vw_ctx *ctx)
 {
     return ctx->cell >= 0 ? ctx->w->cells[ctx->cell].nreps : 0;
+}
+
+void *vw_ctx_enter(vw_ctx *ctx, int cell)
+{
+    vw_world *w = ctx->w;
+    vw__worker *wk = ctx->wk;
+    if (cell < 0 || cell >= w->ncells) {
+        fprintf(stderr, "vwalls: module '%s' entered cell %d of %d\n", w->m->name, cell, w->ncells);
+        abort();
+    }
+    if (w->cell_worker[cell] != wk->global) return NULL;
+    vw__cell *c = &w->cells[cell];
+    if (c->nreps) return NULL;
+    /* Stress: refuse half the hand-offs, so both paths run under every interleaving. */
+    if (w->cfg.stress_seed && (vw__rng_next(&wk->rng) & 1)) return NULL;
+    if (cell != ctx->cell || ctx->rep != 0) meter_note(wk, cell, 0);
+    c->messages_in++;
+    ctx->cell = cell;
+    ctx->rep = 0;
+    return c->state;
+}
+
+void vw_ctx_restore(vw_ctx *ctx, int cell, int replica)
+{
+    if (cell == ctx->cell && replica == ctx->rep) return;
+    vw_world *w = ctx->w;
+    if (cell < 0 || cell >= w->ncells || vw__cell_rep_of(w, cell, ctx->wk->global) != replica) {
+        fprintf(stderr, "vwalls: module '%s' restored cell %d copy %d, which worker %d does not "
+                "host\n", w->m->name, cell, replica, ctx->wk->global);
+        abort();
+    }
+    meter_note(ctx->wk, cell, replica);
+    ctx->cell = cell;
+    ctx->rep = replica;
 }
 
 void vw_send_cell(vw_ctx *ctx, int cell, int kind, const void *msg)
@@ -288,24 +384,6 @@ void vw_count(vw_ctx *ctx, int idx, int64_t n)
 
 /* ---- the worker loop ---------------------------------------------------------------- */
 
-/* Charges the time from t0 to t1 to a cell and its worker, and returns when the
-   charge ends. With a slow-down factor k (an emulated slower machine) the worker first
-   spins for (k-1) times the time spent, and that is charged too. One clock read per
-   switch of cell is all the hot path pays. */
-static double account(vw__worker *wk, int cell, int rep, double t0, double t1)
-{
-    const double *s = wk->w->cfg.worker_slowdown;
-    if (s && s[wk->global] > 1.0) {
-        double until = t1 + (t1 - t0) * (s[wk->global] - 1.0);
-        while ((t1 = vw__now()) < until) {
-        }
-    }
-    wk->busy_s += t1 - t0;
-    if (cell >= 0 && rep) wk->w->cells[cell].reps[rep - 1].busy_s += t1 - t0;
-    else if (cell >= 0) wk->w->cells[cell].busy_s += t1 - t0;
-    return t1;
-}
-
 static void handle_packet(vw__worker *wk, vw_ctx *ctx, vw__packet *p)
 {
     vw_world *w = wk->w;
@@ -313,11 +391,10 @@ static void handle_packet(vw__worker *wk, vw_ctx *ctx, vw__packet *p)
     int cur = -1, rep = 0;
     void *state = NULL;
     uint64_t *msgs_in = NULL;
-    double t0 = vw__now();
+    meter_start(wk, -1, 0);
     for (uint32_t i = 0; i < p->nmsgs; i++) {
         const vw__msg_header *h = (const vw__msg_header *)(p->data + off);
         if (h->cell != cur) {
-            t0 = account(wk, cur, rep, t0, vw__now());
             cur = h->cell;
             /* This worker's copy of the cell (the master, or a copy of a duplicated one). */
             rep = vw__cell_rep_of(w, cur, wk->global);
@@ -326,9 +403,13 @@ static void handle_packet(vw__worker *wk, vw_ctx *ctx, vw__packet *p)
                         "does not host\n", wk->global, cur);
                 abort();
             }
+            meter_switch(wk, cur, rep);
             vw__cell *c = &w->cells[cur];
             state = *unit_state(w, cur, rep);
             msgs_in = rep ? &c->reps[rep - 1].messages_in : &c->messages_in;
+        } else if (ctx->cell != cur || ctx->rep != rep) {
+            /* The last handler handed off inline and came back: this unit runs again. */
+            meter_note(wk, cur, rep);
         }
         (*msgs_in)++;
         ctx->cell = h->cell;
@@ -337,7 +418,7 @@ static void handle_packet(vw__worker *wk, vw_ctx *ctx, vw__packet *p)
         if (k->handle) k->handle(ctx, state, p->data + off + sizeof *h);
         off += msg_stride(h->size);
     }
-    account(wk, cur, rep, t0, vw__now());
+    meter_stop(wk);
     if (p->src >= 0 && vw__worker_process(w, p->src) == w->rank)
         atomic_fetch_sub(&w->workers[p->src - w->rank * w->nworkers].outstanding, p->used);
 }
@@ -355,9 +436,9 @@ static int run_step(vw__worker *wk, vw_ctx *ctx)
         wk->step_cursor = (wk->step_cursor + 1) % wk->ncells;
         ctx->cell = cell;
         ctx->rep = rep;
-        double t0 = vw__now();
+        meter_start(wk, cell, rep);
         int did = w->m->step(ctx, *unit_state(w, cell, rep));
-        account(wk, cell, rep, t0, vw__now());
+        meter_stop(wk);
         if (did) return 1;
     }
     return 0;

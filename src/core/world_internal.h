@@ -74,6 +74,9 @@ typedef struct vw__cell {
                                 equal shares whatever else the sender sends) */
 } vw__cell;
 
+/* Inline hand-offs (vw_ctx_enter) noted before the meter reads the clock again. */
+#define VW__METER_N 16
+
 typedef struct vw__worker {
     struct vw_world *w;
     int local, global;
@@ -89,6 +92,11 @@ typedef struct vw__worker {
     int step_cursor;
     uint64_t rng;              /* stress switch */
     double busy_s;
+    /* The meter (runtime.c): the units (cell, copy) that ran since the clock was last
+       read at `mark`; that time is shared evenly among them when it is next read. */
+    struct { int cell, rep; } metered[VW__METER_N];
+    int nmetered;
+    double mark;
     uint64_t msgs_sent, bytes_sent, packets_sent;
     uint64_t msgs_remote, bytes_remote; /* to other processes */
     /* Cell-to-cell traffic by destination, for the mapping's locality figures

@@ -490,6 +490,7 @@ int vw_decomp_next_segment(const vw_decomp *d, const double o[3], const double d
                            double t0, double t1, vw_segment *out)
 {
     if (!(t0 < t1)) return 0;
+    if (!d->has_frame) return descend(d, o, dir, o, dir, t0, t1, out); /* it runs per wall */
     double q[3], v[3];
     ray_to_frame(d, o, dir, q, v);
     return descend(d, o, dir, q, v, t0, t1, out);

@@ -3,6 +3,8 @@
  * the seed (every child is derived from its parent's content), so the number of
  * deliveries and a checksum of what was delivered are known in advance whatever the
  * order; every message must arrive exactly once, intact, and the run must end.
+ * Half the sparks whose cell is on the same worker are handed off inline
+ * (vw_ctx_enter / vw_ctx_restore) instead of sent: they must count the same.
  *
  * usage: test_storm [SEEDS] [--stress]   (also honours VW_STRESS / VW_STRESS_SPLIT)
  */
@@ -113,11 +115,23 @@ static void on_spark(vw_ctx *ctx, void *state, const void *msg)
     }
     int n = children(s);
     if (n == 3) vw_send_neighbours(ctx, MSG_ECHO, s); /* the other route */
+    int cell = vw_ctx_cell(ctx), replica = vw_ctx_replica(ctx);
     for (int c = 0; c < n; c++) {
         spark k;
         uint64_t key = mix(s->key + 100 + (uint64_t)c);
         fill(&k, key, s->hops - 1);
-        vw_send_cell(ctx, dest_of(key, st->ncells), MSG_SPARK, &k);
+        int dest = dest_of(key, st->ncells);
+        /* Every other child is handed off inline when its cell is on this worker
+           (vw_ctx_enter): it must count exactly as if it had been delivered. */
+        void *there = (key >> 7) & 1 ? vw_ctx_enter(ctx, dest) : NULL;
+        if (!there) {
+            vw_send_cell(ctx, dest, MSG_SPARK, &k);
+            continue;
+        }
+        if (vw_ctx_cell(ctx) != dest) vw_count(ctx, CNT_CORRUPT, 1);
+        on_spark(ctx, there, &k);
+        vw_ctx_restore(ctx, cell, replica);
+        if (vw_ctx_cell(ctx) != cell || vw_ctx_replica(ctx) != replica) vw_count(ctx, CNT_CORRUPT, 1);
     }
 }
 

@@ -179,7 +179,7 @@ static vw_status mtl_color(obj *O, span *line, const char *key, float col[3])
 
 static vw_status mtl_scalar(obj *O, span *line, const char *key, float *out)
 {
-    double v;
+    double v = 0;
     vw_status st = read_numbers(O, line, key, &v, 1, 1, NULL);
     if (st != VW_OK)
         return st;

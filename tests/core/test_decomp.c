@@ -121,6 +121,24 @@ static void check_decomp(const vw_decomp *d)
             dir[a] = urand() - 0.5;
         }
         if (i % 7 == 0) dir[i % 3] = 0; /* axis-parallel components */
+        if (i % 5 == 1) {
+            /* Through a corner of a cell, with dyadic directions: the ray meets two or
+               three walls at the same t (ties the walk and a grid step must agree on). */
+            vw_box cb = vw_decomp_cell_box(d, i % n);
+            const double *F = vw_decomp_frame(d);
+            double q[3], p[3], v[3];
+            static const double steps[] = {0.5, -0.5, 0.25, -0.25, 0};
+            for (int a = 0; a < 3; a++) {
+                q[a] = (i >> a) & 2 ? cb.hi[a] : cb.lo[a];
+                v[a] = steps[(unsigned)(i / 5 + 3 * a) % 5];
+            }
+            if (v[0] == 0 && v[1] == 0 && v[2] == 0) v[0] = 0.5;
+            for (int a = 0; a < 3; a++) { /* frame -> world: F^T */
+                p[a] = F ? F[a] * q[0] + F[3 + a] * q[1] + F[6 + a] * q[2] : q[a];
+                dir[a] = F ? F[a] * v[0] + F[3 + a] * v[1] + F[6 + a] * v[2] : v[a];
+            }
+            for (int a = 0; a < 3; a++) o[a] = p[a] - 2 * dir[a];
+        }
         walk_a.n = 0;
         vw_decomp_walk(d, o, dir, 0, INFINITY, collect, &walk_a);
         {
@@ -174,7 +192,9 @@ static void check_decomp(const vw_decomp *d)
                     CHECK_NEAR(walk_a.s[s].t0, lo, 1e-9 * (1 + fabs(lo)));
                     CHECK_NEAR(walk_a.s[s].t1, hi, 1e-9 * (1 + fabs(hi)));
                 }
-            if (want) CHECK(got);
+            /* A ray along a wall touches the cells on both sides; the walk gives it to
+               one of them: brute force cannot judge the corner rays there. */
+            if (want && i % 5 != 1) CHECK(got);
         }
         /* Front-to-back from the origin (when inside): the walk respects that order. */
         if (vw_decomp_locate(d, o, dir) >= 0) {

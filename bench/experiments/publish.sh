@@ -197,8 +197,9 @@ What this says, honestly:
   other jobs' noise weigh as much as the work.
 - **Ray tracing: a wall costs more now than in 1994.** Counted work says so without any
   timer: 8 cells trace ${segs:-?}× the ray segments of 1 cell, because every wall a ray
-  crosses ends one segment and starts another (a message, a packet, a new traversal in
-  the next cell). When a ray-object test cost far more than a message, that overhead
+  crosses ends one segment and starts another (a new traversal in the next cell, and a
+  message when that cell is on another worker; on the same worker the ray is handed on
+  inline). When a ray-object test cost far more than a message, that overhead
   vanished; with Embree a segment costs well under a microsecond, so the per-crossing
   cost is of the order of the tracing itself. The model efficiency at 8 cells ($rt_m
   unbalanced, $rtb_m balanced; best $rt_model_best) is the figure to hold against the

@@ -457,8 +457,12 @@ static void cell_free(void *state, void *user)
 
 static vw_status cell_build(vw_ctx *ctx, const void *objects, size_t n, void **state)
 {
-    rt_cell *c = calloc(1, sizeof *c);
+    /* Whole cache lines: cells of different workers never share one (the package and
+       counters are written per ray). */
+    size_t bytes = (sizeof(rt_cell) + 63) / 64 * 64;
+    rt_cell *c = aligned_alloc(64, bytes);
     if (!c) return VW_E_NOMEM;
+    memset(c, 0, bytes);
     c->sh = vw_ctx_user(ctx);
     vw_status st = rt_cell_geo_build(c->sh->device, objects, n, &c->geo);
     if (st == VW_OK) st = primary_pixels(ctx, c);

@@ -9,6 +9,7 @@
 #include "vwalls/engine.h"
 
 #include <stdarg.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -83,6 +84,16 @@ static vw_status assign_units(vw_world *w)
     return VW_OK;
 }
 
+void *vw__calloc_lines(size_t n, size_t size)
+{
+    if (size && n > (SIZE_MAX - VW__LINE) / size) return NULL;
+    size_t bytes = (n * size + VW__LINE - 1) / VW__LINE * VW__LINE;
+    if (!bytes) bytes = VW__LINE;
+    void *p = aligned_alloc(VW__LINE, bytes);
+    if (p) memset(p, 0, bytes);
+    return p;
+}
+
 /* Sets up cells -> workers and the per-worker cell lists for the current mapping. */
 static vw_status map_cells(vw_world *w, const int *cell_worker)
 {
@@ -100,12 +111,12 @@ static vw_status map_cells(vw_world *w, const int *cell_worker)
 static vw_status alloc_cells(vw_world *w)
 {
     w->ncells = vw_decomp_cell_count(w->decomp);
-    w->cells = calloc((size_t)w->ncells, sizeof *w->cells);
+    w->cells = vw__calloc_lines((size_t)w->ncells, sizeof *w->cells);
     w->cell_worker = calloc((size_t)w->ncells, sizeof(int));
     if (!w->cells || !w->cell_worker) return VW_E_NOMEM;
     int nc = w->m->ncounters > 0 ? w->m->ncounters : 1;
     for (int c = 0; c < w->ncells; c++) {
-        w->cells[c].counters = calloc((size_t)nc, sizeof(int64_t));
+        w->cells[c].counters = vw__calloc_lines((size_t)nc, sizeof(int64_t));
         if (!w->cells[c].counters) return VW_E_NOMEM;
     }
     vw_box wb = vw_decomp_world(w->decomp);
@@ -179,7 +190,7 @@ vw_status vw_world_create(const vw_module *m, void *user, const vw_decomp *d, co
     if (st == VW_OK) st = vw_decomp_clone(d, &w->decomp);
     if (st == VW_OK) st = alloc_cells(w);
     if (st == VW_OK) {
-        w->workers = calloc((size_t)w->nworkers, sizeof *w->workers);
+        w->workers = vw__calloc_lines((size_t)w->nworkers, sizeof *w->workers);
         if (!w->workers) st = VW_E_NOMEM;
     }
     for (int i = 0; st == VW_OK && i < w->nworkers; i++) {
@@ -191,8 +202,8 @@ vw_status vw_world_create(const vw_module *m, void *user, const vw_decomp *d, co
         pthread_cond_init(&wk->cv, NULL);
         atomic_init(&wk->outstanding, 0);
         wk->rng = w->cfg.stress_seed * 0x2545f4914f6cdd1dull + (uint64_t)wk->global + 1;
-        wk->out = calloc((size_t)w->gworkers + 1, sizeof *wk->out);
-        wk->tr_proc = calloc(2 * (size_t)w->nprocs, sizeof *wk->tr_proc);
+        wk->out = vw__calloc_lines((size_t)w->gworkers + 1, sizeof *wk->out);
+        wk->tr_proc = vw__calloc_lines(2 * (size_t)w->nprocs, sizeof *wk->tr_proc);
         if (!wk->out || !wk->tr_proc) st = VW_E_NOMEM;
     }
     if (st == VW_OK) st = map_cells(w, c ? c->cell_worker : NULL);
@@ -463,16 +474,16 @@ vw_status vw_world_set_replicas(vw_world *w, int cell, const int *workers, int n
             return vw__world_error(w, VW_E_INVAL, "cell %d cannot have a copy on worker %d", cell,
                                    workers[i]);
     }
-    vw__replica *nr = calloc((size_t)(n ? n : 1), sizeof *nr);
+    vw__replica *nr = vw__calloc_lines((size_t)(n ? n : 1), sizeof *nr);
     if (!nr) return VW_E_NOMEM;
     size_t nc = (size_t)(w->m->ncounters > 0 ? w->m->ncounters : 1);
     vw_status st = VW_OK;
     for (int i = 0; i < n && st == VW_OK; i++) {
         nr[i].worker = workers[i];
-        nr[i].counters = calloc(nc, sizeof(int64_t));
+        nr[i].counters = vw__calloc_lines(nc, sizeof(int64_t));
         if (!nr[i].counters) st = VW_E_NOMEM;
     }
-    unsigned *rr = n ? calloc((size_t)w->nworkers, sizeof *rr) : NULL;
+    unsigned *rr = n ? vw__calloc_lines((size_t)w->nworkers, sizeof *rr) : NULL;
     if (n && !rr) st = VW_E_NOMEM;
     if (st != VW_OK) {
         for (int i = 0; i < n; i++) free(nr[i].counters);

@@ -45,8 +45,13 @@ typedef struct vw__packet {
 /* A copy of a duplicated cell on another worker (balance strategy "duplicate"): its
    own module state built from the cell's objects, and its own figures, which add up
    with the master's to the cell's. */
+/* Cache-line alignment of what one worker writes on its hot path (a cell's figures and
+   counters, a worker's own state): two workers never write the same line. Arrays of
+   these types come from vw__calloc_lines. */
+#define VW__LINE 64
+
 typedef struct vw__replica {
-    int worker;              /* global worker id, never the master's */
+    _Alignas(VW__LINE) int worker; /* global worker id, never the master's */
     void *state;
     int built;
     unsigned built_version;  /* the cell's version it was built from */
@@ -57,7 +62,7 @@ typedef struct vw__replica {
 } vw__replica;
 
 typedef struct vw__cell {
-    int worker;              /* global worker id */
+    _Alignas(VW__LINE) int worker; /* global worker id */
     void *state;             /* the module's cell state */
     int built, dirty;
     size_t *objs;            /* ids of the objects overlapping the cell */
@@ -78,7 +83,7 @@ typedef struct vw__cell {
 #define VW__METER_N 16
 
 typedef struct vw__worker {
-    struct vw_world *w;
+    _Alignas(VW__LINE) struct vw_world *w;
     int local, global;
     pthread_t thread;
     pthread_mutex_t mu;
@@ -170,6 +175,8 @@ struct vw_world {
 vw_status vw__world_error(vw_world *w, vw_status st, const char *fmt, ...)
     __attribute__((format(printf, 3, 4)));
 int vw__worker_process(const vw_world *w, int global_worker);
+/* calloc for n items of `size`, aligned to and padded to whole cache lines. */
+void *vw__calloc_lines(size_t n, size_t size);
 vw_status vw__world_build_cell(vw_world *w, int cell, vw__worker *wk);
 vw_status vw__world_build_replica(vw_world *w, int cell, int rep, vw__worker *wk);
 /* Which copy of cell this global worker hosts: 0 = the master, r >= 1 = reps[r-1],

@@ -312,7 +312,10 @@ void vw_ctx_restore(vw_ctx *ctx, int cell, int replica)
 {
     if (cell == ctx->cell && replica == ctx->rep) return;
     vw_world *w = ctx->w;
-    if (cell < 0 || cell >= w->ncells || vw__cell_rep_of(w, cell, ctx->wk->global) != replica) {
+    int hosted = cell >= 0 && cell < w->ncells &&
+                 (replica == 0 ? w->cell_worker[cell] == ctx->wk->global
+                               : vw__cell_rep_of(w, cell, ctx->wk->global) == replica);
+    if (!hosted) {
         fprintf(stderr, "vwalls: module '%s' restored cell %d copy %d, which worker %d does not "
                 "host\n", w->m->name, cell, replica, ctx->wk->global);
         abort();

@@ -80,7 +80,7 @@ typedef struct vw__cell {
 } vw__cell;
 
 /* Inline hand-offs (vw_ctx_enter) noted before the meter reads the clock again. */
-#define VW__METER_N 16
+#define VW__METER_N 64
 
 typedef struct vw__worker {
     _Alignas(VW__LINE) struct vw_world *w;

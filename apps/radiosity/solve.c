@@ -38,6 +38,56 @@ static void piece_bounds(const void *obj, vw_box *out, void *user)
         }
 }
 
+/* Level-0 receiver elements per cell: the grid squares of each piece that cell_build's
+   add_elem keeps (a polygon of 3 or more vertices and more than 1e-14 of the piece's
+   area), counted on the piece's owner cell. The same on every process (every process
+   meshes the whole scene). */
+static void cell_elements(const rad_mesh *m, int ncells, double *load)
+{
+    for (int c = 0; c < ncells; c++) load[c] = 0;
+    for (size_t i = 0; i < m->npieces; i++) {
+        const rad_piece *pc = &m->pieces[i];
+        int lo[2], hi[2];
+        if (m->owner[i] < 0 || m->owner[i] >= ncells) continue;
+        rad_piece_grid(pc, lo, hi);
+        for (int gi = lo[0]; gi <= hi[0]; gi++)
+            for (int gj = lo[1]; gj <= hi[1]; gj++) {
+                rad_poly poly;
+                if (rad_elem_polygon(pc, 0, gi, gj, &poly) >= 3 &&
+                    rad_poly_area(&poly, NULL, NULL) > 1e-14 * pc->area)
+                    load[m->owner[i]] += 1;
+            }
+    }
+}
+
+/* Maps the cells onto the workers by their element counts, longest first, instead of
+   the runtime's contiguous blocks. A cell's work is rasterising its elements for every
+   shot that reaches it, and nearly every shot reaches every cell, so it is nearly
+   proportional to its element count (busy time per element within 5 % over the room's
+   cells), in every round alike. The room's 2x2x2 cells on 2 workers: blocks give the
+   busier worker 9 % more than the mean (the cells of the lower half hold the furniture),
+   this mapping 1-2 %. Neighbour preference is off (slack 0): a bitmap to a cell on
+   another worker of this process costs a queue push, not a network message, and a few
+   percent of imbalance cost more than that. With no more cells than workers every
+   mapping is one cell per worker, and the runtime's is kept. */
+static vw_status map_by_elements(rad_solver *s, const rad_mesh *m, const vw_decomp *d)
+{
+    int ncells = vw_decomp_cell_count(d);
+    int gworkers = vw_world_processes(s->w) * vw_world_workers(s->w);
+    if (gworkers < 2 || ncells <= gworkers) return VW_OK;
+    double *load = malloc(sizeof(double) * (size_t)ncells);
+    int *map = malloc(sizeof(int) * (size_t)ncells);
+    vw_status st = load && map ? VW_OK : VW_E_NOMEM;
+    if (st == VW_OK) {
+        cell_elements(m, ncells, load);
+        st = vw_map_greedy(d, load, gworkers, NULL, 0.0, map);
+    }
+    if (st == VW_OK) st = vw_world_remap(s->w, map);
+    free(load);
+    free(map);
+    return st;
+}
+
 static vw_status run_world(rad_solver *s, char *err, size_t errlen)
 {
     memset(&s->rep, 0, sizeof s->rep);
@@ -93,6 +143,7 @@ vw_status rad_solver_create(const rad_mesh *m, const vw_decomp *d, const rad_opt
     vw_config_init(&cfg);
     cfg.workers = o->workers;
     st = vw_world_create(&s->mod, s, d, &cfg, &s->w);
+    if (st == VW_OK) st = map_by_elements(s, m, d);
     if (st == VW_OK) st = vw_world_add_objects(s->w, m->pieces, m->npieces);
     if (st == VW_OK) st = vw_world_commit(s->w);
     if (st != VW_OK) {

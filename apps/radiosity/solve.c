@@ -144,6 +144,12 @@ vw_status rad_solver_create(const rad_mesh *m, const vw_decomp *d, const rad_opt
     cfg.workers = o->workers;
     st = vw_world_create(&s->mod, s, d, &cfg, &s->w);
     if (st == VW_OK) st = map_by_elements(s, m, d);
+    if (st == VW_OK) {
+        size_t gw = (size_t)vw_world_processes(s->w) * (size_t)vw_world_workers(s->w);
+        s->slots = aligned_alloc(sizeof *s->slots, gw * sizeof *s->slots);
+        if (s->slots) memset(s->slots, 0, gw * sizeof *s->slots);
+        else st = VW_E_NOMEM;
+    }
     if (st == VW_OK) st = vw_world_add_objects(s->w, m->pieces, m->npieces);
     if (st == VW_OK) st = vw_world_commit(s->w);
     if (st != VW_OK) {
@@ -232,6 +238,7 @@ void rad_solver_free(rad_solver *s)
     rad_hemicube_free(&s->hc);
     free(s->elems);
     free(s->patches);
+    free(s->slots);
     free(s);
 }
 

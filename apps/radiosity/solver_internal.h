@@ -51,6 +51,14 @@ typedef struct rad_report_msg {
     double unshot[3], absorbed[3], shot[3], won[3];
 } rad_report_msg;
 
+/* Per worker (global id): how many shots its cells hold ready to rasterise (module.c,
+   step). Only that worker's thread touches its slot; one slot per cache line, so two
+   workers never write one line. */
+typedef struct rad_worker_slot {
+    int ready;
+    char pad[60];
+} rad_worker_slot;
+
 struct rad_solver {
     const rad_mesh *mesh;
     const vw_decomp *d;
@@ -64,6 +72,7 @@ struct rad_solver {
     double thr;
     double near_eps;
     int round;
+    rad_worker_slot *slots;
     /* The output process's view, rebuilt by the REPORT messages of every run. */
     rad_report_msg rep;
     int nreports;

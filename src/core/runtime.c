@@ -12,6 +12,10 @@
  * thread (the thread that called run) holds one extra count, so workers never end the
  * run on local quiescence; it gives the count back once all processes agree (see
  * transport/mpi.c). The threads engine has no such thread and never polls.
+ *
+ * The worker threads are a pool kept for the world's life (pool_start, pool_dispatch,
+ * pool_wait): a run or a build is a job every worker does once, so an iterative
+ * solver's hundreds of runs start no threads, and each worker stays on its CPU.
  */
 #include "core/world_internal.h"
 #include "vwalls/engine.h"
@@ -468,9 +472,9 @@ static void stress_pause(vw__worker *wk)
     }
 }
 
-static void *worker_main(void *arg)
+/* One run of a worker: until global quiescence. */
+static void worker_run(vw__worker *wk)
 {
-    vw__worker *wk = arg;
     vw_world *w = wk->w;
     vw_ctx ctx = {w, wk, -1, 0};
     for (;;) {
@@ -521,7 +525,74 @@ static void *worker_main(void *arg)
         atomic_fetch_add(&w->active, 1);
         pthread_mutex_unlock(&wk->mu);
     }
+}
+
+/* A worker thread: one job (a run, or a build) per dispatch, until the pool stops. */
+static void *worker_main(void *arg)
+{
+    vw__worker *wk = arg;
+    vw_world *w = wk->w;
+    unsigned gen = 0;
+    pthread_mutex_lock(&w->pool_mu);
+    for (;;) {
+        while (w->run_gen == gen && !w->pool_quit) pthread_cond_wait(&w->pool_cv, &w->pool_mu);
+        if (w->pool_quit) break;
+        gen = w->run_gen;
+        void (*job)(vw__worker *) = w->pool_job;
+        pthread_mutex_unlock(&w->pool_mu);
+        job(wk);
+        pthread_mutex_lock(&w->pool_mu);
+        if (--w->pool_left == 0) pthread_cond_broadcast(&w->pool_cv);
+    }
+    pthread_mutex_unlock(&w->pool_mu);
     return NULL;
+}
+
+void vw__runtime_stop(vw_world *w)
+{
+    if (!w->pool_started) return;
+    pthread_mutex_lock(&w->pool_mu);
+    w->pool_quit = 1;
+    pthread_cond_broadcast(&w->pool_cv);
+    pthread_mutex_unlock(&w->pool_mu);
+    for (int i = 0; i < w->pool_started; i++) pthread_join(w->workers[i].thread, NULL);
+    w->pool_started = 0;
+    w->pool_quit = 0;
+}
+
+/* Starts the worker threads once; they wait for jobs. -1 when a thread cannot be
+   started (those that were are stopped again). */
+static int pool_start(vw_world *w)
+{
+    while (w->pool_started < w->nworkers) {
+        vw__worker *wk = &w->workers[w->pool_started];
+        if (pthread_create(&wk->thread, NULL, worker_main, wk) != 0) {
+            int failed = w->pool_started;
+            vw__runtime_stop(w);
+            return failed;
+        }
+        w->pool_started++;
+    }
+    return -1;
+}
+
+/* Every worker does job once; everything the caller wrote before happens before. */
+static void pool_dispatch(vw_world *w, void (*job)(vw__worker *))
+{
+    pthread_mutex_lock(&w->pool_mu);
+    w->pool_job = job;
+    w->pool_left = w->nworkers;
+    w->run_gen++;
+    pthread_cond_broadcast(&w->pool_cv);
+    pthread_mutex_unlock(&w->pool_mu);
+}
+
+/* Until every worker has finished the job: its figures are then complete. */
+static void pool_wait(vw_world *w)
+{
+    pthread_mutex_lock(&w->pool_mu);
+    while (w->pool_left > 0) pthread_cond_wait(&w->pool_cv, &w->pool_mu);
+    pthread_mutex_unlock(&w->pool_mu);
 }
 
 vw_status vw__runtime_run(vw_world *w)
@@ -536,20 +607,12 @@ vw_status vw__runtime_run(vw_world *w)
         w->posted = p->next;
         vw__deliver(w, NULL, p);
     }
-    int started = 0;
     vw_status st = VW_OK;
-    for (int i = 0; i < w->nworkers; i++) {
-        if (pthread_create(&w->workers[i].thread, NULL, worker_main, &w->workers[i]) != 0) {
-            st = vw__world_error(w, VW_E_LIMIT, "cannot start worker thread %d", i);
-            break;
-        }
-        started++;
-    }
-    if (st != VW_OK) {
-        /* The threads that did start cannot end without the others: count the missing
-           ones out so quiescence is still reached. */
-        for (int i = started; i < w->nworkers; i++) vw__uncount(w);
-    }
+    int failed = pool_start(w);
+    if (failed >= 0)
+        st = vw__world_error(w, VW_E_LIMIT, "cannot start worker thread %d", failed);
+    else
+        pool_dispatch(w, worker_run);
     if (w->transport) {
         /* Other processes cannot finish without this one's workers; a process that
            cannot run them must end the job rather than leave the others waiting. */
@@ -560,7 +623,7 @@ vw_status vw__runtime_run(vw_world *w)
         }
         st = w->transport->run(w);
     }
-    for (int i = 0; i < started; i++) pthread_join(w->workers[i].thread, NULL);
+    if (failed < 0) pool_wait(w);
     w->runs++;
     vw__stats_local(w);
     if (w->transport && st == VW_OK) st = w->transport->sync(w);
@@ -569,9 +632,8 @@ vw_status vw__runtime_run(vw_world *w)
 
 /* ---- building cells in parallel ----------------------------------------------------- */
 
-static void *build_main(void *arg)
+static void build_job(vw__worker *wk)
 {
-    vw__worker *wk = arg;
     wk->build_status = VW_OK;
     for (int i = 0; i < wk->ncells && wk->build_status == VW_OK; i++) {
         vw__cell *c = &wk->w->cells[wk->cells[i]];
@@ -586,18 +648,18 @@ static void *build_main(void *arg)
         if (c->built && !c->dirty) continue;
         wk->build_status = vw__world_build_cell(wk->w, wk->cells[i], wk);
     }
-    return NULL;
 }
 
 vw_status vw__runtime_build(vw_world *w)
 {
-    int started = 0;
-    for (int i = 0; i < w->nworkers; i++) {
-        if (pthread_create(&w->workers[i].thread, NULL, build_main, &w->workers[i]) != 0) break;
-        started++;
+    /* Each worker builds its own cells, on its own thread (or all here if threads
+       cannot be started). */
+    if (pool_start(w) < 0) {
+        pool_dispatch(w, build_job);
+        pool_wait(w);
+    } else {
+        for (int i = 0; i < w->nworkers; i++) build_job(&w->workers[i]);
     }
-    for (int i = started; i < w->nworkers; i++) build_main(&w->workers[i]);
-    for (int i = 0; i < started; i++) pthread_join(w->workers[i].thread, NULL);
     for (int i = 0; i < w->nworkers; i++)
         if (w->workers[i].build_status != VW_OK) return w->workers[i].build_status;
     return VW_OK;

@@ -179,6 +179,8 @@ vw_status vw_world_create(const vw_module *m, void *user, const vw_decomp *d, co
     }
     w->cfg.cell_worker = NULL; /* copied into w->cell_worker below */
     pthread_mutex_init(&w->output_mu, NULL);
+    pthread_mutex_init(&w->pool_mu, NULL);
+    pthread_cond_init(&w->pool_cv, NULL);
     /* Under MPI: rank, nprocs and the transport. Every process must pass the same
        worker count, decomposition and mapping (checked by the transport). */
     vw_status st = vw__mpi_attach(w);
@@ -218,6 +220,7 @@ vw_status vw_world_create(const vw_module *m, void *user, const vw_decomp *d, co
 void vw_world_free(vw_world *w)
 {
     if (!w) return;
+    vw__runtime_stop(w);
     if (w->transport) w->transport->free(w);
     free(w->wstats);
     free_cells(w);
@@ -246,6 +249,8 @@ void vw_world_free(vw_world *w)
         free(p);
     }
     pthread_mutex_destroy(&w->output_mu);
+    pthread_mutex_destroy(&w->pool_mu);
+    pthread_cond_destroy(&w->pool_cv);
     vw_decomp_free(w->decomp);
     free(w->objects);
     free(w);

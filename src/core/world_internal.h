@@ -156,6 +156,14 @@ struct vw_world {
     vw__packet *posted;        /* messages posted before run */
     atomic_long active;
     atomic_int finished;
+    /* The worker threads, started at the first run and kept until the world is freed
+       (an iterative solver runs hundreds of times): under pool_mu, run_gen counts the
+       runs started, pool_left the workers still in the current one. */
+    pthread_mutex_t pool_mu;
+    pthread_cond_t pool_cv;
+    unsigned run_gen;
+    int pool_started, pool_left, pool_quit;
+    void (*pool_job)(struct vw__worker *); /* what the current run does: run or build */
     pthread_mutex_t output_mu; /* output handlers run one at a time */
     vw__transport *transport;
     vw__worker_stats *wstats;  /* gworkers entries, valid after a run */
@@ -187,6 +195,8 @@ int vw__replica_total(const vw_world *w);
 
 /* runtime.c */
 vw_status vw__runtime_run(vw_world *w);
+/* Ends and joins the worker threads (before the world is freed). */
+void vw__runtime_stop(vw_world *w);
 vw_status vw__runtime_build(vw_world *w);
 vw__packet *vw__packet_new(int dest, int src, size_t cap);
 void vw__deliver(vw_world *w, vw__worker *from, vw__packet *p);

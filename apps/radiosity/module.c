@@ -364,8 +364,12 @@ static vw_status cell_build(vw_ctx *ctx, const void *objects, size_t n, void **s
 {
     rad_solver *S = vw_ctx_user(ctx);
     const vw_decomp *d = vw_ctx_decomp(ctx);
-    rad_cell *c = calloc(1, sizeof *c);
+    /* Whole cache lines: the rasteriser reads this state per pixel while the other
+       worker writes its own cells' states, so two cells must never share a line. */
+    size_t bytes = (sizeof(rad_cell) + 63) / 64 * 64;
+    rad_cell *c = aligned_alloc(64, bytes);
     if (!c) return VW_E_NOMEM;
+    memset(c, 0, bytes);
     c->S = S;
     c->cell = vw_ctx_cell(ctx);
     c->box = vw_ctx_cell_box(ctx);

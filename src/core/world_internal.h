@@ -42,14 +42,14 @@ typedef struct vw__packet {
     unsigned char data[];
 } vw__packet;
 
-/* A copy of a duplicated cell on another worker (balance strategy "duplicate"): its
-   own module state built from the cell's objects, and its own figures, which add up
-   with the master's to the cell's. */
 /* Cache-line alignment of what one worker writes on its hot path (a cell's figures and
    counters, a worker's own state): two workers never write the same line. Arrays of
    these types come from vw__calloc_lines. */
 #define VW__LINE 64
 
+/* A copy of a duplicated cell on another worker (balance strategy "duplicate"): its
+   own module state built from the cell's objects, and its own figures, which add up
+   with the master's to the cell's. */
 typedef struct vw__replica {
     _Alignas(VW__LINE) int worker; /* global worker id, never the master's */
     void *state;
@@ -156,14 +156,14 @@ struct vw_world {
     vw__packet *posted;        /* messages posted before run */
     atomic_long active;
     atomic_int finished;
-    /* The worker threads, started at the first run and kept until the world is freed
-       (an iterative solver runs hundreds of times): under pool_mu, run_gen counts the
-       runs started, pool_left the workers still in the current one. */
+    /* The worker threads, started at the first build or run and kept until the world
+       is freed (an iterative solver runs hundreds of times): under pool_mu, run_gen
+       counts the jobs dispatched, pool_left the workers still in the current one. */
     pthread_mutex_t pool_mu;
     pthread_cond_t pool_cv;
     unsigned run_gen;
     int pool_started, pool_left, pool_quit;
-    void (*pool_job)(struct vw__worker *); /* what the current run does: run or build */
+    void (*pool_job)(struct vw__worker *); /* the current job: a run or a build */
     pthread_mutex_t output_mu; /* output handlers run one at a time */
     vw__transport *transport;
     vw__worker_stats *wstats;  /* gworkers entries, valid after a run */

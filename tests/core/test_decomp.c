@@ -123,7 +123,8 @@ static void check_decomp(const vw_decomp *d)
         if (i % 7 == 0) dir[i % 3] = 0; /* axis-parallel components */
         if (i % 5 == 1) {
             /* Through a corner of a cell, with dyadic directions: the ray meets two or
-               three walls at the same t (ties the walk, its descent and a restart must agree on). */
+               three walls at the same t, ties on which the walk, its first-segment
+               descent and a restart at an exit must agree. */
             vw_box cb = vw_decomp_cell_box(d, i % n);
             const double *F = vw_decomp_frame(d);
             double q[3], p[3], v[3];

@@ -4,7 +4,8 @@
 #      depth 5, its 3 lights), one thread each and two threads each;
 #  (b) vwalls on 1 cell vs a raw rtcIntersect1/rtcOccluded1 loop over the same ray tree
 #      (bench/embree_raw.c): the framework's overhead over Embree's kernel;
-#  (c) 2x2x2 cells vs 1 cell on 1 worker, and 2 workers vs 1.
+#  (c) 2x2x2 cells vs 1 cell on 1 worker, and 2 workers vs 1: whole processes, then
+#      the compute phase alone (from the stats) and the two workers' busy time.
 # Whole processes are timed with date +%s.%N (best of REPEAT runs).
 # usage: bench/raytrace.sh [BUILD_DIR] [SIZE] [REPEAT]     (e.g. bench/raytrace.sh build 512 3)
 set -euo pipefail
@@ -86,11 +87,25 @@ echo "(c) cells and workers (whole process)"
 printf "    1 worker : 1 cell %6.3f s, 2x2x2 %6.3f s   2x2x2/1cell time = %s\n" "$c1" "$c8" "$(ratio "$c8" "$c1")"
 printf "    1 cell   : 1 worker %6.3f s, 2 workers %6.3f s   speedup = %s\n" "$c1" "$w2" "$(ratio "$c1" "$w2")"
 printf "    2x2x2    : 1 worker %6.3f s, 2 workers %6.3f s   speedup = %s\n" "$c8" "$vw2c" "$(ratio "$c8" "$vw2c")"
-render --cells 2x2x2 --workers 2 --stats "$T/s8.json"
-python3 - "$T/s8.json" <<'EOF'
+# The compute phase alone (no parse, build or PNG): best of REPEAT runs each, from
+# the stats; and where the time of 2x2x2 on 2 workers goes.
+for cfg in "1 1" "2x2x2 1" "2x2x2 2"; do
+  set -- $cfg
+  for i in $(seq "$REPEAT"); do render --cells "$1" --workers "$2" --stats "$T/c-$1-$2-$i.json"; done
+done
+python3 - "$T" "$REPEAT" <<'EOF'
 import json, sys
-j = json.load(open(sys.argv[1]))
-print("    2x2x2 on 2 workers: imbalance lambda %.3f, worker busy %s s, messages %d (%.1f MB)" % (
-    j["balance"]["imbalance"], ", ".join("%.3f" % w["busy_s"] for w in j["workers"]),
+t, n = sys.argv[1], int(sys.argv[2])
+def runs(c, w): return [json.load(open("%s/c-%s-%s-%d.json" % (t, c, w, i))) for i in range(1, n + 1)]
+def best(c, w): return min(j["time_s"]["compute"] for j in runs(c, w))
+one, c8, c8w2 = best("1", 1), best("2x2x2", 1), best("2x2x2", 2)
+print("    compute phase only: 1 cell %.3f s, 2x2x2 %.3f s (x%.2f), 2x2x2 on 2 workers %.3f s"
+      " (speedup %.2f)" % (one, c8, c8 / one, c8w2, c8 / c8w2))
+j = runs("2x2x2", 2)[-1]
+b1 = sum(w["busy_s"] for w in runs("2x2x2", 1)[-1]["workers"])
+b2 = sum(w["busy_s"] for w in j["workers"])
+print("    2x2x2 on 2 workers: imbalance lambda %.3f, worker busy %s s (sum %.2fx one"
+      " worker's), messages %d (%.1f MB)" % (
+    j["balance"]["imbalance"], ", ".join("%.3f" % w["busy_s"] for w in j["workers"]), b2 / b1,
     j["messages"]["count"], j["messages"]["bytes"] / 1e6))
 EOF

@@ -130,12 +130,7 @@ vw_status rt_anim_create(vw_scene *s, const rt_anim_params *p, rt_anim **out, ch
     vw_dynscene_params dp;
     memset(&dp, 0, sizeof dp);
     dp.decomp = vw_world_decomp(rt_job_world(a->job));
-    vw_config cfg;
-    if (p->config)
-        cfg = *p->config;
-    else
-        vw_config_init(&cfg);
-    if (p->workers > 0) cfg.workers = p->workers;
+    vw_config cfg = rt_job_config(&rp); /* the dynamic scene runs as the job does */
     dp.config = &cfg;
     dp.brute_force = p->brute_force;
     st = vw_dynscene_create(s, &dp, &a->ds, err, errlen); /* owns s from here */

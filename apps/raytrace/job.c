@@ -68,6 +68,17 @@ static vw_status owners(rt_job *j)
     return VW_OK;
 }
 
+vw_config rt_job_config(const rt_params *p)
+{
+    vw_config cfg;
+    if (p->config)
+        cfg = *p->config;
+    else
+        vw_config_init(&cfg);
+    if (p->workers > 0) cfg.workers = p->workers;
+    return cfg;
+}
+
 vw_status rt_job_create(const vw_scene *s, const rt_params *p, rt_job **out, char *err,
                         size_t errlen)
 {
@@ -170,12 +181,7 @@ vw_status rt_job_create(const vw_scene *s, const rt_params *p, rt_job **out, cha
         return VW_E_STATE;
     }
 
-    vw_config cfg;
-    if (p->config)
-        cfg = *p->config;
-    else
-        vw_config_init(&cfg);
-    if (p->workers > 0) cfg.workers = p->workers;
+    vw_config cfg = rt_job_config(p);
     st = vw_world_create(&rt_module, sh, j->decomp, &cfg, &j->world);
     if (st != VW_OK) {
         snprintf(err, errlen, "cannot create the world: %s", vw_status_message(st));

@@ -150,6 +150,9 @@ typedef struct rt_job rt_job;
    objects added), commit (cells built), run (rays traced). err gets a message. */
 vw_status rt_job_create(const vw_scene *s, const rt_params *p, rt_job **out, char *err,
                         size_t errlen);
+/* The runtime configuration a job with these parameters runs with: p->config (or the
+   defaults) with p->workers when given. */
+vw_config rt_job_config(const rt_params *p);
 vw_status rt_job_commit(rt_job *j, char *err, size_t errlen);
 vw_status rt_job_run(rt_job *j, char *err, size_t errlen);
 void rt_job_free(rt_job *j);

@@ -1,6 +1,6 @@
 /* vw_test.h - the few assertion macros every test executable uses: on failure they
  * print the expression, both values, file and line, and exit non-zero (ctest reads
- * the status).
+ * the status); EXPECT records the failure and goes on.
  */
 #ifndef VW_TEST_H
 #define VW_TEST_H
@@ -40,6 +40,20 @@ static int vw_test_checks;
             fprintf(stderr, "%s:%d: |%s - %s| <= %s failed: %.17g vs %.17g\n", __FILE__, \
                     __LINE__, #a, #b, #tol, va_, vb_);                                  \
             exit(1);                                                                    \
+        }                                                                               \
+    } while (0)
+
+/* Like CHECK, but goes on after a failure (counted in vw_test_failures; the test ends
+   with that count's verdict) and prints a printf-style message with the expression. */
+static int vw_test_failures __attribute__((unused));
+#define EXPECT(cond, ...)                                                               \
+    do {                                                                                \
+        vw_test_checks++;                                                               \
+        if (!(cond)) {                                                                  \
+            fprintf(stderr, "%s:%d: check failed: %s: ", __FILE__, __LINE__, #cond);     \
+            fprintf(stderr, __VA_ARGS__);                                               \
+            fputc('\n', stderr);                                                        \
+            vw_test_failures++;                                                         \
         }                                                                               \
     } while (0)
 

@@ -12,22 +12,12 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "../vw_test.h"
 #include "raytrace/geometry.h"
 #include "raytrace/raytrace.h"
 #include "vwalls/gen.h"
 #include "vwalls/image.h"
 
-static int failures;
-
-#define CHECK(cond, ...)                                                        \
-    do {                                                                        \
-        if (!(cond)) {                                                          \
-            fprintf(stderr, "%s:%d: check failed: %s: ", __FILE__, __LINE__, #cond); \
-            fprintf(stderr, __VA_ARGS__);                                       \
-            fputc('\n', stderr);                                                \
-            failures++;                                                         \
-        }                                                                       \
-    } while (0)
 
 static vw_scene *load(const char *spec)
 {
@@ -98,11 +88,11 @@ static int test_identical(const char *spec, const char *size)
     printf("%s %dx%d: eye %lld reflect %lld refract %lld shadow %lld\n", spec, w, h,
            (long long)c0[RT_C_EYE], (long long)c0[RT_C_REFLECT], (long long)c0[RT_C_REFRACT],
            (long long)c0[RT_C_SHADOW]);
-    CHECK(rays == c0[RT_C_ENDED], "created %lld, ended %lld", (long long)rays,
+    EXPECT(rays == c0[RT_C_ENDED], "created %lld, ended %lld", (long long)rays,
           (long long)c0[RT_C_ENDED]);
-    CHECK(c0[RT_C_EYE] == c0[RT_C_PIXELS], "eye %lld, pixels %lld", (long long)c0[RT_C_EYE],
+    EXPECT(c0[RT_C_EYE] == c0[RT_C_PIXELS], "eye %lld, pixels %lld", (long long)c0[RT_C_EYE],
           (long long)c0[RT_C_PIXELS]);
-    CHECK(c0[RT_C_EYE] > 0, "no eye rays");
+    EXPECT(c0[RT_C_EYE] > 0, "no eye rays");
     for (size_t li = 0; li < sizeof layouts / sizeof layouts[0]; li++)
         for (size_t wi = 0; wi < sizeof workers / sizeof workers[0]; wi++) {
             if (li == 0 && wi == 0) continue;
@@ -114,22 +104,22 @@ static int test_identical(const char *spec, const char *size)
                     if (!diff) first = i;
                     diff++;
                 }
-            CHECK(diff == 0, "layout %dx%dx%d workers %d: %zu sums differ (first: pixel %zu)",
+            EXPECT(diff == 0, "layout %dx%dx%d workers %d: %zu sums differ (first: pixel %zu)",
                   layouts[li][0], layouts[li][1], layouts[li][2], workers[wi], diff, first / 3);
             int64_t r = c[RT_C_EYE] + c[RT_C_REFLECT] + c[RT_C_REFRACT] + c[RT_C_SHADOW];
-            CHECK(r == c[RT_C_ENDED], "layout %dx%dx%d workers %d: created %lld, ended %lld",
+            EXPECT(r == c[RT_C_ENDED], "layout %dx%dx%d workers %d: created %lld, ended %lld",
                   layouts[li][0], layouts[li][1], layouts[li][2], workers[wi], (long long)r,
                   (long long)c[RT_C_ENDED]);
             /* The same rays, whatever the walls. */
             for (int k = RT_C_EYE; k <= RT_C_PIXELS; k++)
-                CHECK(c[k] == c0[k], "layout %dx%dx%d workers %d: counter %d is %lld, not %lld",
+                EXPECT(c[k] == c0[k], "layout %dx%dx%d workers %d: counter %d is %lld, not %lld",
                       layouts[li][0], layouts[li][1], layouts[li][2], workers[wi], k,
                       (long long)c[k], (long long)c0[k]);
             free(img);
         }
     free(ref);
     vw_scene_free(s);
-    return failures ? 1 : 0;
+    return vw_test_failures ? 1 : 0;
 }
 
 /* One diffuse sphere lit by one light, no specular, no ambient: every pixel is either
@@ -197,17 +187,17 @@ static int test_analytic(void)
                 int want = (int)lround(fmin(1, fmax(0, expect[a])) * 255);
                 int e = abs(got - want);
                 if (e > worst) worst = e;
-                CHECK(e <= 1, "pixel (%d,%d) channel %d: got %d, expected %d", x, y, a, got, want);
+                EXPECT(e <= 1, "pixel (%d,%d) channel %d: got %d, expected %d", x, y, a, got, want);
             }
             checked++;
         }
     printf("analytic: %d pixels checked, worst difference %d/255\n", checked, worst);
-    CHECK(checked > W * H / 2, "only %d pixels checked", checked);
+    EXPECT(checked > W * H / 2, "only %d pixels checked", checked);
     int64_t rays = c[RT_C_EYE] + c[RT_C_REFLECT] + c[RT_C_REFRACT] + c[RT_C_SHADOW];
-    CHECK(rays == c[RT_C_ENDED], "created %lld, ended %lld", (long long)rays, (long long)c[RT_C_ENDED]);
+    EXPECT(rays == c[RT_C_ENDED], "created %lld, ended %lld", (long long)rays, (long long)c[RT_C_ENDED]);
     free(sums);
     vw_scene_free(s);
-    return failures ? 1 : 0;
+    return vw_test_failures ? 1 : 0;
 }
 
 /* Rays aimed at points sampled on a cone's side must hit it there, from outside. */
@@ -223,7 +213,7 @@ static int test_cone(void)
     o.g.cone.r1 = 0.3;
     void *dev = rt_device_new();
     rt_cell_geo g;
-    CHECK(rt_cell_geo_build(dev, &o, 1, &g) == VW_OK, "build");
+    EXPECT(rt_cell_geo_build(dev, &o, 1, &g) == VW_OK, "build");
     int hits = 0, n = 0;
     for (int i = 0; i < 200; i++) {
         double s = (i % 20 + 0.5) / 20.0, phi = (i / 20) * 0.6283 + 0.1;
@@ -258,22 +248,22 @@ static int test_cone(void)
             }
             /* A ray along the outward radial of a cone whose sides slope: it meets the side
                at p, exactly (float t). */
-            CHECK(sqrt(err) < 1e-5, "ray %d: hit %g away from the sampled point", i, sqrt(err));
+            EXPECT(sqrt(err) < 1e-5, "ray %d: hit %g away from the sampled point", i, sqrt(err));
             double nn[3];
             rt_cone_normal(&o, q, nn);
-            CHECK(nn[0] * radial[0] + nn[1] * radial[1] + nn[2] * radial[2] > 0.8,
+            EXPECT(nn[0] * radial[0] + nn[1] * radial[1] + nn[2] * radial[2] > 0.8,
                   "ray %d: normal does not point outward", i);
             hits++;
         }
         /* Shadow query agrees. */
-        CHECK(rt_cell_geo_occluded(&g, org, dir, 0, 100) == 1, "ray %d: not occluded", i);
-        CHECK(rt_cell_geo_occluded(&g, org, dir, 0, 2.9) == 0, "ray %d: occluded too early", i);
+        EXPECT(rt_cell_geo_occluded(&g, org, dir, 0, 100) == 1, "ray %d: not occluded", i);
+        EXPECT(rt_cell_geo_occluded(&g, org, dir, 0, 2.9) == 0, "ray %d: occluded too early", i);
     }
-    CHECK(hits == n, "%d of %d rays hit", hits, n);
+    EXPECT(hits == n, "%d of %d rays hit", hits, n);
     rt_cell_geo_free(&g);
     rt_device_free(dev);
     printf("cone: %d of %d sampled points hit\n", hits, n);
-    return failures ? 1 : 0;
+    return vw_test_failures ? 1 : 0;
 }
 
 static int write_png(int argc, char **argv)

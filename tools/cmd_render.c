@@ -46,6 +46,11 @@ static void help(void)
            "                     take up to 3 more, stopping when no gain is predicted)\n"
            "  --prepass N      pre-pass traces every N-th row and column (default: about 256\n"
            "                   eye rays per cell, N between 1 and 8)\n"
+           "  --farm F         idle (default) | all | none: the workers of a process share\n"
+           "                   its cells by holding copies; idle: only workers that host no\n"
+           "                   cell get copies (of all the process's cells), all: every worker\n"
+           "                   gets one of every cell (rays cross only to other processes;\n"
+           "                   memory: a scene per worker)\n"
            "  --map K          block (default) | greedy (by load) | weighted (by --speeds)\n"
            "  --speeds LIST    relative speed of every worker, like 1,1,2,4\n"
            "  --slow W:K[,..]  worker W does its work K times slower (emulates a slow machine)\n"
@@ -102,7 +107,7 @@ static void *progress_main(void *arg)
 static char *with_balance_json(char *rt, rt_job *job, vw_world *w, const vw_traffic *tr,
                                const rt_balance_result *bi,
                                vw_balance_strategy s, vw_map_kind map, const vw_load_spec *ls,
-                               const double *speeds)
+                               const double *speeds, rt_farm farm, int farm_copies)
 {
     if (!rt) return NULL;
     static const char *const models[] = {"busy", "segments", "model"};
@@ -116,7 +121,7 @@ static char *with_balance_json(char *rt, rt_job *job, vw_world *w, const vw_traf
              "\"imbalance_work\": %.6g, \"migrated_objects\": %llu, \"bytes_moved\": %llu, "
              "\"max_neighbours\": %d, \"prepass_s\": %.6f, \"balance_s\": %.6f, "
              "\"prepass_stride\": %d, \"reverted\": %d, \"imbalance_measured\": %.6g, "
-             "\"duplicates\": %d},\n"
+             "\"duplicates\": %d, \"farm\": \"%s\", \"farm_copies\": %d},\n"
              "  \"traffic\": {\"messages\": %llu, \"bytes\": %llu, \"worker_messages\": %llu, "
              "\"worker_bytes\": %llu, \"process_messages\": %llu, \"process_bytes\": %llu, "
              "\"machine_messages\": %llu, \"machine_bytes\": %llu, \"share_worker\": %.6g, "
@@ -127,7 +132,7 @@ static char *with_balance_json(char *rt, rt_job *job, vw_world *w, const vw_traf
              rt_job_work_imbalance(job, speeds), (unsigned long long)bi->migrated,
              (unsigned long long)bi->bytes, vw_decomp_max_neighbours(vw_world_decomp(w)),
              bi->prepass_s, vw_world_time(w, "balance"), bi->stride, bi->reverted, bi->measured,
-             bi->rep.duplicates, (unsigned long long)tr->msgs,
+             bi->rep.duplicates, rt_farm_name(farm), farm_copies, (unsigned long long)tr->msgs,
              (unsigned long long)tr->bytes, (unsigned long long)tr->msgs_worker,
              (unsigned long long)tr->bytes_worker, (unsigned long long)tr->msgs_process,
              (unsigned long long)tr->bytes_process, (unsigned long long)tr->msgs_machine,
@@ -148,6 +153,7 @@ int vw_cmd_render(int argc, char **argv)
     int has_from = 0, has_at = 0, has_up = 0, has_angle = 0;
     const char *speeds_s = NULL, *slow_s = NULL;
     vw_balance_strategy strategy = VW_BALANCE_NONE;
+    int farm = RT_FARM_IDLE, farm_copies = 0;
     vw_map_kind map = VW_MAP_BLOCK;
     int map_given = 0, by_worker = 0;
     long iters = 2, prepass = 0; /* 0: rt_prepass_stride() */
@@ -212,6 +218,12 @@ int vw_cmd_render(int argc, char **argv)
                 return VW_EXIT_USAGE;
             }
             map_given = 1;
+        } else if (!strcmp(a, "--farm")) {
+            if (!(v = vw_cli_value(CMD, argc, argv, &i))) return VW_EXIT_USAGE;
+            if ((farm = rt_farm_parse(v)) < 0) {
+                vw_cli_error(CMD, "--farm: bad value '%s' (expected idle, all or none)", v);
+                return VW_EXIT_USAGE;
+            }
         } else if (!strcmp(a, "--speeds")) {
             if (!(speeds_s = vw_cli_value(CMD, argc, argv, &i))) return VW_EXIT_USAGE;
         } else if (!strcmp(a, "--slow")) {
@@ -354,8 +366,9 @@ int vw_cmd_render(int argc, char **argv)
         free(speeds), free(slowdown);
         return VW_EXIT_FAIL;
     }
+    double t_loaded = vw_cli_now(); /* the balance phase (pre-pass) is timed apart */
     if (balancing) {
-        double tb0 = vw_cli_now();
+        double tb0 = t_loaded;
         rt_balance rb = {strategy, map, speeds, lspec, (int)iters, (int)prepass};
         st = rt_job_balance(job, &rb, &bi, err, sizeof err);
         if (st != VW_OK) {
@@ -368,7 +381,8 @@ int vw_cmd_render(int argc, char **argv)
         vw_world_add_time(w, "balance", vw_cli_now() - tb0 - vw_world_time(w, "balance"));
     }
     double t_build0 = vw_cli_now();
-    if (rt_job_commit(job, err, sizeof err) != VW_OK) {
+    if (rt_job_farm(job, (rt_farm)farm, &farm_copies, err, sizeof err) != VW_OK ||
+        rt_job_commit(job, err, sizeof err) != VW_OK) {
         vw_cli_error(CMD, "%s", err);
         rt_job_free(job);
         free(speeds), free(slowdown);
@@ -404,7 +418,7 @@ int vw_cmd_render(int argc, char **argv)
         /* After: measured on the full render (busy time over workers), not predicted. */
         vw_world_set_balance_info(w, vw_balance_strategy_name(strategy), bi.rep.imbalance_before,
                                   vw_world_imbalance(w), bi.migrated);
-    vw_world_add_time(w, "load", t_build0 - t_load0);
+    vw_world_add_time(w, "load", t_loaded - t_load0);
     vw_world_add_time(w, "build", t_run0 - t_build0);
     vw_world_add_time(w, "compute", t_run1 - t_run0);
 
@@ -457,7 +471,7 @@ int vw_cmd_render(int argc, char **argv)
         vw_world_add_time(w, "write", t_end - t_run1);
         if (stats && rc == VW_EXIT_OK) {
             char *extra = with_balance_json(rt_job_stats_json(job), job, w, &traffic, &bi, strategy, map, &lspec,
-                                            speeds);
+                                            speeds, (rt_farm)farm, farm_copies);
             if (vw_world_write_stats(w, stats, CMD, extra) != VW_OK) {
                 vw_cli_error(CMD, "%s", vw_world_errmsg(w));
                 rc = VW_EXIT_FAIL;
@@ -473,9 +487,10 @@ int vw_cmd_render(int argc, char **argv)
             vw_decomp_layout_string(vw_world_decomp(w), layout, sizeof layout);
             printf("render %s -> %s: %dx%d, depth %d, %zu objects\n", scene_path, out, W, H,
                    sh->max_depth, nobjects);
-            printf("cells %s (%d), workers %d x %d process%s, imbalance lambda %.3f\n", layout,
-                   vw_decomp_cell_count(vw_world_decomp(w)), vw_world_workers(w),
-                   vw_world_processes(w), vw_world_processes(w) == 1 ? "" : "es",
+            printf("cells %s (%d), workers %d x %d process%s, farm %s (%d copies), imbalance "
+                   "lambda %.3f\n", layout, vw_decomp_cell_count(vw_world_decomp(w)),
+                   vw_world_workers(w), vw_world_processes(w),
+                   vw_world_processes(w) == 1 ? "" : "es", rt_farm_name((rt_farm)farm), farm_copies,
                    vw_world_imbalance(w));
             if (balancing)
                 printf("balance %s, map %s: lambda before %.3f, predicted %.3f, after %.3f "
@@ -484,8 +499,9 @@ int vw_cmd_render(int argc, char **argv)
                        bi.rep.imbalance_before, bi.rep.imbalance_predicted, vw_world_imbalance(w),
                        rt_job_work_imbalance(job, speeds), (unsigned long long)bi.migrated,
                        vw_world_time(w, "balance"));
-            printf("time: load %.3f s, build %.3f s, compute %.3f s, write %.3f s, total %.3f s\n",
-                   t_build0 - t_load0, t_run0 - t_build0, comp, t_end - t_run1, t_end - t_load0);
+            printf("time: load %.3f s, balance %.3f s, build %.3f s, compute %.3f s, write %.3f s, "
+                   "total %.3f s\n", t_loaded - t_load0, t_build0 - t_loaded, t_run0 - t_build0, comp,
+                   t_end - t_run1, t_end - t_load0);
             printf("rays: eye %lld, reflect %lld, refract %lld, shadow %lld; %lld in all, "
                    "%.3f Mrays/s\n",
                    eye, refl, refr, shad, total, comp > 0 ? total / comp * 1e-6 : 0.0);

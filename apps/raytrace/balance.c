@@ -52,6 +52,52 @@ vw_status rt_job_map(rt_job *j, vw_map_kind kind, const double *load, const doub
     return st;
 }
 
+int rt_farm_parse(const char *s)
+{
+    static const char *const names[] = {"idle", "all", "none"};
+    for (int f = 0; f < 3; f++)
+        if (!strcmp(s, names[f])) return f;
+    return -1;
+}
+
+const char *rt_farm_name(rt_farm f)
+{
+    return f == RT_FARM_ALL ? "all" : f == RT_FARM_NONE ? "none" : "idle";
+}
+
+vw_status rt_job_farm(rt_job *j, rt_farm f, int *copies, char *err, size_t errlen)
+{
+    vw_world *w = rt_job_world(j);
+    int nc = vw_decomp_cell_count(vw_world_decomp(w));
+    int W = vw_world_workers(w), gw = W * vw_world_processes(w);
+    if (copies) *copies = 0;
+    if (f == RT_FARM_NONE || W < 2) return VW_OK;
+    /* Which workers host something (a master or a copy) now. */
+    unsigned char *hosts = calloc((size_t)gw, 1);
+    int *on = malloc(sizeof(int) * (size_t)gw), *have = malloc(sizeof(int) * (size_t)gw);
+    vw_status st = hosts && on && have ? VW_OK : VW_E_NOMEM;
+    for (int c = 0; st == VW_OK && c < nc; c++) {
+        hosts[vw_world_cell_worker(w, c)] = 1;
+        int n = vw_world_replicas(w, c, have, gw);
+        for (int i = 0; i < n; i++) hosts[have[i]] = 1;
+    }
+    for (int c = 0; st == VW_OK && c < nc; c++) {
+        int m = vw_world_cell_worker(w, c), p0 = m / W * W;
+        int n = vw_world_replicas(w, c, on, gw), before = n;
+        for (int g = p0; g < p0 + W; g++) {
+            if (g == m || (f == RT_FARM_IDLE && hosts[g])) continue;
+            int dup = 0;
+            for (int i = 0; i < n; i++) dup |= on[i] == g;
+            if (!dup) on[n++] = g;
+        }
+        if (n > before) st = vw_world_set_replicas(w, c, on, n);
+        if (copies) *copies += n - before;
+    }
+    if (st != VW_OK) snprintf(err, errlen, "farming the cells: %s", vw_status_message(st));
+    free(hosts), free(on), free(have);
+    return st;
+}
+
 /* Rebuilds the cells in place (same walls, same workers, same copies of duplicated
    cells: nothing migrates), for cells that were last built for the pre-pass's sparse
    pixels. */

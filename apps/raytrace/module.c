@@ -49,10 +49,11 @@ typedef struct rt_cell {
     rt_cell_geo geo;
     rt_shared *sh;
     int *pixels;          /* primary pixels whose eye ray enters the world here */
-    size_t npixels, next; /* next pixel to generate */
+    size_t npixels;
+    int eye_done;         /* this run's eye rays are all made (by this copy or others) */
     rt_package pkg;       /* contributions not yet sent */
     int64_t rays_pending; /* rays created, not yet added to sh->rays */
-    unsigned frame;       /* the run whose eye rays next/npixels describe */
+    unsigned frame;       /* the run eye_done describes */
 } rt_cell;
 
 static const char *const counter_names[RT_NCOUNTERS] = {
@@ -158,9 +159,7 @@ static void spawn(vw_ctx *ctx, rt_cell *c, rt_ray *r)
     }
     r->t0 = s.t0;
     r->t1 = s.t1;
-    /* The master of a duplicated cell shares the eye rays it creates: sent to itself,
-       they go to the master and its copies in turn (rays are independent messages). */
-    if (s.cell == vw_ctx_cell(ctx) && !(r->kind == RT_EYE && vw_ctx_replicas(ctx) > 0))
+    if (s.cell == vw_ctx_cell(ctx))
         trace(ctx, c, r);
     else
         vw_send_cell(ctx, s.cell, RT_K_RAY, r);
@@ -337,7 +336,7 @@ static int walk_ray(vw_ctx *ctx, rt_cell *c, rt_ray *r)
             r->t0 = s.t0;
             r->t1 = s.t1;
             if (s.cell == me) continue;
-            rt_cell *next = vw_ctx_enter(ctx, s.cell);
+            rt_cell *next = vw_ctx_enter(ctx, s.cell, RT_K_RAY);
             if (next) {
                 c = next;
                 me = s.cell;
@@ -479,28 +478,34 @@ static int step(vw_ctx *ctx, void *state)
     rt_cell *c = state;
     if (c->frame != c->sh->frame) { /* a new run: all of this cell's eye rays again */
         c->frame = c->sh->frame;
-        c->next = 0;
+        c->eye_done = 0;
     }
-    /* Eye rays are the master's work: a copy of a duplicated cell gets its share as
-       messages, and only flushes here. */
-    if (c->next < c->npixels && vw_ctx_replica(ctx) == 0) {
-        const rt_view *v = &c->sh->view;
-        size_t end = c->next + RT_BATCH < c->npixels ? c->next + RT_BATCH : c->npixels;
-        vw_count(ctx, RT_C_PIXELS, (int64_t)(end - c->next));
-        for (; c->next < end; c->next++) {
-            int px = c->pixels[c->next];
-            rt_ray r;
-            memcpy(r.org, v->eye, sizeof r.org);
-            rt_view_ray(v, px % v->width, px / v->width, r.dir);
-            r.tmax = INFINITY;
-            r.weight[0] = r.weight[1] = r.weight[2] = 1.0;
-            r.pixel = px;
-            r.depth = 1;
-            r.kind = RT_EYE;
-            r.pad = 0;
-            spawn(ctx, c, &r);
+    /* The eye rays, RT_BATCH pixels a call. A duplicated cell's copies farm them
+       (vw_ctx_next_batch hands each batch to one copy): no eye ray is a message, and
+       every copy starts at once and takes more while it is faster. */
+    if (!c->eye_done) {
+        uint64_t b = vw_ctx_next_batch(ctx);
+        size_t begin = b <= c->npixels / RT_BATCH ? (size_t)b * RT_BATCH : c->npixels;
+        if (begin < c->npixels) {
+            const rt_view *v = &c->sh->view;
+            size_t end = begin + RT_BATCH < c->npixels ? begin + RT_BATCH : c->npixels;
+            vw_count(ctx, RT_C_PIXELS, (int64_t)(end - begin));
+            for (size_t i = begin; i < end; i++) {
+                int px = c->pixels[i];
+                rt_ray r;
+                memcpy(r.org, v->eye, sizeof r.org);
+                rt_view_ray(v, px % v->width, px / v->width, r.dir);
+                r.tmax = INFINITY;
+                r.weight[0] = r.weight[1] = r.weight[2] = 1.0;
+                r.pixel = px;
+                r.depth = 1;
+                r.kind = RT_EYE;
+                r.pad = 0;
+                spawn(ctx, c, &r);
+            }
+            return 1;
         }
-        return 1;
+        c->eye_done = 1;
     }
     /* Called after every delivery too: a partial package leaves here, so no
        contribution waits in a cell when the world goes quiet. Sending counts as work:

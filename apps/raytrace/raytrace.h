@@ -213,6 +213,24 @@ vw_status rt_job_balance(rt_job *j, const rt_balance *b, rt_balance_result *out,
 /* Re-maps the cells (kind, loads or NULL, speeds or NULL) before or between runs. */
 vw_status rt_job_map(rt_job *j, vw_map_kind kind, const double *load, const double *speeds,
                      char *err, size_t errlen);
+/* Farming within a process: the workers of a process share its cells by holding copies
+   of them (vw_world_set_replicas). A ray then moves to another worker only when it
+   crosses into a cell of another process, and every copy takes eye-ray batches on
+   demand (vw_ctx_next_batch), so the workers stay evenly loaded. The cost is memory:
+   each copy builds its own Embree scene. */
+typedef enum rt_farm {
+    RT_FARM_IDLE = 0, /* only workers that host no cell get copies (of all their
+                         process's cells): --cells 1 on 2 workers uses both */
+    RT_FARM_ALL,      /* every worker hosts every cell of its process */
+    RT_FARM_NONE      /* no copies besides those a balancer made */
+} rt_farm;
+/* Parses "idle" | "all" | "none"; -1 if none of them. */
+int rt_farm_parse(const char *s);
+const char *rt_farm_name(rt_farm f);
+/* Adds the copies of mode f to the current mapping (after balancing, before commit).
+   *copies gets the number of copies added (may be NULL). */
+vw_status rt_job_farm(rt_job *j, rt_farm f, int *copies, char *err, size_t errlen);
+
 /* lambda of the deterministic work (ray-cell visits, RT_C_SEGMENTS) over workers. */
 double rt_job_work_imbalance(const rt_job *j, const double *speeds);
 

@@ -92,6 +92,13 @@ VW_API void *vw_ctx_user(const vw_ctx *ctx);
    and how many copies besides the master the cell has. */
 VW_API int vw_ctx_replica(const vw_ctx *ctx);
 VW_API int vw_ctx_replicas(const vw_ctx *ctx);
+/* Farming a cell's own work (what step() creates) among its copies: the work is cut
+   into batches numbered 0, 1, 2, ... and each call returns the number of the next
+   batch this copy is to make. Within one run every number goes to exactly one copy of
+   the cell: on demand among the copies of one process (a fast worker takes more), in
+   turn among processes. Counting restarts at every run; a cell without copies gets
+   0, 1, 2, ... Call it from step() until the number is past the cell's last batch. */
+VW_API uint64_t vw_ctx_next_batch(vw_ctx *ctx);
 
 /* Sending. A message is copied when sent; the caller keeps its buffer.
    Messages are batched per destination into packets, flushed when full or when the
@@ -110,15 +117,16 @@ VW_API int vw_send_neighbours(vw_ctx *ctx, int kind, const void *msg);
 /* To the output process, where the kind's output handler receives it. */
 VW_API void vw_send_output(vw_ctx *ctx, int kind, const void *msg);
 
-/* Inline hand-off, "a message delivered by a function call": when this worker hosts
-   `cell` (and the cell is not duplicated), switches ctx to it and returns its state;
-   otherwise NULL, and the caller sends the message instead. The caller then does for
-   that cell exactly what the message's handler would do (vw_count, sends, and time are
-   charged to it), and must go back with vw_ctx_restore(ctx, cell, replica) using the
-   values vw_ctx_cell() and vw_ctx_replica() had before, before it returns or uses the
-   first cell's state again. Messages are the model; this only skips the packet for
-   the common case of a neighbour on the same worker (a ray crossing a wall). */
-VW_API void *vw_ctx_enter(vw_ctx *ctx, int cell);
+/* Inline hand-off, "a message of kind `kind` delivered by a function call": when this
+   worker hosts `cell` (or, if the cell is duplicated and the kind independent, hosts a
+   copy of it), switches ctx to it and returns its state; otherwise NULL, and the caller
+   sends the message instead. The caller then does for that cell exactly what the
+   message's handler would do (vw_count, sends, and time are charged to it), and must go
+   back with vw_ctx_restore(ctx, cell, replica) using the values vw_ctx_cell() and
+   vw_ctx_replica() had before, before it returns or uses the first cell's state again.
+   Messages are the model; this only skips the packet for the common case of a
+   neighbour on the same worker (a ray crossing a wall). */
+VW_API void *vw_ctx_enter(vw_ctx *ctx, int cell, int kind);
 VW_API void vw_ctx_restore(vw_ctx *ctx, int cell, int replica);
 
 /* Add n to the module's counter idx for this cell. */

@@ -292,24 +292,49 @@ int vw_ctx_replicas(const vw_ctx *ctx)
     return ctx->cell >= 0 ? ctx->w->cells[ctx->cell].nreps : 0;
 }
 
-void *vw_ctx_enter(vw_ctx *ctx, int cell)
+uint64_t vw_ctx_next_batch(vw_ctx *ctx)
+{
+    if (ctx->cell < 0) return 0;
+    vw__cell *c = &ctx->w->cells[ctx->cell];
+    uint64_t k = atomic_fetch_add_explicit(&c->batches_taken, 1, memory_order_relaxed);
+    return (uint64_t)c->batch_slot + (uint64_t)c->batch_procs * k;
+}
+
+void *vw_ctx_enter(vw_ctx *ctx, int cell, int kind)
 {
     vw_world *w = ctx->w;
     vw__worker *wk = ctx->wk;
-    if (cell < 0 || cell >= w->ncells) {
-        fprintf(stderr, "vwalls: module '%s' entered cell %d of %d\n", w->m->name, cell, w->ncells);
+    if (cell < 0 || cell >= w->ncells || kind < 0 || kind >= w->m->nkinds) {
+        fprintf(stderr, "vwalls: module '%s' entered cell %d of %d with kind %d\n", w->m->name,
+                cell, w->ncells, kind);
         abort();
     }
-    if (w->cell_worker[cell] != wk->global) return NULL;
     vw__cell *c = &w->cells[cell];
-    if (c->nreps) return NULL;
+    int rep = 0;
+    if (c->nreps) {
+        /* A duplicated cell: any copy may take an independent message, so this worker's
+           own copy takes it (farming keeps a ray on the worker it started on). */
+        if (!(w->m->kinds[kind].flags & VW_MSG_INDEPENDENT)) return NULL;
+        rep = vw__cell_rep_of(w, cell, wk->global);
+        if (rep < 0) return NULL;
+    } else if (w->cell_worker[cell] != wk->global) {
+        return NULL;
+    }
     /* Stress: refuse half the hand-offs, so both paths run under every interleaving. */
     if (w->cfg.stress_seed && (vw__rng_next(&wk->rng) & 1)) return NULL;
-    if (cell != ctx->cell || ctx->rep != 0) meter_note(wk, cell, 0);
-    c->messages_in++;
+    if (cell != ctx->cell || ctx->rep != rep) meter_note(wk, cell, rep);
+    void *state;
+    if (rep) {
+        vw__replica *r = &c->reps[rep - 1];
+        r->messages_in++;
+        state = r->state;
+    } else {
+        c->messages_in++;
+        state = c->state;
+    }
     ctx->cell = cell;
-    ctx->rep = 0;
-    return c->state;
+    ctx->rep = rep;
+    return state;
 }
 
 void vw_ctx_restore(vw_ctx *ctx, int cell, int replica)
@@ -342,7 +367,7 @@ void vw_send_cell(vw_ctx *ctx, int cell, int kind, const void *msg)
         (w->m->kinds[kind].flags & VW_MSG_INDEPENDENT)) {
         /* A duplicated cell: the master and its copies in turn. The receiving worker
            finds its copy by (cell, worker), so the header needs no copy number. */
-        unsigned u = c->rr[ctx->wk->local]++ % (unsigned)(c->nreps + 1);
+        unsigned u = c->rr[(size_t)ctx->wk->local * VW__RR_STRIDE]++ % (unsigned)(c->nreps + 1);
         if (u) dest = c->reps[u - 1].worker;
     }
     enqueue(ctx, dest, dest, cell, kind, msg);
@@ -601,6 +626,23 @@ vw_status vw__runtime_run(vw_world *w)
     /* With a transport, its thread (this one) is counted too: see the top of the file. */
     atomic_store(&w->active, w->nworkers + (w->transport ? 1 : 0));
     for (int i = 0; i < w->nworkers; i++) w->workers[i].busy = 1;
+    /* Farming (vw_ctx_next_batch): the processes hosting a copy of each cell take its
+       batches in turn, ordered by rank; every run counts them afresh. */
+    for (int cl = 0; cl < w->ncells; cl++) {
+        vw__cell *c = &w->cells[cl];
+        int procs = 0, slot = 0;
+        for (int p = 0; p < w->nprocs; p++) {
+            int hosts = vw__worker_process(w, c->worker) == p;
+            for (int r = 0; r < c->nreps && !hosts; r++)
+                hosts = vw__worker_process(w, c->reps[r].worker) == p;
+            if (!hosts) continue;
+            if (p == w->rank) slot = procs;
+            procs++;
+        }
+        c->batch_slot = slot;
+        c->batch_procs = procs > 0 ? procs : 1;
+        atomic_store_explicit(&c->batches_taken, 0, memory_order_relaxed);
+    }
     /* Posted messages: counted like any packet. */
     while (w->posted) {
         vw__packet *p = w->posted;

@@ -488,7 +488,7 @@ vw_status vw_world_set_replicas(vw_world *w, int cell, const int *workers, int n
         nr[i].counters = vw__calloc_lines(nc, sizeof(int64_t));
         if (!nr[i].counters) st = VW_E_NOMEM;
     }
-    unsigned *rr = n ? vw__calloc_lines((size_t)w->nworkers, sizeof *rr) : NULL;
+    unsigned *rr = n ? vw__calloc_lines((size_t)w->nworkers * VW__RR_STRIDE, sizeof *rr) : NULL;
     if (n && !rr) st = VW_E_NOMEM;
     if (st != VW_OK) {
         for (int i = 0; i < n; i++) free(nr[i].counters);

@@ -74,10 +74,19 @@ typedef struct vw__cell {
     unsigned version;        /* bumped whenever the cell's objects change (copies rebuild) */
     vw__replica *reps;       /* copies besides the master, nreps of them */
     int nreps;
+    /* Farming the cell's own work among its copies (vw_ctx_next_batch): this process's
+       place among the processes that host a copy (the master counts), how many do,
+       and the batches its copies have taken in this run (reset by every run). */
+    int batch_slot, batch_procs;
+    _Alignas(VW__LINE) atomic_ullong batches_taken; /* a line of its own: shared by copies */
     unsigned *rr;            /* duplicated cells: per local worker, the next copy to send to
                                 (one counter per sender and cell, so each cell's copies get
-                                equal shares whatever else the sender sends) */
+                                equal shares whatever else the sender sends), at
+                                rr[local * VW__RR_STRIDE]: a cache line per sender */
 } vw__cell;
+
+/* Stride of vw__cell.rr: one cache line per sending worker. */
+#define VW__RR_STRIDE (VW__LINE / sizeof(unsigned))
 
 /* Inline hand-offs (vw_ctx_enter) noted before the meter reads the clock again. */
 #define VW__METER_N 64

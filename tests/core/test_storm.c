@@ -5,6 +5,9 @@
  * order; every message must arrive exactly once, intact, and the run must end.
  * Half the sparks whose cell is on the same worker are handed off inline
  * (vw_ctx_enter / vw_ctx_restore) instead of sent: they must count the same.
+ * Sparks are independent messages, and in every other run a third of the cells are
+ * duplicated: the copies share the sparks sent to their cell (and take the ones
+ * handed off inline on their worker), and the counts must not change.
  *
  * usage: test_storm [SEEDS] [--stress]   (also honours VW_STRESS / VW_STRESS_SPLIT)
  */
@@ -89,6 +92,7 @@ static int step(vw_ctx *ctx, void *state)
 {
     storm_cell *sc = state;
     storm *st = vw_ctx_user(ctx);
+    if (vw_ctx_replica(ctx) > 0) return 0; /* the roots are the master's */
     if (sc->roots_sent == st->roots_per_cell) return 0;
     spark s;
     uint64_t key = mix(st->seed ^ ((uint64_t)vw_ctx_cell(ctx) << 20) ^ (uint64_t)sc->roots_sent);
@@ -123,7 +127,7 @@ static void on_spark(vw_ctx *ctx, void *state, const void *msg)
         int dest = dest_of(key, st->ncells);
         /* Every other child is handed off inline when its cell is on this worker
            (vw_ctx_enter): it must count exactly as if it had been delivered. */
-        void *there = (key >> 7) & 1 ? vw_ctx_enter(ctx, dest) : NULL;
+        void *there = (key >> 7) & 1 ? vw_ctx_enter(ctx, dest, MSG_SPARK) : NULL;
         if (!there) {
             vw_send_cell(ctx, dest, MSG_SPARK, &k);
             continue;
@@ -149,7 +153,7 @@ static void on_output(void *user, const void *msg)
 }
 
 static const vw_msg_kind kinds[NKINDS] = {
-    [MSG_SPARK] = {"spark", sizeof(spark), on_spark, on_output},
+    [MSG_SPARK] = {"spark", sizeof(spark), on_spark, on_output, VW_MSG_INDEPENDENT},
     [MSG_ECHO] = {"echo", 16, on_echo, NULL},
 };
 static const char *const counters[NCOUNTERS] = {"received", "sum", "corrupt", "output", "echo"};
@@ -171,7 +175,7 @@ int main(int argc, char **argv)
     int stress = argc > 2 && !strcmp(argv[2], "--stress");
     vw_box world = {{0, 0, 0}, {1, 1, 1}};
     const char *layouts[] = {"1", "2", "2x2", "3x1x2", "2x2x2", "4x4x4"};
-    int runs = 0;
+    int runs = 0, dup_runs = 0;
     int64_t total = 0;
     for (int seed = 1; seed <= seeds; seed++) {
         for (size_t li = 0; li < sizeof layouts / sizeof layouts[0]; li++) {
@@ -197,6 +201,15 @@ int main(int argc, char **argv)
             if (seed % 3 == 0) cfg.cap_bytes = 256;
             vw_world *w;
             CHECK_EQ_INT(vw_world_create(&storm_module, &st, d, &cfg, &w), VW_OK);
+            int ncopies = 0;
+            if (workers > 1 && seed % 2 == 0)
+                for (int c = 0; c < ncells; c += 3) {
+                    /* Copies on up to two other workers. */
+                    int m = vw_world_cell_worker(w, c), on[2], n = 0;
+                    for (int k = 1; k <= 2 && k < workers; k++) on[n++] = (m + k) % workers;
+                    CHECK_EQ_INT(vw_world_set_replicas(w, c, on, n), VW_OK);
+                    ncopies += n;
+                }
             CHECK_EQ_INT(vw_world_run(w), VW_OK);
             int64_t received = vw_world_counter(w, CNT_RECEIVED);
             CHECK_EQ_INT(received, want);
@@ -219,8 +232,10 @@ int main(int argc, char **argv)
             vw_world_free(w);
             vw_decomp_free(d);
             runs++;
+            dup_runs += ncopies > 0;
         }
     }
-    printf("%d storm runs, %lld sparks delivered\n", runs, (long long)total);
+    printf("%d storm runs (%d with copies), %lld sparks delivered\n", runs, dup_runs,
+           (long long)total);
     TEST_DONE();
 }

@@ -47,8 +47,8 @@ static vw_scene *load(const char *spec)
 }
 
 /* Renders; returns the malloc'ed fixed-point sums (w*h*3) and the ray counters. */
-static int64_t *render(const vw_scene *s, int w, int h, const int dims[3], int workers,
-                       int64_t counters[RT_NCOUNTERS], rt_job **keep)
+static int64_t *render_farm(const vw_scene *s, int w, int h, const int dims[3], int workers,
+                            rt_farm farm, int64_t counters[RT_NCOUNTERS], rt_job **keep)
 {
     rt_params p;
     memset(&p, 0, sizeof p);
@@ -58,7 +58,8 @@ static int64_t *render(const vw_scene *s, int w, int h, const int dims[3], int w
     p.workers = workers;
     char err[512];
     rt_job *j;
-    if (rt_job_create(s, &p, &j, err, sizeof err) != VW_OK || rt_job_commit(j, err, sizeof err) ||
+    if (rt_job_create(s, &p, &j, err, sizeof err) != VW_OK ||
+        rt_job_farm(j, farm, NULL, err, sizeof err) || rt_job_commit(j, err, sizeof err) ||
         rt_job_run(j, err, sizeof err)) {
         fprintf(stderr, "render failed: %s\n", err);
         exit(1);
@@ -72,6 +73,12 @@ static int64_t *render(const vw_scene *s, int w, int h, const int dims[3], int w
     else
         rt_job_free(j);
     return sums;
+}
+
+static int64_t *render(const vw_scene *s, int w, int h, const int dims[3], int workers,
+                       int64_t counters[RT_NCOUNTERS], rt_job **keep)
+{
+    return render_farm(s, w, h, dims, workers, RT_FARM_NONE, counters, keep);
 }
 
 static int test_identical(const char *spec, const char *size)
@@ -93,28 +100,39 @@ static int test_identical(const char *spec, const char *size)
     EXPECT(c0[RT_C_EYE] == c0[RT_C_PIXELS], "eye %lld, pixels %lld", (long long)c0[RT_C_EYE],
           (long long)c0[RT_C_PIXELS]);
     EXPECT(c0[RT_C_EYE] > 0, "no eye rays");
+    /* Each layout and worker count without copies, then (more than one worker) with
+       the workers farming the cells: copies of every cell (all), or only on the
+       workers that host no cell (idle). */
+    static const char *const farm_names[] = {"idle", "all", "none"};
+    for (int farm = RT_FARM_NONE; farm >= 0; farm--)
     for (size_t li = 0; li < sizeof layouts / sizeof layouts[0]; li++)
         for (size_t wi = 0; wi < sizeof workers / sizeof workers[0]; wi++) {
             if (li == 0 && wi == 0) continue;
+            if (farm != RT_FARM_NONE && workers[wi] == 1) continue;
+            /* idle changes nothing where every worker hosts a cell */
+            if (farm == RT_FARM_IDLE &&
+                layouts[li][0] * layouts[li][1] * layouts[li][2] >= workers[wi])
+                continue;
             int64_t c[RT_NCOUNTERS];
-            int64_t *img = render(s, w, h, layouts[li], workers[wi], c, NULL);
+            int64_t *img = render_farm(s, w, h, layouts[li], workers[wi], (rt_farm)farm, c, NULL);
             size_t diff = 0, first = n;
             for (size_t i = 0; i < n; i++)
                 if (img[i] != ref[i]) {
                     if (!diff) first = i;
                     diff++;
                 }
-            EXPECT(diff == 0, "layout %dx%dx%d workers %d: %zu sums differ (first: pixel %zu)",
-                  layouts[li][0], layouts[li][1], layouts[li][2], workers[wi], diff, first / 3);
+            EXPECT(diff == 0, "layout %dx%dx%d workers %d farm %s: %zu sums differ (first: pixel "
+                   "%zu)", layouts[li][0], layouts[li][1], layouts[li][2], workers[wi],
+                   farm_names[farm], diff, first / 3);
             int64_t r = c[RT_C_EYE] + c[RT_C_REFLECT] + c[RT_C_REFRACT] + c[RT_C_SHADOW];
-            EXPECT(r == c[RT_C_ENDED], "layout %dx%dx%d workers %d: created %lld, ended %lld",
-                  layouts[li][0], layouts[li][1], layouts[li][2], workers[wi], (long long)r,
-                  (long long)c[RT_C_ENDED]);
+            EXPECT(r == c[RT_C_ENDED], "layout %dx%dx%d workers %d farm %s: created %lld, ended "
+                   "%lld", layouts[li][0], layouts[li][1], layouts[li][2], workers[wi],
+                   farm_names[farm], (long long)r, (long long)c[RT_C_ENDED]);
             /* The same rays, whatever the walls. */
             for (int k = RT_C_EYE; k <= RT_C_PIXELS; k++)
-                EXPECT(c[k] == c0[k], "layout %dx%dx%d workers %d: counter %d is %lld, not %lld",
-                      layouts[li][0], layouts[li][1], layouts[li][2], workers[wi], k,
-                      (long long)c[k], (long long)c0[k]);
+                EXPECT(c[k] == c0[k], "layout %dx%dx%d workers %d farm %s: counter %d is %lld, "
+                       "not %lld", layouts[li][0], layouts[li][1], layouts[li][2], workers[wi],
+                       farm_names[farm], k, (long long)c[k], (long long)c0[k]);
             free(img);
         }
     free(ref);

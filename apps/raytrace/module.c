@@ -20,6 +20,10 @@ enum { RT_EYE = 0, RT_REFLECT = 1, RT_REFRACT = 2, RT_SHADOW = 3 };
 
 /* Eye rays generated per step() call: bounds the messages one call can create. */
 #define RT_BATCH 256
+/* Eye rays per farmed batch (vw_ctx_next_batch): copies of a duplicated cell take
+   every k-th run of this many pixels of the cell's row-major list, fine enough that
+   each copy's share samples the whole cell (a quarter row would make column stripes). */
+#define RT_SHARE 16
 
 typedef struct rt_ray {
     double org[3], dir[3]; /* original, for the ray's whole life; dir is unit length */
@@ -480,15 +484,20 @@ static int step(vw_ctx *ctx, void *state)
         c->frame = c->sh->frame;
         c->eye_done = 0;
     }
-    /* The eye rays, RT_BATCH pixels a call. A duplicated cell's copies farm them
-       (vw_ctx_next_batch hands each batch to one copy): no eye ray is a message, and
-       every copy starts at once and takes more while it is faster. */
+    /* The eye rays, up to RT_BATCH a call, in batches of RT_SHARE pixels: a duplicated
+       cell's copies farm them (vw_ctx_next_batch gives each batch to one copy, in
+       turn), so no eye ray is a message and every copy starts at once. */
     if (!c->eye_done) {
-        uint64_t b = vw_ctx_next_batch(ctx);
-        size_t begin = b <= c->npixels / RT_BATCH ? (size_t)b * RT_BATCH : c->npixels;
-        if (begin < c->npixels) {
-            const rt_view *v = &c->sh->view;
-            size_t end = begin + RT_BATCH < c->npixels ? begin + RT_BATCH : c->npixels;
+        const rt_view *v = &c->sh->view;
+        size_t made = 0;
+        while (made < RT_BATCH) {
+            uint64_t b = vw_ctx_next_batch(ctx);
+            if (b > c->npixels / RT_SHARE || (size_t)b * RT_SHARE >= c->npixels) {
+                c->eye_done = 1;
+                break;
+            }
+            size_t begin = (size_t)b * RT_SHARE;
+            size_t end = begin + RT_SHARE < c->npixels ? begin + RT_SHARE : c->npixels;
             vw_count(ctx, RT_C_PIXELS, (int64_t)(end - begin));
             for (size_t i = begin; i < end; i++) {
                 int px = c->pixels[i];
@@ -503,9 +512,9 @@ static int step(vw_ctx *ctx, void *state)
                 r.pad = 0;
                 spawn(ctx, c, &r);
             }
-            return 1;
+            made += end - begin;
         }
-        c->eye_done = 1;
+        if (made) return 1;
     }
     /* Called after every delivery too: a partial package leaves here, so no
        contribution waits in a cell when the world goes quiet. Sending counts as work:

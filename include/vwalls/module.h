@@ -94,10 +94,12 @@ VW_API int vw_ctx_replica(const vw_ctx *ctx);
 VW_API int vw_ctx_replicas(const vw_ctx *ctx);
 /* Farming a cell's own work (what step() creates) among its copies: the work is cut
    into batches numbered 0, 1, 2, ... and each call returns the number of the next
-   batch this copy is to make. Within one run every number goes to exactly one copy of
-   the cell: on demand among the copies of one process (a fast worker takes more), in
-   turn among processes. Counting restarts at every run; a cell without copies gets
-   0, 1, 2, ... Call it from step() until the number is past the cell's last batch. */
+   batch this copy is to make. Within one run every number goes to exactly one copy,
+   in turn: of k copies, copy r (the master is 0) gets r, r + k, r + 2k, ... so each
+   makes an equal share, as the balancer plans, on any process and with no message.
+   Counting restarts at every run; a cell without copies gets 0, 1, 2, ... Call it
+   from step() until the number is past the cell's last batch; small batches spread
+   the work evenly when its cost varies along the batch numbers. */
 VW_API uint64_t vw_ctx_next_batch(vw_ctx *ctx);
 
 /* Sending. A message is copied when sent; the caller keeps its buffer.
@@ -118,8 +120,9 @@ VW_API int vw_send_neighbours(vw_ctx *ctx, int kind, const void *msg);
 VW_API void vw_send_output(vw_ctx *ctx, int kind, const void *msg);
 
 /* Inline hand-off, "a message of kind `kind` delivered by a function call": when this
-   worker hosts `cell` (or, if the cell is duplicated and the kind independent, hosts a
-   copy of it), switches ctx to it and returns its state; otherwise NULL, and the caller
+   worker hosts `cell` (or, if the kind is independent and every worker of the process
+   holds a copy of the cell, when farming, its own copy), switches ctx to it and
+   returns its state; otherwise NULL, and the caller
    sends the message instead. The caller then does for that cell exactly what the
    message's handler would do (vw_count, sends, and time are charged to it), and must go
    back with vw_ctx_restore(ctx, cell, replica) using the values vw_ctx_cell() and

@@ -296,8 +296,8 @@ uint64_t vw_ctx_next_batch(vw_ctx *ctx)
 {
     if (ctx->cell < 0) return 0;
     vw__cell *c = &ctx->w->cells[ctx->cell];
-    uint64_t k = atomic_fetch_add_explicit(&c->batches_taken, 1, memory_order_relaxed);
-    return (uint64_t)c->batch_slot + (uint64_t)c->batch_procs * k;
+    uint64_t *n = ctx->rep ? &c->reps[ctx->rep - 1].batches : &c->batches;
+    return (uint64_t)ctx->rep + (uint64_t)(c->nreps + 1) * (*n)++;
 }
 
 void *vw_ctx_enter(vw_ctx *ctx, int cell, int kind)
@@ -312,9 +312,11 @@ void *vw_ctx_enter(vw_ctx *ctx, int cell, int kind)
     vw__cell *c = &w->cells[cell];
     int rep = 0;
     if (c->nreps) {
-        /* A duplicated cell: any copy may take an independent message, so this worker's
-           own copy takes it (farming keeps a ray on the worker it started on). */
-        if (!(w->m->kinds[kind].flags & VW_MSG_INDEPENDENT)) return NULL;
+        /* A duplicated cell: any copy may take an independent message. When every
+           worker of this process holds one (farming), this worker's own copy takes it,
+           and a ray stays on the worker it started on; otherwise the copies share what
+           is sent to the cell in turn, the equal shares the balancer planned. */
+        if (!c->farmed || !(w->m->kinds[kind].flags & VW_MSG_INDEPENDENT)) return NULL;
         rep = vw__cell_rep_of(w, cell, wk->global);
         if (rep < 0) return NULL;
     } else if (w->cell_worker[cell] != wk->global) {
@@ -626,22 +628,17 @@ vw_status vw__runtime_run(vw_world *w)
     /* With a transport, its thread (this one) is counted too: see the top of the file. */
     atomic_store(&w->active, w->nworkers + (w->transport ? 1 : 0));
     for (int i = 0; i < w->nworkers; i++) w->workers[i].busy = 1;
-    /* Farming (vw_ctx_next_batch): the processes hosting a copy of each cell take its
-       batches in turn, ordered by rank; every run counts them afresh. */
+    /* Every run numbers the cells' batches afresh (vw_ctx_next_batch), and notes the
+       cells every worker of this process holds a copy of (vw_ctx_enter). */
     for (int cl = 0; cl < w->ncells; cl++) {
         vw__cell *c = &w->cells[cl];
-        int procs = 0, slot = 0;
-        for (int p = 0; p < w->nprocs; p++) {
-            int hosts = vw__worker_process(w, c->worker) == p;
-            for (int r = 0; r < c->nreps && !hosts; r++)
-                hosts = vw__worker_process(w, c->reps[r].worker) == p;
-            if (!hosts) continue;
-            if (p == w->rank) slot = procs;
-            procs++;
+        c->batches = 0;
+        int local = vw__worker_process(w, c->worker) == w->rank;
+        for (int r = 0; r < c->nreps; r++) {
+            c->reps[r].batches = 0;
+            local += vw__worker_process(w, c->reps[r].worker) == w->rank;
         }
-        c->batch_slot = slot;
-        c->batch_procs = procs > 0 ? procs : 1;
-        atomic_store_explicit(&c->batches_taken, 0, memory_order_relaxed);
+        c->farmed = c->nreps > 0 && local == w->nworkers;
     }
     /* Posted messages: counted like any packet. */
     while (w->posted) {

@@ -59,6 +59,7 @@ typedef struct vw__replica {
     double busy_s;
     int64_t *counters;       /* module counters, ncounters */
     double load;             /* load() of the hosting process at the last run's end */
+    uint64_t batches;        /* vw_ctx_next_batch calls in this run */
 } vw__replica;
 
 typedef struct vw__cell {
@@ -72,13 +73,10 @@ typedef struct vw__cell {
     int64_t *counters;       /* module counters, ncounters */
     double load;             /* load() of the hosting process at the last run's end */
     unsigned version;        /* bumped whenever the cell's objects change (copies rebuild) */
+    uint64_t batches;        /* vw_ctx_next_batch calls of the master in this run */
+    int farmed;              /* every worker of this process holds a copy (set per run) */
     vw__replica *reps;       /* copies besides the master, nreps of them */
     int nreps;
-    /* Farming the cell's own work among its copies (vw_ctx_next_batch): this process's
-       place among the processes that host a copy (the master counts), how many do,
-       and the batches its copies have taken in this run (reset by every run). */
-    int batch_slot, batch_procs;
-    _Alignas(VW__LINE) atomic_ullong batches_taken; /* a line of its own: shared by copies */
     unsigned *rr;            /* duplicated cells: per local worker, the next copy to send to
                                 (one counter per sender and cell, so each cell's copies get
                                 equal shares whatever else the sender sends), at

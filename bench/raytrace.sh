@@ -5,7 +5,10 @@
 #  (b) vwalls on 1 cell vs a raw rtcIntersect1/rtcOccluded1 loop over the same ray tree
 #      (bench/embree_raw.c): the framework's overhead over Embree's kernel;
 #  (c) 2x2x2 cells vs 1 cell on 1 worker, and 2 workers vs 1: whole processes, then
-#      the compute phase alone (from the stats) and the two workers' busy time.
+#      the compute phase alone (from the stats) and the two workers' busy time. Two
+#      workers run the cells mapped onto them (--farm none: rays cross between workers
+#      as messages) and farmed (--farm all: each worker holds a copy of every cell);
+#      1 cell on 2 workers is farmed by default (--farm idle).
 # Whole processes are timed with date +%s.%N (best of REPEAT runs).
 # usage: bench/raytrace.sh [BUILD_DIR] [SIZE] [REPEAT]     (e.g. bench/raytrace.sh build 512 3)
 set -euo pipefail
@@ -56,12 +59,14 @@ echo
 vw1=$(timeit render --cells 1 --workers 1)
 pov1=$(timeit pov 1)
 vw2=$(timeit render --cells 1 --workers 2)
-vw2c=$(timeit render --cells 2x2x2 --workers 2)
+vw2c=$(timeit render --cells 2x2x2 --workers 2 --farm none)
+vw2f=$(timeit render --cells 2x2x2 --workers 2 --farm all)
 pov2=$(timeit pov 2)
 echo "(a) vs POV-Ray 3.7 (whole process: parse + build + render + write)"
 printf "    1 thread : vwalls %6.3f s   povray %6.3f s   povray/vwalls = %s\n" "$vw1" "$pov1" "$(ratio "$pov1" "$vw1")"
 printf "    2 threads: vwalls %6.3f s   povray %6.3f s   povray/vwalls = %s  (vwalls 1 cell)\n" "$vw2" "$pov2" "$(ratio "$pov2" "$vw2")"
 printf "               vwalls %6.3f s (2x2x2 cells)          povray/vwalls = %s\n" "$vw2c" "$(ratio "$pov2" "$vw2c")"
+printf "               vwalls %6.3f s (2x2x2, farm all)      povray/vwalls = %s\n" "$vw2f" "$(ratio "$pov2" "$vw2f")"
 echo
 
 # (b) vs raw Embree: rays/s from vwalls' own compute phase and from the raw loop
@@ -86,26 +91,34 @@ w2=$vw2
 echo "(c) cells and workers (whole process)"
 printf "    1 worker : 1 cell %6.3f s, 2x2x2 %6.3f s   2x2x2/1cell time = %s\n" "$c1" "$c8" "$(ratio "$c8" "$c1")"
 printf "    1 cell   : 1 worker %6.3f s, 2 workers %6.3f s   speedup = %s\n" "$c1" "$w2" "$(ratio "$c1" "$w2")"
-printf "    2x2x2    : 1 worker %6.3f s, 2 workers %6.3f s   speedup = %s\n" "$c8" "$vw2c" "$(ratio "$c8" "$vw2c")"
+printf "    2x2x2    : 1 worker %6.3f s, 2 workers %6.3f s   speedup = %s  (farm none)\n" "$c8" "$vw2c" "$(ratio "$c8" "$vw2c")"
+printf "    2x2x2    : 1 worker %6.3f s, 2 workers %6.3f s   speedup = %s  (farm all)\n" "$c8" "$vw2f" "$(ratio "$c8" "$vw2f")"
 # The compute phase alone (no parse, build or PNG): best of REPEAT runs each, from
 # the stats; and where the time of 2x2x2 on 2 workers goes.
-for cfg in "1 1" "2x2x2 1" "2x2x2 2"; do
-  set -- $cfg
-  for i in $(seq "$REPEAT"); do render --cells "$1" --workers "$2" --stats "$T/c-$1-$2-$i.json"; done
+# Interleaved, so that a drift of the machine's speed hits every configuration alike.
+for i in $(seq "$REPEAT"); do
+  for cfg in "1 1 idle" "1 2 idle" "2x2x2 1 none" "2x2x2 2 none" "2x2x2 2 all"; do
+    set -- $cfg
+    render --cells "$1" --workers "$2" --farm "$3" --stats "$T/c-$1-$2-$3-$i.json"
+  done
 done
 python3 - "$T" "$REPEAT" <<'EOF'
 import json, sys
 t, n = sys.argv[1], int(sys.argv[2])
-def runs(c, w): return [json.load(open("%s/c-%s-%s-%d.json" % (t, c, w, i))) for i in range(1, n + 1)]
-def best(c, w): return min(j["time_s"]["compute"] for j in runs(c, w))
-one, c8, c8w2 = best("1", 1), best("2x2x2", 1), best("2x2x2", 2)
-print("    compute phase only: 1 cell %.3f s, 2x2x2 %.3f s (x%.2f), 2x2x2 on 2 workers %.3f s"
-      " (speedup %.2f)" % (one, c8, c8 / one, c8w2, c8 / c8w2))
-j = runs("2x2x2", 2)[-1]
-b1 = sum(w["busy_s"] for w in runs("2x2x2", 1)[-1]["workers"])
-b2 = sum(w["busy_s"] for w in j["workers"])
-print("    2x2x2 on 2 workers: imbalance lambda %.3f, worker busy %s s (sum %.2fx one"
-      " worker's), messages %d (%.1f MB)" % (
-    j["balance"]["imbalance"], ", ".join("%.3f" % w["busy_s"] for w in j["workers"]), b2 / b1,
-    j["messages"]["count"], j["messages"]["bytes"] / 1e6))
+def runs(c, w, f): return [json.load(open("%s/c-%s-%s-%s-%d.json" % (t, c, w, f, i))) for i in range(1, n + 1)]
+def best(c, w, f): return min(j["time_s"]["compute"] for j in runs(c, w, f))
+one, one2 = best("1", 1, "idle"), best("1", 2, "idle")
+c8, c8w2, c8f = best("2x2x2", 1, "none"), best("2x2x2", 2, "none"), best("2x2x2", 2, "all")
+print("    compute phase only (best of %d, interleaved):" % n)
+print("      1 cell : 1 worker %.3f s, 2 workers %.3f s (speedup %.2f, farm idle)" % (one, one2, one / one2))
+print("      2x2x2  : 1 worker %.3f s (x%.2f of 1 cell), 2 workers %.3f s (speedup %.2f, farm none),"
+      " %.3f s (speedup %.2f, farm all)" % (c8, c8 / one, c8w2, c8 / c8w2, c8f, c8 / c8f))
+b1 = sum(w["busy_s"] for w in runs("2x2x2", 1, "none")[-1]["workers"])
+for f in ("none", "all"):
+    j = runs("2x2x2", 2, f)[-1]
+    b2 = sum(w["busy_s"] for w in j["workers"])
+    print("    2x2x2 on 2 workers, farm %s: imbalance lambda %.3f, worker busy %s s (sum %.2fx one"
+          " worker's), messages %d (%.1f MB)" % (f,
+        j["balance"]["imbalance"], ", ".join("%.3f" % w["busy_s"] for w in j["workers"]), b2 / b1,
+        j["messages"]["count"], j["messages"]["bytes"] / 1e6))
 EOF

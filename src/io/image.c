@@ -69,6 +69,12 @@ static int encode_png(FILE *f, int w, int h, const uint8_t *rgb8, png_ctx *ctx)
     png_init_io(png, f);
     png_set_IHDR(png, info, (png_uint_32)w, (png_uint_32)h, 8, PNG_COLOR_TYPE_RGB,
                  PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
+    /* zlib level 3 with the Sub filter on every row: a third of the instructions of
+       the defaults (level 6, adaptive filter choice) for rendered images, at about
+       the same size (sphereflake 512x512: 58 M against 169 M instructions, 255 KB
+       against 257 KB). Writing the image is a serial phase of every render. */
+    png_set_compression_level(png, 3);
+    png_set_filter(png, 0, PNG_FILTER_SUB);
     png_write_info(png, info);
     for (int y = 0; y < h; y++)
         png_write_row(png, rgb8 + (size_t)y * (size_t)w * 3);

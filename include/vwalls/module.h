@@ -73,7 +73,9 @@ typedef struct vw_module {
     void (*cell_free)(void *state, void *user);
     /* Optional: local work that needs no message (generate primary rays, shoot a patch).
        Return nonzero when it did some work; it is called again until it returns 0, and
-       again after the cell receives messages. */
+       again after the cell receives messages. A worker goes idle only after a pass in
+       which step() of every cell (and copy) it hosts returned 0, so a cell may keep
+       tallies or partial buffers between calls and hand them over here. */
     int (*step)(vw_ctx *ctx, void *state);
     /* Optional load estimate of a cell; otherwise measured busy time is used. */
     double (*load)(vw_ctx *ctx, void *state);

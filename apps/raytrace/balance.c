@@ -71,21 +71,26 @@ vw_status rt_job_farm(rt_job *j, rt_farm f, int *copies, char *err, size_t errle
     int nc = vw_decomp_cell_count(vw_world_decomp(w));
     int W = vw_world_workers(w), gw = W * vw_world_processes(w);
     if (copies) *copies = 0;
-    if (f == RT_FARM_NONE || W < 2) return VW_OK;
-    /* Which workers host something (a master or a copy) now. */
-    unsigned char *hosts = calloc((size_t)gw, 1);
+    if (f == RT_FARM_NONE || gw < 2) return VW_OK;
+    /* Which workers and processes host something (a master or a copy) now. */
+    int np = vw_world_processes(w);
+    unsigned char *hosts = calloc((size_t)gw, 1), *proc_hosts = calloc((size_t)np, 1);
     int *on = malloc(sizeof(int) * (size_t)gw), *have = malloc(sizeof(int) * (size_t)gw);
-    vw_status st = hosts && on && have ? VW_OK : VW_E_NOMEM;
+    vw_status st = hosts && proc_hosts && on && have ? VW_OK : VW_E_NOMEM;
     for (int c = 0; st == VW_OK && c < nc; c++) {
         hosts[vw_world_cell_worker(w, c)] = 1;
         int n = vw_world_replicas(w, c, have, gw);
         for (int i = 0; i < n; i++) hosts[have[i]] = 1;
     }
+    for (int g = 0; st == VW_OK && g < gw; g++) proc_hosts[g / W] |= hosts[g];
     for (int c = 0; st == VW_OK && c < nc; c++) {
-        int m = vw_world_cell_worker(w, c), p0 = m / W * W;
+        int m = vw_world_cell_worker(w, c);
         int n = vw_world_replicas(w, c, on, gw), before = n;
-        for (int g = p0; g < p0 + W; g++) {
-            if (g == m || (f == RT_FARM_IDLE && hosts[g])) continue;
+        for (int g = 0; g < gw; g++) {
+            /* A worker farms its own process's cells; a process that hosts none (more
+               processes than cells) farms them all. */
+            if (g == m || (g / W != m / W && proc_hosts[g / W])) continue;
+            if (f == RT_FARM_IDLE && hosts[g]) continue;
             int dup = 0;
             for (int i = 0; i < n; i++) dup |= on[i] == g;
             if (!dup) on[n++] = g;
@@ -94,7 +99,7 @@ vw_status rt_job_farm(rt_job *j, rt_farm f, int *copies, char *err, size_t errle
         if (copies) *copies += n - before;
     }
     if (st != VW_OK) snprintf(err, errlen, "farming the cells: %s", vw_status_message(st));
-    free(hosts), free(on), free(have);
+    free(hosts), free(proc_hosts), free(on), free(have);
     return st;
 }
 

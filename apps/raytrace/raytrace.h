@@ -222,6 +222,7 @@ typedef enum rt_farm {
     RT_FARM_IDLE = 0, /* only workers that host no cell get copies (of all their
                          process's cells): --cells 1 on 2 workers uses both */
     RT_FARM_ALL,      /* every worker hosts every cell of its process */
+                      /* (a process that hosts no cell at all farms every cell) */
     RT_FARM_NONE      /* no copies besides those a balancer made */
 } rt_farm;
 /* Parses "idle" | "all" | "none"; -1 if none of them. */

@@ -9,7 +9,8 @@
 #      workers run the cells mapped onto them (--farm none: rays cross between workers
 #      as messages) and farmed (--farm all: each worker holds a copy of every cell);
 #      1 cell on 2 workers is farmed by default (--farm idle).
-# Whole processes are timed with date +%s.%N (best of REPEAT runs).
+# Whole processes are timed with date +%s.%N: best of REPEAT runs, the configurations
+# interleaved (one run of each per round: the shared machine's speed drifts).
 # usage: bench/raytrace.sh [BUILD_DIR] [SIZE] [REPEAT]     (e.g. bench/raytrace.sh build 512 3)
 set -euo pipefail
 B=${1:-${VW_BUILD_DIR:-build}}
@@ -31,17 +32,31 @@ if "$VW" gen balls > "$T/balls.nff" 2>/dev/null; then :; else
 fi
 python3 "$HERE/nff2pov.py" "$T/balls.nff" "$SIZE" "$SIZE" 5 > "$T/balls.pov"
 
-# best-of-N wall time of a whole command, in seconds
-timeit() {
-  local best=""
+# Wall time of one whole command, in seconds.
+once() {
+  local s e
+  s=$(date +%s.%N)
+  "$@" > "$T/last.out" 2> "$T/last.err" || { cat "$T/last.err" >&2; exit 1; }
+  e=$(date +%s.%N)
+  awk -v a="$s" -v b="$e" 'BEGIN { printf "%.3f", b - a }'
+}
+# Best-of-REPEAT wall times of named commands, run interleaved (every command once per
+# round), so that a drift of the shared machine's speed hits them all alike:
+#   timeall NAME 'command args' NAME 'command args' ...   ->  BEST[NAME]
+declare -A BEST
+timeall() {
+  local -a names=() cmds=()
+  while [ $# -gt 0 ]; do names+=("$1"); cmds+=("$2"); shift 2; done
   for _ in $(seq "$REPEAT"); do
-    local s e
-    s=$(date +%s.%N)
-    "$@" > "$T/last.out" 2> "$T/last.err" || { cat "$T/last.err" >&2; exit 1; }
-    e=$(date +%s.%N)
-    best=$(awk -v a="$s" -v b="$e" -v best="$best" 'BEGIN { d = b - a; if (best == "" || d < best) best = d; printf "%.3f", best }')
+    for k in "${!names[@]}"; do
+      local t
+      t=$(once ${cmds[$k]})
+      local n=${names[$k]}
+      if [ -z "${BEST[$n]:-}" ] || awk -v a="$t" -v b="${BEST[$n]}" 'BEGIN { exit !(a < b) }'; then
+        BEST[$n]=$t
+      fi
+    done
   done
-  echo "$best"
 }
 ratio() { awk -v a="$1" -v b="$2" 'BEGIN { printf "%.2f", a / b }'; }
 
@@ -55,13 +70,13 @@ echo "ray tracer benchmark: sphereflake (balls), ${SIZE}x${SIZE}, depth 5, best 
 echo "machine: $(nproc) cores; $(uname -sr)"
 echo
 
-# (a) vs POV-Ray
-vw1=$(timeit render --cells 1 --workers 1)
-pov1=$(timeit pov 1)
-vw2=$(timeit render --cells 1 --workers 2)
-vw2c=$(timeit render --cells 2x2x2 --workers 2 --farm none)
-vw2f=$(timeit render --cells 2x2x2 --workers 2 --farm all)
-pov2=$(timeit pov 2)
+# (a) and (c): every whole-process configuration, interleaved
+timeall vw1 'render --cells 1 --workers 1' pov1 'pov 1' \
+        vw2 'render --cells 1 --workers 2' vw2c 'render --cells 2x2x2 --workers 2 --farm none' \
+        vw2f 'render --cells 2x2x2 --workers 2 --farm all' pov2 'pov 2' \
+        c8 'render --cells 2x2x2 --workers 1'
+vw1=${BEST[vw1]} pov1=${BEST[pov1]} vw2=${BEST[vw2]} vw2c=${BEST[vw2c]} vw2f=${BEST[vw2f]}
+pov2=${BEST[pov2]} c8=${BEST[c8]}
 echo "(a) vs POV-Ray 3.7 (whole process: parse + build + render + write)"
 printf "    1 thread : vwalls %6.3f s   povray %6.3f s   povray/vwalls = %s\n" "$vw1" "$pov1" "$(ratio "$pov1" "$vw1")"
 printf "    2 threads: vwalls %6.3f s   povray %6.3f s   povray/vwalls = %s  (vwalls 1 cell)\n" "$vw2" "$pov2" "$(ratio "$pov2" "$vw2")"
@@ -69,13 +84,21 @@ printf "               vwalls %6.3f s (2x2x2 cells)          povray/vwalls = %s\
 printf "               vwalls %6.3f s (2x2x2, farm all)      povray/vwalls = %s\n" "$vw2f" "$(ratio "$pov2" "$vw2f")"
 echo
 
-# (b) vs raw Embree: rays/s from vwalls' own compute phase and from the raw loop
-render --cells 1 --workers 1 --stats "$T/s1.json"
-vw_rays=$(python3 -c "import json,sys; j=json.load(open('$T/s1.json')); r=j['rays']; print(r['eye']+r['reflect']+r['refract']+r['shadow'], j['time_s']['compute'])")
-raw_out=$("$RAW" "$T/balls.nff" "${SIZE}x${SIZE}" 5)
-raw_rays=$(echo "$raw_out" | sed -n 's/.*rays \([0-9]*\),.*/\1/p')
-raw_time=$(echo "$raw_out" | sed -n 's/.*trace \([0-9.]*\) s.*/\1/p')
-set -- $vw_rays
+# (b) vs raw Embree: rays/s of vwalls' own compute phase and of the raw loop, best of
+# REPEAT each, interleaved
+vw_best="" raw_best=""
+for i in $(seq "$REPEAT"); do
+  render --cells 1 --workers 1 --stats "$T/s1.json"
+  vw_rays=$(python3 -c "import json,sys; j=json.load(open('$T/s1.json')); r=j['rays']; print(r['eye']+r['reflect']+r['refract']+r['shadow'], j['time_s']['compute'])")
+  raw_out=$("$RAW" "$T/balls.nff" "${SIZE}x${SIZE}" 5)
+  raw_rays=$(echo "$raw_out" | sed -n 's/.*rays \([0-9]*\),.*/\1/p')
+  raw_time=$(echo "$raw_out" | sed -n 's/.*trace \([0-9.]*\) s.*/\1/p')
+  set -- $vw_rays
+  if [ -z "$vw_best" ] || awk -v a="$2" -v b="$vw_best" 'BEGIN { exit !(a < b) }'; then vw_best=$2; fi
+  if [ -z "$raw_best" ] || awk -v a="$raw_time" -v b="$raw_best" 'BEGIN { exit !(a < b) }'; then raw_best=$raw_time; fi
+done
+set -- "$1" "$vw_best"
+raw_time=$raw_best
 vw_rate=$(awk -v n="$1" -v t="$2" 'BEGIN { printf "%.3f", n / t * 1e-6 }')
 raw_rate=$(awk -v n="$raw_rays" -v t="$raw_time" 'BEGIN { printf "%.3f", n / t * 1e-6 }')
 echo "(b) vs raw Embree, 1 thread (compute phase only)"
@@ -86,7 +109,6 @@ echo
 
 # (c) cells and workers
 c1=$vw1
-c8=$(timeit render --cells 2x2x2 --workers 1)
 w2=$vw2
 echo "(c) cells and workers (whole process)"
 printf "    1 worker : 1 cell %6.3f s, 2x2x2 %6.3f s   2x2x2/1cell time = %s\n" "$c1" "$c8" "$(ratio "$c8" "$c1")"

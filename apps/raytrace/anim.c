@@ -247,6 +247,9 @@ vw_status rt_anim_render(rt_anim *a, rt_anim_stats *rs, char *err, size_t errlen
     }
     st = rt_job_reset(a->job); /* cells keep their state; run() restarts eye rays */
     double t0 = now();
+    /* Workers without a cell (fewer cells than workers) farm the cells; copies follow
+       the objects' edits (they rebuild with their cell) and go with a new layout. */
+    if (st == VW_OK) st = rt_job_farm(a->job, RT_FARM_IDLE, NULL, err, errlen);
     if (st == VW_OK) st = rt_job_commit(a->job, err, errlen);
     double t1 = now();
     if (st == VW_OK) st = rt_job_run(a->job, err, errlen);

@@ -25,6 +25,11 @@ grep -q '"animation"' s.json || fail "no animation member in the stats"
 grep -q '"command": "animate"' s.json || fail "stats command"
 grep -q "accepted" out.txt || fail "no summary"
 [ "$(wc -l < log.txt)" -eq 2 ] || fail "log should list both edits"
+# One cell on two workers: the idle worker farms it (a copy, rebuilt with the cell
+# after the edits); the frames are the same bytes.
+"$V" animate scene.nff ok.txt -o 'g%02d.png' --cells 1 --workers 2 > gout.txt \
+  || fail "animate --cells 1 status $?"
+cmp -s f00.png g00.png && cmp -s f01.png g01.png || fail "frames differ with one cell farmed"
 
 printf 'frame\nmove 999999 1 0 0\nfrobnicate 3\nmove 1 nan 0 0\nmoveto 2 1e9 0 0\nframe\n' > bad.txt
 "$V" animate scene.nff bad.txt -o 'b%02d.png' --workers 2 > bout.txt 2> berr.txt

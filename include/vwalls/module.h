@@ -123,14 +123,13 @@ VW_API void vw_send_output(vw_ctx *ctx, int kind, const void *msg);
 
 /* Inline hand-off, "a message of kind `kind` delivered by a function call": when this
    worker hosts `cell` (or, if the kind is independent and every worker of the process
-   holds a copy of the cell, when farming, its own copy), switches ctx to it and
-   returns its state; otherwise NULL, and the caller
-   sends the message instead. The caller then does for that cell exactly what the
-   message's handler would do (vw_count, sends, and time are charged to it), and must go
-   back with vw_ctx_restore(ctx, cell, replica) using the values vw_ctx_cell() and
-   vw_ctx_replica() had before, before it returns or uses the first cell's state again.
-   Messages are the model; this only skips the packet for the common case of a
-   neighbour on the same worker (a ray crossing a wall). */
+   holds a copy of the cell, when farming, its own copy), switches ctx to it and returns
+   its state; otherwise NULL, and the caller sends the message instead. The caller then
+   does for that cell exactly what the message's handler would do (vw_count, sends, and
+   time are charged to it), and must go back with vw_ctx_restore(ctx, cell, replica)
+   using the values vw_ctx_cell() and vw_ctx_replica() had before, before it returns or
+   uses the first cell's state again. Messages are the model; this only skips the packet
+   for the common case of a neighbour on the same worker (a ray crossing a wall). */
 VW_API void *vw_ctx_enter(vw_ctx *ctx, int cell, int kind);
 VW_API void vw_ctx_restore(vw_ctx *ctx, int cell, int replica);
 

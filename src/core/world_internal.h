@@ -55,32 +55,37 @@ typedef struct vw__replica {
     void *state;
     int built;
     unsigned built_version;  /* the cell's version it was built from */
-    uint64_t messages_in;
-    double busy_s;
     int64_t *counters;       /* module counters, ncounters */
     double load;             /* load() of the hosting process at the last run's end */
+    /* Written by the hosting worker per message; other workers read `worker` above
+       (vw__cell_rep_of), so these get a line of their own. */
+    _Alignas(VW__LINE) uint64_t messages_in;
+    double busy_s;
     uint64_t batches;        /* vw_ctx_next_batch calls in this run */
 } vw__replica;
 
 typedef struct vw__cell {
+    /* Read by every worker that sends to or enters the cell: */
     _Alignas(VW__LINE) int worker; /* global worker id */
-    void *state;             /* the module's cell state */
-    int built, dirty;
-    size_t *objs;            /* ids of the objects overlapping the cell */
-    size_t nobjs, capobjs;
-    uint64_t messages_in;
-    double busy_s;
-    int64_t *counters;       /* module counters, ncounters */
-    double load;             /* load() of the hosting process at the last run's end */
-    unsigned version;        /* bumped whenever the cell's objects change (copies rebuild) */
-    uint64_t batches;        /* vw_ctx_next_batch calls of the master in this run */
-    int farmed;              /* every worker of this process holds a copy (set per run) */
-    vw__replica *reps;       /* copies besides the master, nreps of them */
     int nreps;
+    vw__replica *reps;       /* copies besides the master, nreps of them */
+    int farmed;              /* every worker of this process holds a copy (set per run) */
     unsigned *rr;            /* duplicated cells: per local worker, the next copy to send to
                                 (one counter per sender and cell, so each cell's copies get
                                 equal shares whatever else the sender sends), at
                                 rr[local * VW__RR_STRIDE]: a cache line per sender */
+    void *state;             /* the module's cell state */
+    int built, dirty;
+    size_t *objs;            /* ids of the objects overlapping the cell */
+    size_t nobjs, capobjs;
+    int64_t *counters;       /* module counters, ncounters */
+    double load;             /* load() of the hosting process at the last run's end */
+    unsigned version;        /* bumped whenever the cell's objects change (copies rebuild) */
+    /* Written by the hosting worker per message or hand-off: a line of their own, or
+       every other worker's reads of the fields above would bounce it between cores. */
+    _Alignas(VW__LINE) uint64_t messages_in;
+    double busy_s;
+    uint64_t batches;        /* vw_ctx_next_batch calls of the master in this run */
 } vw__cell;
 
 /* Stride of vw__cell.rr: one cache line per sending worker. */

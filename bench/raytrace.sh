@@ -8,7 +8,8 @@
 #      the compute phase alone (from the stats) and the two workers' busy time. Two
 #      workers run the cells mapped onto them (--farm none: rays cross between workers
 #      as messages) and farmed (--farm all: each worker holds a copy of every cell);
-#      1 cell on 2 workers is farmed by default (--farm idle).
+#      1 cell on 2 workers is farmed by default (--farm idle);
+#  (d) 2x2x2 against 1 cell by instruction count (callgrind): free of the noise.
 # Whole processes are timed with date +%s.%N: best of REPEAT runs, the configurations
 # interleaved (one run of each per round: the shared machine's speed drifts).
 # usage: bench/raytrace.sh [BUILD_DIR] [SIZE] [REPEAT]     (e.g. bench/raytrace.sh build 512 3)
@@ -144,3 +145,18 @@ for f in ("none", "all"):
         j["balance"]["imbalance"], ", ".join("%.3f" % w["busy_s"] for w in j["workers"]), b2 / b1,
         j["messages"]["count"], j["messages"]["bytes"] / 1e6))
 EOF
+
+# (d) The decomposition overhead without the machine's noise: instructions executed by
+# the whole process (valgrind's callgrind, one worker, 256x256: the ratio hardly depends
+# on the size), 2x2x2 cells against 1 cell. Skipped when valgrind is not installed.
+if command -v valgrind > /dev/null 2>&1; then
+  instr() {
+    valgrind --tool=callgrind --callgrind-out-file="$T/cg.out" "$VW" render "$T/balls.nff" \
+      -o "$T/cg.png" --size 256x256 --depth 5 --quiet --workers 1 --cells "$1" 2>&1 |
+      sed -n 's/.*Collected : \([0-9]*\).*/\1/p'
+  }
+  i1=$(instr 1)
+  i8=$(instr 2x2x2)
+  echo "(d) instructions (callgrind, 1 worker, 256x256, whole process)"
+  printf "    1 cell %s, 2x2x2 %s: 2x2x2/1cell = %s\n" "$i1" "$i8" "$(awk -v a="$i8" -v b="$i1" 'BEGIN { printf "%.3f", a / b }')"
+fi

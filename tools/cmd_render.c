@@ -55,7 +55,9 @@ static void help(void)
            "  --map K          block (default) | greedy (by load) | weighted (by --speeds)\n"
            "  --speeds LIST    relative speed of every worker, like 1,1,2,4\n"
            "  --slow W:K[,..]  worker W does its work K times slower (emulates a slow machine)\n"
-           "  --overlay-by B   load (default) or worker: what tints the overlay's cells\n"
+           "  --overlay-by B   load (default): each cell by its measured load; worker: each\n"
+           "                   pixel by the worker that made its eye ray (farmed cells show\n"
+           "                   their copies' turns)\n"
            "  --quiet          no progress bar and no summary\n"
            "Runs under mpirun too; only the first process writes files.\n");
 }

@@ -404,11 +404,22 @@ void rt_job_overlay_workers(const rt_job *j, uint8_t *out)
     const rt_view *v = &j->sh.view;
     int w = v->width, h = v->height;
     rt_job_rgb8(j, out);
-    if (j->owner)
+    /* The worker that made each pixel's eye ray: the cell's, or with copies the one
+       whose turn the pixel's batch was (RT_SHARE pixels of the cell's row-major list,
+       copy r of k taking batches r, r + k, ...: step() in module.c). */
+    vw_world *world = j->world;
+    int nc = vw_decomp_cell_count(vw_world_decomp(world));
+    int gw = vw_world_workers(world) * vw_world_processes(world);
+    size_t *pos = calloc((size_t)nc, sizeof *pos);
+    int *reps = malloc(sizeof(int) * (size_t)gw);
+    if (j->owner && pos && reps)
         for (size_t i = 0; i < (size_t)w * h; i++) {
             int c = j->owner[i];
             if (c < 0) continue;
-            int g = vw_world_cell_worker(j->world, c);
+            int g = vw_world_cell_worker(world, c);
+            int ncopies = 1 + vw_world_replicas(world, c, reps, gw);
+            int r = (int)(pos[c]++ / RT_SHARE % (size_t)ncopies);
+            if (r) g = reps[r - 1];
             double hh = fmod(g * 137.508, 360.0) / 60.0, f = hh - floor(hh);
             static const double ramp[6][3][2] = { /* (constant, slope) per channel */
                 {{1, 0}, {0, 1}, {0, 0}}, {{1, -1}, {1, 0}, {0, 0}}, {{0, 0}, {1, 0}, {0, 1}},
@@ -419,6 +430,8 @@ void rt_job_overlay_workers(const rt_job *j, uint8_t *out)
             for (int k = 0; k < 3; k++)
                 out[i * 3 + k] = (uint8_t)lround(0.5 * out[i * 3 + k] + 0.5 * 255.0 * rgb[k]);
         }
+    free(pos);
+    free(reps);
     draw_walls(j, out);
 }
 

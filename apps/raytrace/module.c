@@ -20,10 +20,6 @@ enum { RT_EYE = 0, RT_REFLECT = 1, RT_REFRACT = 2, RT_SHADOW = 3 };
 
 /* Eye rays generated per step() call: bounds the messages one call can create. */
 #define RT_BATCH 256
-/* Eye rays per farmed batch (vw_ctx_next_batch): copies of a duplicated cell take
-   every k-th run of this many pixels of the cell's row-major list, fine enough that
-   each copy's share samples the whole cell (a quarter row would make column stripes). */
-#define RT_SHARE 16
 
 typedef struct rt_ray {
     double org[3], dir[3]; /* original, for the ray's whole life; dir is unit length */

@@ -397,29 +397,46 @@ void rt_job_overlay(const rt_job *j, uint8_t *out)
     draw_walls(j, out);
 }
 
-/* Tint by hosting worker: a fixed palette of well-separated hues (golden-angle steps),
-   so the mapping (which cells share a worker) can be seen at a glance. */
-void rt_job_overlay_workers(const rt_job *j, uint8_t *out)
+int rt_job_eye_workers(const rt_job *j, int *worker)
 {
     const rt_view *v = &j->sh.view;
-    int w = v->width, h = v->height;
-    rt_job_rgb8(j, out);
-    /* The worker that made each pixel's eye ray: the cell's, or with copies the one
-       whose turn the pixel's batch was (RT_SHARE pixels of the cell's row-major list,
-       copy r of k taking batches r, r + k, ...: step() in module.c). */
+    size_t np = (size_t)v->width * (size_t)v->height;
     vw_world *world = j->world;
     int nc = vw_decomp_cell_count(vw_world_decomp(world));
     int gw = vw_world_workers(world) * vw_world_processes(world);
     size_t *pos = calloc((size_t)nc, sizeof *pos);
     int *reps = malloc(sizeof(int) * (size_t)gw);
-    if (j->owner && pos && reps)
-        for (size_t i = 0; i < (size_t)w * h; i++) {
-            int c = j->owner[i];
-            if (c < 0) continue;
-            int g = vw_world_cell_worker(world, c);
-            int ncopies = 1 + vw_world_replicas(world, c, reps, gw);
-            int r = (int)(pos[c]++ / RT_SHARE % (size_t)ncopies);
-            if (r) g = reps[r - 1];
+    int ok = j->owner && pos && reps;
+    for (size_t i = 0; i < np; i++) {
+        int c = ok ? j->owner[i] : -1;
+        if (c < 0) {
+            worker[i] = -1;
+            continue;
+        }
+        /* Copy r of k makes batches r, r + k, ... of RT_SHARE pixels of the cell's
+           row-major list (step() in module.c); r = 0 is the master. */
+        int ncopies = 1 + vw_world_replicas(world, c, reps, gw);
+        int r = (int)(pos[c]++ / RT_SHARE % (size_t)ncopies);
+        worker[i] = r ? reps[r - 1] : vw_world_cell_worker(world, c);
+    }
+    free(pos);
+    free(reps);
+    return ok;
+}
+
+/* Tint by the worker that made each pixel's eye ray: a fixed palette of well-separated
+   hues (golden-angle steps), so the mapping (which cells share a worker) and the
+   copies' turns can be seen at a glance. */
+void rt_job_overlay_workers(const rt_job *j, uint8_t *out)
+{
+    const rt_view *v = &j->sh.view;
+    size_t np = (size_t)v->width * (size_t)v->height;
+    rt_job_rgb8(j, out);
+    int *worker = malloc(np * sizeof *worker);
+    if (worker && rt_job_eye_workers(j, worker))
+        for (size_t i = 0; i < np; i++) {
+            int g = worker[i];
+            if (g < 0) continue;
             double hh = fmod(g * 137.508, 360.0) / 60.0, f = hh - floor(hh);
             static const double ramp[6][3][2] = { /* (constant, slope) per channel */
                 {{1, 0}, {0, 1}, {0, 0}}, {{1, -1}, {1, 0}, {0, 0}}, {{0, 0}, {1, 0}, {0, 1}},
@@ -430,8 +447,7 @@ void rt_job_overlay_workers(const rt_job *j, uint8_t *out)
             for (int k = 0; k < 3; k++)
                 out[i * 3 + k] = (uint8_t)lround(0.5 * out[i * 3 + k] + 0.5 * 255.0 * rgb[k]);
         }
-    free(pos);
-    free(reps);
+    free(worker);
     draw_walls(j, out);
 }
 

@@ -179,8 +179,11 @@ void rt_job_set_sample(rt_job *j, int stride);
    pixel from the world's current decomposition (after the balancer changed it), so
    the next run renders from scratch. The world's cells are rebuilt at the next commit. */
 vw_status rt_job_reset(rt_job *j);
-/* The overlay variant that tints each pixel by the worker that made its eye ray (the
-   cell's, or with copies the one whose turn the pixel's batch was). */
+/* The global worker that made each pixel's eye ray after a full render (width*height
+   entries, -1 where the ray misses the world): the cell's worker, or with copies the
+   one whose turn the pixel's batch was. 0 if it cannot tell (out of memory). */
+int rt_job_eye_workers(const rt_job *j, int *worker);
+/* The overlay variant that tints each pixel by that worker. */
 void rt_job_overlay_workers(const rt_job *j, uint8_t *out);
 /* ---- load balancing (apps/raytrace/balance.c) ---------------------------------------- */
 

@@ -67,6 +67,21 @@ static int64_t *render_farm(const vw_scene *s, int w, int h, const int dims[3], 
     size_t n = (size_t)w * h * 3;
     int64_t *sums = malloc(n * sizeof *sums);
     memcpy(sums, rt_job_sums(j), n * sizeof *sums);
+    /* The overlay's account of who made each eye ray must be what each worker made. */
+    vw_world *world = rt_job_world(j);
+    int gw = vw_world_workers(world) * vw_world_processes(world);
+    int *eye = malloc((size_t)w * h * sizeof *eye);
+    int64_t *per = calloc((size_t)gw, sizeof *per);
+    EXPECT(eye && per && rt_job_eye_workers(j, eye), "eye workers");
+    for (size_t i = 0; eye && per && i < (size_t)w * h; i++)
+        if (eye[i] >= 0 && eye[i] < gw) per[eye[i]]++;
+    for (int g = 0; per && g < gw; g++)
+        EXPECT(per[g] == vw_world_worker_counter(world, g, RT_C_PIXELS),
+               "%d workers, farm %d: worker %d made %lld eye rays, the map says %lld", workers,
+               (int)farm, g, (long long)vw_world_worker_counter(world, g, RT_C_PIXELS),
+               (long long)per[g]);
+    free(eye);
+    free(per);
     for (int k = 0; k < RT_NCOUNTERS; k++) counters[k] = vw_world_counter(rt_job_world(j), k);
     if (keep)
         *keep = j;

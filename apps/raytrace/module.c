@@ -321,7 +321,9 @@ static int walk_ray(vw_ctx *ctx, rt_cell *c, rt_ray *r)
     int me = vw_ctx_cell(ctx);
     for (;;) {
         c->tally[RT_C_SEGMENTS]++;
-        double tn = fmax(c->sh->eps, r->t0);
+        /* max(eps, t0), as fmax gives it (eps for a NaN t0), without fmax's libm call:
+           gcc keeps the call, whose NaN rules maxsd does not follow. */
+        double tn = r->t0 > c->sh->eps ? r->t0 : c->sh->eps;
         rt_hit h;
         if (r->kind == RT_SHADOW) {
             if (rt_cell_geo_occluded(&c->geo, r->org, r->dir, tn, r->t1)) {

@@ -436,9 +436,12 @@ static void ray_to_frame(const vw_decomp *d, const double o[3], const double dir
    makes that descent with the walk's own arithmetic (the same (split - o[a]) / d[a],
    the same min/max), so it returns the walk's first segment bit for bit, at a fraction
    of its cost: it runs for every wall a ray crosses. Only a NaN can make the descent
-   fail (both comparisons false); the walk itself then decides. [t0, t1] is clipped. */
-static int descend(const vw_decomp *d, const double o[3], const double dir[3],
-                   const double q[3], const double v[3], double t0, double t1, vw_segment *out)
+   fail (both comparisons false); the walk itself then decides. [t0, t1] is clipped.
+   Inlined into its two callers: the call alone was ~1% of a 2x2x2 render's
+   instructions. */
+static inline __attribute__((always_inline)) int
+descend(const vw_decomp *d, const double o[3], const double dir[3], const double q[3],
+        const double v[3], double t0, double t1, vw_segment *out)
 {
     const double t0_in = t0, t1_in = t1;
     const vw_kd_node *nodes = d->nodes, *n = &nodes[0];

@@ -50,7 +50,7 @@ static void help(void)
            "                   its cells by holding copies; idle: only workers that host no\n"
            "                   cell get copies (of all the process's cells), all: every worker\n"
            "                   gets one of every cell (rays cross only to other processes;\n"
-           "                   memory: a scene per worker); a process hosting no cell\n"
+           "                   the copies read one built scene); a process hosting no cell\n"
            "                   farms them all\n"
            "  --map K          block (default) | greedy (by load) | weighted (by --speeds)\n"
            "  --speeds LIST    relative speed of every worker, like 1,1,2,4\n"

@@ -12,6 +12,7 @@
  */
 #include <embree3/rtcore.h>
 #include <math.h>
+#include <pthread.h>
 #include <stdlib.h>
 #include <string.h>
 #include "raytrace/geometry.h"
@@ -304,4 +305,145 @@ void *rt_device_new(void)
 void rt_device_free(void *device)
 {
     if (device) rtcReleaseDevice((RTCDevice)device);
+}
+
+/* ---- built cells shared within a process ------------------------------------------- */
+
+typedef struct rt_geo_entry {
+    struct rt_geo_entry *next;
+    /* The records it is built from, compared under the lock: a copy while it is being
+       built, then geo.obj. The geometry is built in place (Embree keeps its address
+       for the cones' callbacks), outside the lock, and read only once ready. */
+    const rt_object *key;
+    size_t nkey;
+    rt_cell_geo geo;
+    int refs;
+    int state;         /* 0 building, 1 ready, -1 failed (waiters give up) */
+    vw_status status;
+} rt_geo_entry;
+
+struct rt_geo_cache {
+    pthread_mutex_t mu;
+    pthread_cond_t cv; /* an entry left the building state */
+    rt_geo_entry *head;
+};
+
+rt_geo_cache *rt_geo_cache_new(void)
+{
+    rt_geo_cache *c = calloc(1, sizeof *c);
+    if (!c) return NULL;
+    pthread_mutex_init(&c->mu, NULL);
+    pthread_cond_init(&c->cv, NULL);
+    return c;
+}
+
+void rt_geo_cache_free(rt_geo_cache *c)
+{
+    if (!c) return;
+    while (c->head) { /* only after a leak elsewhere: free what is left */
+        rt_geo_entry *e = c->head;
+        c->head = e->next;
+        rt_cell_geo_free(&e->geo);
+        free(e);
+    }
+    pthread_cond_destroy(&c->cv);
+    pthread_mutex_destroy(&c->mu);
+    free(c);
+}
+
+size_t rt_geo_cache_size(rt_geo_cache *c)
+{
+    size_t n = 0;
+    pthread_mutex_lock(&c->mu);
+    for (rt_geo_entry *e = c->head; e; e = e->next) n++;
+    pthread_mutex_unlock(&c->mu);
+    return n;
+}
+
+/* An entry with these very records (its records are set before it is listed). */
+static rt_geo_entry *find(rt_geo_cache *c, const rt_object *objects, size_t n)
+{
+    for (rt_geo_entry *e = c->head; e; e = e->next)
+        if (e->state >= 0 && e->nkey == n &&
+            (n == 0 || memcmp(e->key, objects, n * sizeof *objects) == 0))
+            return e;
+    return NULL;
+}
+
+vw_status rt_geo_acquire(rt_geo_cache *c, void *device, const rt_object *objects, size_t n,
+                         const rt_cell_geo **out)
+{
+    *out = NULL;
+    pthread_mutex_lock(&c->mu);
+    rt_geo_entry *e = find(c, objects, n);
+    if (e) {
+        e->refs++;
+        while (e->state == 0) pthread_cond_wait(&c->cv, &c->mu);
+        vw_status st = e->state > 0 ? VW_OK : e->status;
+        if (st == VW_OK) {
+            *out = &e->geo;
+        } else if (--e->refs == 0) { /* the builder failed; the last one out frees it */
+            rt_geo_entry **pp = &c->head;
+            while (*pp != e) pp = &(*pp)->next;
+            *pp = e->next;
+            rt_cell_geo_free(&e->geo);
+            free(e);
+        }
+        pthread_mutex_unlock(&c->mu);
+        return st;
+    }
+    /* Build it here, listed as building so that others asking for it wait; the records
+       are copied first, so that they can compare while the scene is built. */
+    e = calloc(1, sizeof *e);
+    rt_object *copy = e ? malloc((n ? n : 1) * sizeof *copy) : NULL;
+    if (!e || !copy) {
+        pthread_mutex_unlock(&c->mu);
+        free(e);
+        free(copy);
+        return VW_E_NOMEM;
+    }
+    if (n) memcpy(copy, objects, n * sizeof *copy);
+    e->key = copy;
+    e->nkey = n;
+    e->refs = 1;
+    e->next = c->head;
+    c->head = e;
+    pthread_mutex_unlock(&c->mu);
+
+    vw_status st = rt_cell_geo_build(device, objects, n, &e->geo);
+
+    pthread_mutex_lock(&c->mu);
+    free(copy);
+    e->key = st == VW_OK ? e->geo.obj : NULL; /* (a failed entry is never compared) */
+    e->state = st == VW_OK ? 1 : -1;
+    e->status = st;
+    pthread_cond_broadcast(&c->cv);
+    if (st == VW_OK) {
+        *out = &e->geo;
+    } else if (--e->refs == 0) {
+        rt_geo_entry **pp = &c->head;
+        while (*pp != e) pp = &(*pp)->next;
+        *pp = e->next;
+        rt_cell_geo_free(&e->geo);
+        free(e);
+    }
+    pthread_mutex_unlock(&c->mu);
+    return st;
+}
+
+void rt_geo_release(rt_geo_cache *c, const rt_cell_geo *g)
+{
+    if (!c || !g) return;
+    pthread_mutex_lock(&c->mu);
+    for (rt_geo_entry **pp = &c->head; *pp; pp = &(*pp)->next) {
+        rt_geo_entry *e = *pp;
+        if (&e->geo != g) continue;
+        if (--e->refs == 0) {
+            *pp = e->next;
+            rt_cell_geo_free(&e->geo);
+            free(e);
+        }
+        break;
+    }
+    pthread_mutex_unlock(&c->mu);
 }

@@ -22,6 +22,21 @@ typedef struct rt_hit {
 
 vw_status rt_cell_geo_build(void *device, const rt_object *objects, size_t n, rt_cell_geo *g);
 void rt_cell_geo_free(rt_cell_geo *g);
+/* Built cells shared within a process: the copies of a farmed or duplicated cell have
+   the same records, so they read one scene (Embree's queries are thread-safe) instead
+   of each worker building and keeping its own. Entries are counted references; the
+   first worker to ask for some records builds them while the others wait. */
+typedef struct rt_geo_cache rt_geo_cache;
+rt_geo_cache *rt_geo_cache_new(void);
+void rt_geo_cache_free(rt_geo_cache *c); /* every entry must have been released */
+/* The geometry of objects[0..n): a built one with the very same records, or built now.
+   Release with rt_geo_release. */
+vw_status rt_geo_acquire(rt_geo_cache *c, void *device, const rt_object *objects, size_t n,
+                         const rt_cell_geo **out);
+void rt_geo_release(rt_geo_cache *c, const rt_cell_geo *g);
+/* Distinct geometries alive (tests). */
+size_t rt_geo_cache_size(rt_geo_cache *c);
+
 /* The first hit with t in [tnear, tfar]; 0 when none. */
 int rt_cell_geo_intersect(const rt_cell_geo *g, const double org[3], const double dir[3],
                           double tnear, double tfar, rt_hit *hit);

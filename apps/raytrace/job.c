@@ -24,8 +24,9 @@ struct rt_job {
 void rt_job_free(rt_job *j)
 {
     if (!j) return;
-    vw_world_free(j->world);
+    vw_world_free(j->world); /* (releases the cells' geometry) */
     vw_decomp_free(j->decomp);
+    rt_geo_cache_free(j->sh.geo_cache);
     rt_device_free(j->sh.device);
     free(j->sh.lights);
     free(j->sh.accum);
@@ -214,7 +215,8 @@ vw_status rt_job_create(const vw_scene *s, const rt_params *p, rt_job **out, cha
         return st;
     }
     sh->device = rt_device_new();
-    if (!sh->device) {
+    sh->geo_cache = sh->device ? rt_geo_cache_new() : NULL;
+    if (!sh->device || !sh->geo_cache) {
         snprintf(err, errlen, "cannot create the Embree device");
         free(objs);
         rt_job_free(j);

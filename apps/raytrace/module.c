@@ -46,7 +46,7 @@ typedef struct rt_package {
 } rt_package;
 
 typedef struct rt_cell {
-    rt_cell_geo geo;
+    const rt_cell_geo *geo; /* shared with the cell's other copies in this process */
     rt_shared *sh;
     int *pixels;          /* primary pixels whose eye ray enters the world here */
     size_t npixels;
@@ -326,11 +326,11 @@ static int walk_ray(vw_ctx *ctx, rt_cell *c, rt_ray *r)
         double tn = r->t0 > c->sh->eps ? r->t0 : c->sh->eps;
         rt_hit h;
         if (r->kind == RT_SHADOW) {
-            if (rt_cell_geo_occluded(&c->geo, r->org, r->dir, tn, r->t1)) {
+            if (rt_cell_geo_occluded(c->geo, r->org, r->dir, tn, r->t1)) {
                 c->tally[RT_C_ENDED]++;
                 return entered;
             }
-        } else if (rt_cell_geo_intersect(&c->geo, r->org, r->dir, tn, r->t1, &h)) {
+        } else if (rt_cell_geo_intersect(c->geo, r->org, r->dir, tn, r->t1, &h)) {
             c->tally[RT_C_ENDED]++;
             shade(ctx, c, r, &h);
             return entered;
@@ -455,7 +455,7 @@ static void cell_free(void *state, void *user)
     (void)user;
     rt_cell *c = state;
     if (!c) return;
-    rt_cell_geo_free(&c->geo);
+    rt_geo_release(c->sh->geo_cache, c->geo);
     free(c->pixels);
     free(c);
 }
@@ -469,7 +469,7 @@ static vw_status cell_build(vw_ctx *ctx, const void *objects, size_t n, void **s
     if (!c) return VW_E_NOMEM;
     memset(c, 0, bytes);
     c->sh = vw_ctx_user(ctx);
-    vw_status st = rt_cell_geo_build(c->sh->device, objects, n, &c->geo);
+    vw_status st = rt_geo_acquire(c->sh->geo_cache, c->sh->device, objects, n, &c->geo);
     if (st == VW_OK) st = primary_pixels(ctx, c);
     if (st != VW_OK) {
         cell_free(c, NULL);

@@ -94,6 +94,8 @@ typedef struct rt_shared {
     double eps;      /* minimum t of a secondary ray: avoids self-intersection */
     double bpad;     /* objects' bounds are widened by this before placement */
     void *device;    /* RTCDevice, one per process, shared by every cell */
+    struct rt_geo_cache *geo_cache; /* the built cells of this process, shared by the
+                                       copies of a cell (geometry.h) */
     int sample;      /* primary pixels: every sample-th row and column only (the load
                         balancer's cheap pre-pass); 0 or 1 = every pixel */
     /* The cell of each pixel's eye ray (-1: misses the world) on decomposition

@@ -67,8 +67,14 @@ static int64_t *render_farm(const vw_scene *s, int w, int h, const int dims[3], 
     size_t n = (size_t)w * h * 3;
     int64_t *sums = malloc(n * sizeof *sums);
     memcpy(sums, rt_job_sums(j), n * sizeof *sums);
-    /* The overlay's account of who made each eye ray must be what each worker made. */
+    /* The copies of a cell in this process read one built scene: never more scenes
+       alive than cells. */
     vw_world *world = rt_job_world(j);
+    int ncells = vw_decomp_cell_count(vw_world_decomp(world));
+    size_t scenes = rt_geo_cache_size(rt_job_shared(j)->geo_cache);
+    EXPECT(scenes <= (size_t)ncells, "%d cells, %d workers, farm %d: %zu scenes built", ncells,
+           workers, (int)farm, scenes);
+    /* The overlay's account of who made each eye ray must be what each worker made. */
     int gw = vw_world_workers(world) * vw_world_processes(world);
     int *eye = malloc((size_t)w * h * sizeof *eye);
     int64_t *per = calloc((size_t)gw, sizeof *per);

@@ -370,6 +370,17 @@ static rt_geo_entry *find(rt_geo_cache *c, const rt_object *objects, size_t n)
     return NULL;
 }
 
+/* Drops one reference, the lock held; the last one unlinks and frees the entry. */
+static void unref(rt_geo_cache *c, rt_geo_entry *e)
+{
+    if (--e->refs > 0) return;
+    rt_geo_entry **pp = &c->head;
+    while (*pp != e) pp = &(*pp)->next;
+    *pp = e->next;
+    rt_cell_geo_free(&e->geo);
+    free(e);
+}
+
 vw_status rt_geo_acquire(rt_geo_cache *c, void *device, const rt_object *objects, size_t n,
                          const rt_cell_geo **out)
 {
@@ -380,15 +391,10 @@ vw_status rt_geo_acquire(rt_geo_cache *c, void *device, const rt_object *objects
         e->refs++;
         while (e->state == 0) pthread_cond_wait(&c->cv, &c->mu);
         vw_status st = e->state > 0 ? VW_OK : e->status;
-        if (st == VW_OK) {
+        if (st == VW_OK)
             *out = &e->geo;
-        } else if (--e->refs == 0) { /* the builder failed; the last one out frees it */
-            rt_geo_entry **pp = &c->head;
-            while (*pp != e) pp = &(*pp)->next;
-            *pp = e->next;
-            rt_cell_geo_free(&e->geo);
-            free(e);
-        }
+        else
+            unref(c, e); /* the builder failed */
         pthread_mutex_unlock(&c->mu);
         return st;
     }
@@ -418,15 +424,10 @@ vw_status rt_geo_acquire(rt_geo_cache *c, void *device, const rt_object *objects
     e->state = st == VW_OK ? 1 : -1;
     e->status = st;
     pthread_cond_broadcast(&c->cv);
-    if (st == VW_OK) {
+    if (st == VW_OK)
         *out = &e->geo;
-    } else if (--e->refs == 0) {
-        rt_geo_entry **pp = &c->head;
-        while (*pp != e) pp = &(*pp)->next;
-        *pp = e->next;
-        rt_cell_geo_free(&e->geo);
-        free(e);
-    }
+    else
+        unref(c, e);
     pthread_mutex_unlock(&c->mu);
     return st;
 }
@@ -435,15 +436,10 @@ void rt_geo_release(rt_geo_cache *c, const rt_cell_geo *g)
 {
     if (!c || !g) return;
     pthread_mutex_lock(&c->mu);
-    for (rt_geo_entry **pp = &c->head; *pp; pp = &(*pp)->next) {
-        rt_geo_entry *e = *pp;
-        if (&e->geo != g) continue;
-        if (--e->refs == 0) {
-            *pp = e->next;
-            rt_cell_geo_free(&e->geo);
-            free(e);
+    for (rt_geo_entry *e = c->head; e; e = e->next)
+        if (&e->geo == g) {
+            unref(c, e);
+            break;
         }
-        break;
-    }
     pthread_mutex_unlock(&c->mu);
 }

@@ -81,10 +81,16 @@ static void unit3(double v[3])
 
 static int64_t fix(double c)
 {
-    /* Clamp before rounding: llround of a value beyond int64 is undefined. */
+    /* Clamp before rounding: a value beyond int64 has no conversion. */
     if (!(c > -1e9)) c = c != c ? 0 : -1e9;
     if (c > 1e9) c = 1e9;
-    return (int64_t)llround(c * RT_FIX_ONE);
+    /* llround(y), halves away from zero, without its libm call (2.7 % of a render's
+       instructions, one per colour channel of every contribution). Exact: i = trunc(y)
+       is a double's integer part, and y - i is representable for every double y. */
+    double y = c * RT_FIX_ONE;
+    int64_t i = (int64_t)y;
+    double f = y - (double)i;
+    return i + (f >= 0.5) - (f <= -0.5);
 }
 
 static void flush(vw_ctx *ctx, rt_cell *c)

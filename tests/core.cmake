@@ -41,3 +41,9 @@ foreach(bad "--cells;2x" "--cells;0" "--cells;99x99x99" "--workers;0" "--spheres
 endforeach()
 add_test(NAME cli_unknown_command COMMAND vwalls_tool frobnicate)
 set_tests_properties(cli_unknown_command PROPERTIES LABELS "core" WILL_FAIL TRUE)
+
+# Farmed work: every batch of a duplicated cell made once, turns taken when asked.
+vw_core_test(test_farm)
+add_test(NAME core_farm COMMAND test_farm)
+add_test(NAME core_farm_stress COMMAND test_farm --stress)
+set_tests_properties(core_farm core_farm_stress PROPERTIES LABELS "core;threads")

@@ -384,6 +384,12 @@ int vw_cmd_render(int argc, char **argv)
         vw_world_add_time(w, "balance", vw_cli_now() - tb0 - vw_world_time(w, "balance"));
     }
     double t_build0 = vw_cli_now();
+    if (overlay && by_worker && rt_job_record_eye_workers(job) != VW_OK) {
+        vw_cli_error(CMD, "out of memory for the overlay's worker map");
+        rt_job_free(job);
+        free(speeds), free(slowdown);
+        return VW_EXIT_FAIL;
+    }
     if (rt_job_farm(job, (rt_farm)farm, &farm_copies, err, sizeof err) != VW_OK ||
         rt_job_commit(job, err, sizeof err) != VW_OK) {
         vw_cli_error(CMD, "%s", err);

@@ -30,6 +30,7 @@ void rt_job_free(rt_job *j)
     rt_device_free(j->sh.device);
     free(j->sh.lights);
     free(j->sh.accum);
+    free(j->sh.eye_worker);
     free(j->owner);
     vw_decomp_free(j->owner_decomp);
     free(j);
@@ -399,31 +400,23 @@ void rt_job_overlay(const rt_job *j, uint8_t *out)
     draw_walls(j, out);
 }
 
+vw_status rt_job_record_eye_workers(rt_job *j)
+{
+    j->sh.record_eye_workers = 1;
+    if (!j->sh.accum || j->sh.eye_worker) return VW_OK; /* (output process only) */
+    size_t np = (size_t)j->sh.view.width * (size_t)j->sh.view.height;
+    j->sh.eye_worker = malloc(np * sizeof *j->sh.eye_worker);
+    if (!j->sh.eye_worker) return VW_E_NOMEM;
+    for (size_t i = 0; i < np; i++) j->sh.eye_worker[i] = -1;
+    return VW_OK;
+}
+
 int rt_job_eye_workers(const rt_job *j, int *worker)
 {
-    const rt_view *v = &j->sh.view;
-    size_t np = (size_t)v->width * (size_t)v->height;
-    vw_world *world = j->world;
-    int nc = vw_decomp_cell_count(vw_world_decomp(world));
-    int gw = vw_world_workers(world) * vw_world_processes(world);
-    size_t *pos = calloc((size_t)nc, sizeof *pos);
-    int *reps = malloc(sizeof(int) * (size_t)gw);
-    int ok = j->owner && pos && reps;
-    for (size_t i = 0; i < np; i++) {
-        int c = ok ? j->owner[i] : -1;
-        if (c < 0) {
-            worker[i] = -1;
-            continue;
-        }
-        /* Copy r of k makes batches r, r + k, ... of RT_SHARE pixels of the cell's
-           row-major list (step() in module.c); r = 0 is the master. */
-        int ncopies = 1 + vw_world_replicas(world, c, reps, gw);
-        int r = (int)(pos[c]++ / RT_SHARE % (size_t)ncopies);
-        worker[i] = r ? reps[r - 1] : vw_world_cell_worker(world, c);
-    }
-    free(pos);
-    free(reps);
-    return ok;
+    if (!j->sh.eye_worker || !j->owner) return 0;
+    size_t np = (size_t)j->sh.view.width * (size_t)j->sh.view.height;
+    for (size_t i = 0; i < np; i++) worker[i] = j->owner[i] < 0 ? -1 : j->sh.eye_worker[i];
+    return 1;
 }
 
 /* Tint by the worker that made each pixel's eye ray: a fixed palette of well-separated

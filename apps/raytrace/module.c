@@ -36,6 +36,8 @@ typedef struct rt_ray {
    step() finds no more primary pixels, which the runtime calls after every delivery. */
 #define RT_PKG_N 15
 #define RT_F_PRIMARY 1 /* this entry ends an eye ray (progress counting) */
+#define RT_F_WORKER 2  /* no colour: worker flags >> 8 made the pixel's eye ray
+                          (rt_shared.record_eye_workers) */
 typedef struct rt_entry {
     int64_t rgb[3];
     int32_t pixel, flags;
@@ -126,6 +128,7 @@ static void output_pixels(void *user, const void *msg)
             sh->accum[e->pixel][k] =
                 (int64_t)((uint64_t)sh->accum[e->pixel][k] + (uint64_t)e->rgb[k]);
         primary += e->flags & RT_F_PRIMARY;
+        if ((e->flags & RT_F_WORKER) && sh->eye_worker) sh->eye_worker[e->pixel] = e->flags >> 8;
     }
     if (primary) atomic_fetch_add(&sh->pixels_done, primary);
     atomic_fetch_add(&sh->entries, n);
@@ -498,22 +501,27 @@ static int step(vw_ctx *ctx, void *state)
         c->eye_done = 0;
     }
     /* The eye rays, up to RT_BATCH a call, in batches of RT_SHARE pixels: a duplicated
-       cell's copies farm them (vw_ctx_next_batch gives each batch to one copy, in
-       turn), so no eye ray is a message and every copy starts at once. */
+       cell's copies farm them (vw_ctx_next_batch gives each batch to one copy, in turns,
+       and the turns a slow copy has not taken to the copies that are done), so no eye
+       ray is a message and every copy starts at once. */
     if (!c->eye_done) {
         const rt_view *v = &c->sh->view;
+        uint64_t nbatches = (c->npixels + RT_SHARE - 1) / RT_SHARE;
         size_t made = 0;
         while (made < RT_BATCH) {
-            uint64_t b = vw_ctx_next_batch(ctx);
-            if (b > c->npixels / RT_SHARE || (size_t)b * RT_SHARE >= c->npixels) {
+            uint64_t b = vw_ctx_next_batch(ctx, nbatches);
+            if (b >= nbatches) {
                 c->eye_done = 1;
                 break;
             }
             size_t begin = (size_t)b * RT_SHARE;
             size_t end = begin + RT_SHARE < c->npixels ? begin + RT_SHARE : c->npixels;
             c->tally[RT_C_PIXELS] += (int64_t)(end - begin);
+            static const double none[3] = {0, 0, 0};
             for (size_t i = begin; i < end; i++) {
                 int px = c->pixels[i];
+                if (c->sh->record_eye_workers)
+                    emit(ctx, c, px, none, RT_F_WORKER | vw_ctx_worker(ctx) << 8);
                 rt_ray r;
                 memcpy(r.org, v->eye, sizeof r.org);
                 rt_view_ray(v, px % v->width, px / v->width, r.dir);

@@ -103,8 +103,13 @@ typedef struct rt_shared {
        walks the pixels itself otherwise. NULL when not computed. */
     const int *owner;
     const vw_decomp *owner_decomp;
+    /* Every process: record which worker makes each eye ray (rt_job_record_eye_workers):
+       the cell sends it to the output process with the pixel's contributions. */
+    int record_eye_workers;
     /* Output process only: */
     int64_t (*accum)[3];        /* width*height fixed-point sums */
+    int *eye_worker;            /* width*height, when recorded: the worker that made the
+                                   pixel's eye ray in the last run, -1 = none */
     /* The counters below are written while every worker reads the fields above for
        every ray: each gets a cache line of its own, or the writes would bounce the
        read-mostly line between cores. */
@@ -123,7 +128,7 @@ typedef struct rt_shared {
    every k-th run of this many pixels of the cell's row-major list, fine enough that
    each copy's share samples the whole cell (batches of 256 pixels, a quarter row at
    1024 wide, left one copy the image's heavy middle columns: busy 0.98 s against
-   0.80 s). rt_job_overlay_workers draws the turns. */
+   0.80 s). rt_job_overlay_workers draws who made them. */
 #define RT_SHARE 16
 
 extern const vw_module rt_module;
@@ -181,9 +186,14 @@ void rt_job_set_sample(rt_job *j, int stride);
    pixel from the world's current decomposition (after the balancer changed it), so
    the next run renders from scratch. The world's cells are rebuilt at the next commit. */
 vw_status rt_job_reset(rt_job *j);
-/* The global worker that made each pixel's eye ray after a full render (width*height
+/* Record which worker makes each eye ray in the runs that follow (for
+   rt_job_eye_workers; costs one package entry per pixel). Before rt_job_run; on every
+   process. */
+vw_status rt_job_record_eye_workers(rt_job *j);
+/* The global worker that made each pixel's eye ray in the last run (width*height
    entries, -1 where the ray misses the world): the cell's worker, or with copies the
-   one whose turn the pixel's batch was. 0 if it cannot tell (out of memory). */
+   one that took the pixel's batch (vw_ctx_next_batch: its own turn, or another copy's
+   it took). Output process; 0 if not recorded. */
 int rt_job_eye_workers(const rt_job *j, int *worker);
 /* The overlay variant that tints each pixel by that worker. */
 void rt_job_overlay_workers(const rt_job *j, uint8_t *out);
@@ -228,9 +238,10 @@ vw_status rt_job_map(rt_job *j, vw_map_kind kind, const double *load, const doub
                      char *err, size_t errlen);
 /* Farming within a process: the workers of a process share its cells by holding copies
    of them (vw_world_set_replicas). A ray then moves to another worker only when it
-   crosses into a cell of another process, and every copy takes eye-ray batches on
-   demand (vw_ctx_next_batch), so the workers stay evenly loaded. The cost is memory:
-   each copy builds its own Embree scene. */
+   crosses into a cell of another process, and every copy takes eye-ray batches in
+   turns, then the turns a slower copy has not taken (vw_ctx_next_batch), so the
+   workers stay evenly loaded. The copies of a cell share one built Embree scene
+   (rt_geo_acquire). */
 typedef enum rt_farm {
     RT_FARM_IDLE = 0, /* only workers that host no cell get copies (of all their
                          process's cells): --cells 1 on 2 workers uses both */

@@ -95,14 +95,17 @@ VW_API void *vw_ctx_user(const vw_ctx *ctx);
 VW_API int vw_ctx_replica(const vw_ctx *ctx);
 VW_API int vw_ctx_replicas(const vw_ctx *ctx);
 /* Farming a cell's own work (what step() creates) among its copies: the work is cut
-   into batches numbered 0, 1, 2, ... and each call returns the number of the next
-   batch this copy is to make. Within one run every number goes to exactly one copy,
-   in turn: of k copies, copy r (the master is 0) gets r, r + k, r + 2k, ... so each
-   makes an equal share, as the balancer plans, on any process and with no message.
-   Counting restarts at every run; a cell without copies gets 0, 1, 2, ... Call it
-   from step() until the number is past the cell's last batch; small batches spread
-   the work evenly when its cost varies along the batch numbers. */
-VW_API uint64_t vw_ctx_next_batch(vw_ctx *ctx);
+   into nbatches batches numbered 0, 1, ..., nbatches - 1, and each call returns the
+   number of a batch this copy is to make, or nbatches when none is left for it. Within
+   one run every number is returned exactly once. Of k copies, copy r (the master is 0)
+   takes its turns r, r + k, r + 2k, ... first, an equal share as the balancer plans,
+   with no message; a copy whose turns are used up then takes the turns not yet taken
+   by the other copies in its process, so a copy slowed down (a busy core) leaves its
+   rest to the others. Counting restarts at every run; a cell without copies gets
+   0, 1, 2, ... Call it from step() until it returns nbatches, with the same nbatches
+   in every copy; small batches spread the work evenly when its cost varies along the
+   batch numbers. */
+VW_API uint64_t vw_ctx_next_batch(vw_ctx *ctx, uint64_t nbatches);
 
 /* Sending. A message is copied when sent; the caller keeps its buffer.
    Messages are batched per destination into packets, flushed when full or when the

@@ -40,6 +40,15 @@ typedef struct vw_config {
     const void *mpi_comm;
     /* Per-worker slow-down factor for emulating unequal machines (NULL = none). */
     const double *worker_slowdown;
+    /* Farmed work (vw_ctx_next_batch): a copy of a cell whose turns are used up takes
+       the turns the cell's other copies in its process have not taken. 1 = on, 0 = off
+       (every copy makes exactly its equal share), -1 (the default) = on when the
+       process has no more workers than cores. Then taking turns only evens out a
+       machine's speed differences; with more workers than cores (emulating a larger
+       machine) it would hand the work to whichever threads the system happens to run,
+       and the per-worker loads and lambda would no longer mean the same on every
+       machine. */
+    int steal;
 } vw_config;
 
 /* Defaults, then the environment's stress switches. */

@@ -292,12 +292,36 @@ int vw_ctx_replicas(const vw_ctx *ctx)
     return ctx->cell >= 0 ? ctx->w->cells[ctx->cell].nreps : 0;
 }
 
-uint64_t vw_ctx_next_batch(vw_ctx *ctx)
+/* The next of unit u's turns, u + k i (i = 0, 1, ...: its counter), or nbatches when they
+   are used up. One atomic add per batch: every value of the counter goes to one taker. */
+static uint64_t take_turn(_Atomic uint64_t *counter, int u, int k, uint64_t nbatches)
 {
-    if (ctx->cell < 0) return 0;
-    vw__cell *c = &ctx->w->cells[ctx->cell];
-    uint64_t *n = ctx->rep ? &c->reps[ctx->rep - 1].batches : &c->batches;
-    return (uint64_t)ctx->rep + (uint64_t)(c->nreps + 1) * (*n)++;
+    uint64_t i = atomic_fetch_add_explicit(counter, 1, memory_order_relaxed);
+    uint64_t b = (uint64_t)u + (uint64_t)k * i;
+    return b < nbatches && b >= i ? b : nbatches; /* (b < i: wrapped) */
+}
+
+uint64_t vw_ctx_next_batch(vw_ctx *ctx, uint64_t nbatches)
+{
+    if (ctx->cell < 0) return nbatches;
+    vw_world *w = ctx->w;
+    vw__cell *c = &w->cells[ctx->cell];
+    int k = c->nreps + 1;
+    uint64_t b = take_turn(ctx->rep ? &c->reps[ctx->rep - 1].batches : &c->batches, ctx->rep,
+                           k, nbatches);
+    if (b < nbatches || k == 1 || !w->steal) return b;
+    /* Its own turns used up, a copy takes the turns the other copies in this process have
+       not taken yet (the counters of copies in other processes live there): a copy
+       whose worker the machine slowed down leaves its rest to the copies that are done,
+       instead of everyone waiting for it (vw_config.steal says when). */
+    for (int i = 1; i < k; i++) {
+        int u = (ctx->rep + i) % k;
+        int worker = u ? c->reps[u - 1].worker : c->worker;
+        if (vw__worker_process(w, worker) != w->rank) continue;
+        b = take_turn(u ? &c->reps[u - 1].batches : &c->batches, u, k, nbatches);
+        if (b < nbatches) return b;
+    }
+    return nbatches;
 }
 
 void *vw_ctx_enter(vw_ctx *ctx, int cell, int kind)
@@ -632,10 +656,10 @@ vw_status vw__runtime_run(vw_world *w)
        cells every worker of this process holds a copy of (vw_ctx_enter). */
     for (int cl = 0; cl < w->ncells; cl++) {
         vw__cell *c = &w->cells[cl];
-        c->batches = 0;
+        atomic_store_explicit(&c->batches, 0, memory_order_relaxed);
         int local = vw__worker_process(w, c->worker) == w->rank;
         for (int r = 0; r < c->nreps; r++) {
-            c->reps[r].batches = 0;
+            atomic_store_explicit(&c->reps[r].batches, 0, memory_order_relaxed);
             local += vw__worker_process(w, c->reps[r].worker) == w->rank;
         }
         c->farmed = c->nreps > 0 && local == w->nworkers;

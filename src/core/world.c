@@ -46,6 +46,7 @@ void vw_config_init(vw_config *c)
     c->workers = 0;
     c->packet_bytes = 32 * 1024;
     c->cap_bytes = 64u * 1024 * 1024;
+    c->steal = -1;
     c->stress_seed = env_u64("VW_STRESS");
     c->stress_split = env_u64("VW_STRESS_SPLIT") != 0;
 }
@@ -177,6 +178,7 @@ vw_status vw_world_create(const vw_module *m, void *user, const vw_decomp *d, co
         free(w);
         return VW_E_LIMIT;
     }
+    w->steal = w->cfg.steal > 0 || (w->cfg.steal < 0 && w->nworkers <= default_workers());
     w->cfg.cell_worker = NULL; /* copied into w->cell_worker below */
     pthread_mutex_init(&w->output_mu, NULL);
     pthread_mutex_init(&w->pool_mu, NULL);

@@ -61,7 +61,8 @@ typedef struct vw__replica {
        (vw__cell_rep_of), so these get a line of their own. */
     _Alignas(VW__LINE) uint64_t messages_in;
     double busy_s;
-    uint64_t batches;        /* vw_ctx_next_batch calls in this run */
+    _Atomic uint64_t batches; /* turns taken in this run (vw_ctx_next_batch; other
+                                 workers of the process take them too at the end) */
 } vw__replica;
 
 typedef struct vw__cell {
@@ -85,7 +86,7 @@ typedef struct vw__cell {
        every other worker's reads of the fields above would bounce it between cores. */
     _Alignas(VW__LINE) uint64_t messages_in;
     double busy_s;
-    uint64_t batches;        /* vw_ctx_next_batch calls of the master in this run */
+    _Atomic uint64_t batches; /* the master's turns taken in this run (as above) */
 } vw__cell;
 
 /* Stride of vw__cell.rr: one cache line per sending worker. */
@@ -157,6 +158,7 @@ struct vw_world {
     int rank, nprocs;          /* process rank and count (1 without MPI) */
     int nworkers;              /* per process */
     int gworkers;              /* all processes */
+    int steal;                 /* cfg.steal decided (vw_ctx_next_batch) */
     int ncells;
     vw__cell *cells;
     int *cell_worker;          /* cell -> global worker */

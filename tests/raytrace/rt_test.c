@@ -58,7 +58,7 @@ static int64_t *render_farm(const vw_scene *s, int w, int h, const int dims[3], 
     p.workers = workers;
     char err[512];
     rt_job *j;
-    if (rt_job_create(s, &p, &j, err, sizeof err) != VW_OK ||
+    if (rt_job_create(s, &p, &j, err, sizeof err) != VW_OK || rt_job_record_eye_workers(j) ||
         rt_job_farm(j, farm, NULL, err, sizeof err) || rt_job_commit(j, err, sizeof err) ||
         rt_job_run(j, err, sizeof err)) {
         fprintf(stderr, "render failed: %s\n", err);

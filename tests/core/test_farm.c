@@ -1,0 +1,130 @@
+/* test_farm.c - farmed work (vw_ctx_next_batch): the copies of a duplicated cell make
+ * its batches from step(), and every batch must be made exactly once in every run,
+ * whatever the interleaving. With vw_config.steal off each copy makes exactly its
+ * turns (copy r of k: r, r + k, ...); with it on, a copy whose turns are used up takes
+ * the turns the others have not taken, so a copy on a slowed-down worker (emulated with
+ * vw_config.worker_slowdown) leaves most of its share to the fast one.
+ *
+ * usage: test_farm [--stress]   (also honours VW_STRESS)
+ */
+#include <stdatomic.h>
+#include <string.h>
+
+#include "vw_test.h"
+#include "vwalls/vwalls.h"
+
+enum { CNT_MADE, NCOUNTERS };
+
+typedef struct farm {
+    uint64_t nbatches;
+    atomic_int *made; /* per batch: times made in this run */
+} farm;
+
+static vw_status build(vw_ctx *ctx, const void *objs, size_t n, void **state)
+{
+    (void)ctx, (void)objs, (void)n;
+    *state = calloc(1, 1);
+    return *state ? VW_OK : VW_E_NOMEM;
+}
+
+static void cell_free(void *state, void *user)
+{
+    (void)user;
+    free(state);
+}
+
+/* One batch per call, with a little work in it, so the slowdown's meter has time to
+   stretch. */
+static int step(vw_ctx *ctx, void *state)
+{
+    (void)state;
+    farm *f = vw_ctx_user(ctx);
+    uint64_t b = vw_ctx_next_batch(ctx, f->nbatches);
+    if (b >= f->nbatches) return 0;
+    atomic_fetch_add(&f->made[b], 1);
+    vw_count(ctx, CNT_MADE, 1);
+    volatile double x = 1;
+    for (int i = 0; i < 2000; i++) x = x * 1.0000001 + 1e-9;
+    return 1;
+}
+
+static void ignore(vw_ctx *ctx, void *state, const void *msg) { (void)ctx, (void)state, (void)msg; }
+
+static const vw_msg_kind kinds[] = {{"unused", 8, ignore, NULL, VW_MSG_INDEPENDENT}};
+static const char *const counters[] = {"made"};
+
+static const vw_module farm_module = {
+    .abi = VW_MODULE_ABI,
+    .name = "farm",
+    .kinds = kinds,
+    .nkinds = 1,
+    .counters = counters,
+    .ncounters = NCOUNTERS,
+    .cell_build = build,
+    .cell_free = cell_free,
+    .step = step,
+};
+
+/* Runs `runs` times a world of one cell with a copy on every other worker; returns the
+   batches worker 0 made per run on average. Every batch is made once in every run. */
+static int64_t farm_runs(int workers, int steal, const double *slowdown, uint64_t nbatches,
+                         int runs, uint64_t stress)
+{
+    vw_box box = {{0, 0, 0}, {1, 1, 1}};
+    int dims[3] = {1, 1, 1};
+    vw_decomp *d;
+    CHECK_EQ_INT(vw_decomp_create_grid(&box, dims, &d), VW_OK);
+    farm f = {nbatches, calloc(nbatches, sizeof(atomic_int))};
+    CHECK(f.made != NULL);
+    vw_config cfg;
+    vw_config_init(&cfg);
+    cfg.workers = workers;
+    cfg.steal = steal;
+    cfg.worker_slowdown = slowdown;
+    if (stress && !cfg.stress_seed) cfg.stress_seed = stress;
+    vw_world *w;
+    CHECK_EQ_INT(vw_world_create(&farm_module, &f, d, &cfg, &w), VW_OK);
+    int on[64], n = 0;
+    for (int g = 1; g < workers && n < 64; g++) on[n++] = g;
+    CHECK_EQ_INT(vw_world_set_replicas(w, 0, on, n), VW_OK);
+    for (int r = 0; r < runs; r++) {
+        for (uint64_t b = 0; b < nbatches; b++) atomic_store(&f.made[b], 0);
+        CHECK_EQ_INT(vw_world_run(w), VW_OK);
+        uint64_t wrong = 0;
+        for (uint64_t b = 0; b < nbatches; b++) wrong += atomic_load(&f.made[b]) != 1;
+        EXPECT(wrong == 0, "%d workers, steal %d, run %d: %llu of %llu batches not made once",
+               workers, steal, r, (unsigned long long)wrong, (unsigned long long)nbatches);
+        /* The workers' counters add up over the runs. */
+        int64_t sum = 0;
+        for (int g = 0; g < workers; g++) sum += vw_world_worker_counter(w, g, CNT_MADE);
+        EXPECT(sum == (int64_t)nbatches * (r + 1), "run %d: the workers made %lld batches", r,
+               (long long)sum);
+    }
+    int64_t mine = vw_world_worker_counter(w, 0, CNT_MADE);
+    vw_world_free(w);
+    vw_decomp_free(d);
+    free(f.made);
+    return runs > 0 ? mine / runs : 0;
+}
+
+int main(int argc, char **argv)
+{
+    uint64_t stress = argc > 1 && !strcmp(argv[1], "--stress") ? 7 : 0;
+    /* Off: exactly the turns, equal shares (101 batches: the master gets one more). */
+    int64_t mine = farm_runs(2, 0, NULL, 101, 3, stress);
+    EXPECT(mine == 51, "steal off: worker 0 made %lld of 101 batches a run, not its 51 turns",
+           (long long)mine);
+    /* On, the copy's worker 8 times slower: the master takes most of the copy's turns. */
+    static const double slow[2] = {1.0, 8.0};
+    mine = farm_runs(2, 1, slow, 400, 2, stress);
+    EXPECT(mine > 260, "steal on, copy slowed 8x: worker 0 made only %lld of 400 batches",
+           (long long)mine);
+    /* Many copies, every batch once, under any interleaving (more workers than cores
+       too: the copies race for the turns left). */
+    for (int workers = 2; workers <= 6; workers += 2)
+        for (int steal = 0; steal <= 1; steal++) farm_runs(workers, steal, NULL, 997, 3, stress);
+    /* Fewer batches than copies: most copies get none. */
+    farm_runs(6, 1, NULL, 3, 2, stress);
+    printf("farm: %d failures\n", vw_test_failures);
+    return vw_test_failures ? 1 : 0;
+}

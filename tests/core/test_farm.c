@@ -20,18 +20,15 @@ typedef struct farm {
     atomic_int *made; /* per batch: times made in this run */
 } farm;
 
+/* The cells keep nothing of their own: their state is the shared farm. */
 static vw_status build(vw_ctx *ctx, const void *objs, size_t n, void **state)
 {
-    (void)ctx, (void)objs, (void)n;
-    *state = calloc(1, 1);
-    return *state ? VW_OK : VW_E_NOMEM;
+    (void)objs, (void)n;
+    *state = vw_ctx_user(ctx);
+    return VW_OK;
 }
 
-static void cell_free(void *state, void *user)
-{
-    (void)user;
-    free(state);
-}
+static void cell_free(void *state, void *user) { (void)state, (void)user; }
 
 /* One batch per call, with a little work in it, so the slowdown's meter has time to
    stretch. */

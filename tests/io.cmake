@@ -18,3 +18,9 @@ target_link_libraries(test_io_cli PRIVATE vwalls_static m)
 # cli.c uses clock_gettime, which -std=c11 hides without a feature macro.
 target_compile_definitions(test_io_cli PRIVATE _GNU_SOURCE)
 add_test(NAME io_cli COMMAND test_io_cli ${PROJECT_SOURCE_DIR}/tests/data)
+
+# The readers' number parser reads every token as strtod does (its fast path included).
+add_executable(test_io_number ${PROJECT_SOURCE_DIR}/tests/io/test_io_number.c)
+target_include_directories(test_io_number PRIVATE ${PROJECT_SOURCE_DIR}/tests ${PROJECT_SOURCE_DIR}/src)
+target_link_libraries(test_io_number PRIVATE vwalls_static m)
+add_test(NAME io_number COMMAND test_io_number)

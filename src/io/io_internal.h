@@ -29,6 +29,11 @@ vw_status vw__input_error(char *err, size_t errlen, const char *name, int line,
    (so it cannot overflow). Returns 1 and stores it, or 0 when the token is not one. */
 int vw__parse_int(const char *s, size_t n, size_t maxlen, long long *out);
 
+/* A whole token (n bytes, not NUL-terminated) as a number, exactly as strtod reads it:
+   1 and the value, 0 when it is not a number (or longer than 127 bytes), -1 when it is
+   NaN or infinite. Short decimals take an exact fast path (scene.c). */
+int vw__parse_double(const char *s, size_t n, double *out);
+
 /* The scene builder owns a scene under construction plus the capacities of its
    arrays. Invariants: ids are handed out densely in the order primitives are added;
    when s->normals is non-NULL it has as many entries as s->indices (capacity too),

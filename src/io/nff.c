@@ -150,21 +150,7 @@ static vw_status fail_status(nff *P, vw_status st)
 /* 1: a finite number; 0: not a number; -1: NaN or infinite. */
 static int parse_double(const token *t, double *out)
 {
-    char buf[128];
-    if (t->ext || t->n == 0 || t->n >= sizeof buf)
-        return 0;
-    memcpy(buf, t->s, t->n);
-    buf[t->n] = '\0';
-    if (memchr(buf, '\0', t->n))
-        return 0;
-    char *endp;
-    double v = strtod(buf, &endp);
-    if (endp != buf + t->n)
-        return 0;
-    if (!isfinite(v))
-        return -1;
-    *out = v;
-    return 1;
+    return t->ext ? 0 : vw__parse_double(t->s, t->n, out);
 }
 
 static vw_status read_num(nff *P, double *out)

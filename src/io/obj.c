@@ -122,18 +122,12 @@ static vw_status fail_status(obj *O, vw_status st)
 
 static vw_status parse_double(obj *O, span t, double *out)
 {
-    char buf[128], sb[48];
-    if (t.n == 0 || t.n >= sizeof buf || memchr(t.s, '\0', t.n))
+    char sb[48];
+    int r = vw__parse_double(t.s, t.n, out);
+    if (r == 0)
         return fail(O, "bad number '%s'", show(t, sb));
-    memcpy(buf, t.s, t.n);
-    buf[t.n] = '\0';
-    char *endp;
-    double v = strtod(buf, &endp);
-    if (endp != buf + t.n)
-        return fail(O, "bad number '%s'", show(t, sb));
-    if (!isfinite(v))
+    if (r < 0)
         return fail(O, "NaN or infinite number '%s'", show(t, sb));
-    *out = v;
     return VW_OK;
 }
 

@@ -652,6 +652,9 @@ static void put3(FILE *f, const char *key, const double v[3])
     fprintf(f, "%s %.17g %.17g %.17g\n", key, v[0], v[1], v[2]);
 }
 
+/* Differ as bits: -0 and 0 compare equal, but a round trip must keep the sign. */
+static int bits_differ(float a, float b) { return memcmp(&a, &b, sizeof a) != 0; }
+
 static void write_material(FILE *f, const vw_material *m)
 {
     /* diffuse is written with Kd = 1, so the reader's colour*Kd gives it back
@@ -659,10 +662,11 @@ static void write_material(FILE *f, const vw_material *m)
     fprintf(f, "f %.17g %.17g %.17g 1 %.17g %.17g %.17g %.17g\n", (double)m->diffuse[0],
             (double)m->diffuse[1], (double)m->diffuse[2], (double)m->specular[0],
             (double)m->shine, (double)m->transmit, (double)m->ior);
-    if (m->specular[1] != m->specular[0] || m->specular[2] != m->specular[0])
+    if (bits_differ(m->specular[1], m->specular[0]) || bits_differ(m->specular[2], m->specular[0]))
         fprintf(f, "#vw Ks %.17g %.17g %.17g\n", (double)m->specular[0],
                 (double)m->specular[1], (double)m->specular[2]);
-    if (m->emission[0] != 0.0f || m->emission[1] != 0.0f || m->emission[2] != 0.0f)
+    if (bits_differ(m->emission[0], 0.0f) || bits_differ(m->emission[1], 0.0f) ||
+        bits_differ(m->emission[2], 0.0f))
         fprintf(f, "#vw Ke %.17g %.17g %.17g\n", (double)m->emission[0],
                 (double)m->emission[1], (double)m->emission[2]);
 }

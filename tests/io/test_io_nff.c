@@ -184,6 +184,22 @@ int main(int argc, char **argv)
         vw_scene_free(b);
     }
 
+    /* Negative zeros keep their sign through the round trip (found by fuzz_nff: the
+       writer compared them with ==, left out the #vw lines, and read back +0). */
+    {
+        const char *t = VIEW "f 0.2 0.6 0.9 0.9 0.1 300 0.4 5.5\n#vw Ks 0 -0.0 0\n"
+                             "#vw Ke -0 0 0\ns -1.2 0.3 0.3 0.3\n";
+        vw_scene *a = read_text("zeros.nff", t);
+        char *w = nff_string(a, NULL);
+        vw_scene *b = read_text("zeros2.nff", w);
+        CHECK(scene_equal(a, b));
+        CHECK(signbit(b->materials[b->spheres[0].material].specular[1]));
+        CHECK(signbit(b->materials[b->spheres[0].material].emission[0]));
+        free(w);
+        vw_scene_free(a);
+        vw_scene_free(b);
+    }
+
     /* Unused 'f' leaves no material; equal 'f's share one. */
     {
         const char *t = VIEW "f 1 0 0 1 0 0 0 1\nf 0 1 0 1 0 0 0 1\ns 0 0 0 1\n"

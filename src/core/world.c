@@ -184,7 +184,8 @@ vw_status vw_world_create(const vw_module *m, void *user, const vw_decomp *d, co
     pthread_mutex_init(&w->pool_mu, NULL);
     pthread_cond_init(&w->pool_cv, NULL);
     /* Under MPI: rank, nprocs and the transport. Every process must pass the same
-       worker count, decomposition and mapping (checked by the transport). */
+       worker count (checked by the transport here), decomposition and mapping (checked
+       at every commit: world_fingerprint). */
     vw_status st = vw__mpi_attach(w);
     w->gworkers = w->nworkers * w->nprocs;
     if (st == VW_OK) {
@@ -363,9 +364,47 @@ int vw_world_cells_of_object(const vw_world *w, size_t id, int *out, int max)
     return n;
 }
 
+static uint64_t fnv1a(uint64_t h, const void *p, size_t n)
+{
+    const unsigned char *b = p;
+    for (size_t i = 0; i < n; i++) h = (h ^ b[i]) * 0x100000001b3ull;
+    return h;
+}
+
+/* What every process of a world must have been given alike, hashed: the walls (cell
+   boxes and frame), the mapping, the copies of duplicated cells and the number of
+   objects. A process given another scene or layout would otherwise send its rays to
+   cells the others do not expect, and show only as an abort on a malformed packet. */
+static uint64_t world_fingerprint(const vw_world *w)
+{
+    uint64_t h = 0xcbf29ce484222325ull;
+    h = fnv1a(h, &w->ncells, sizeof w->ncells);
+    for (int c = 0; c < w->ncells; c++) {
+        vw_box b = vw_decomp_cell_box(w->decomp, c);
+        h = fnv1a(h, &b, sizeof b);
+        h = fnv1a(h, &w->cell_worker[c], sizeof w->cell_worker[c]);
+        const vw__cell *cl = &w->cells[c];
+        h = fnv1a(h, &cl->nreps, sizeof cl->nreps);
+        for (int r = 0; r < cl->nreps; r++)
+            h = fnv1a(h, &cl->reps[r].worker, sizeof cl->reps[r].worker);
+    }
+    const double *F = vw_decomp_frame(w->decomp);
+    if (F) h = fnv1a(h, F, 9 * sizeof *F);
+    uint64_t n = w->nobjects;
+    return fnv1a(h, &n, sizeof n);
+}
+
 vw_status vw_world_commit(vw_world *w)
 {
     if (!w) return VW_E_INVAL;
+    if (w->transport) {
+        int r = vw__mpi_first_differing(w, world_fingerprint(w));
+        if (r >= 0)
+            return vw__world_error(w, VW_E_STATE,
+                                   "process %d was given another world than process 0 (walls, "
+                                   "mapping, copies or number of objects differ): every process "
+                                   "must run the same command on the same input", r);
+    }
     vw_status st = vw__runtime_build(w);
     char msg[512] = "";
     if (st != VW_OK) snprintf(msg, sizeof msg, "building cells failed: %s", vw_status_message(st));
@@ -678,6 +717,12 @@ vw_status vw__mpi_attach(vw_world *w)
 {
     (void)w;
     return VW_OK;
+}
+
+int vw__mpi_first_differing(vw_world *w, uint64_t v)
+{
+    (void)w, (void)v;
+    return -1;
 }
 
 int vw_engine_launched(void) { return 0; }

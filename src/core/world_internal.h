@@ -230,6 +230,9 @@ uint64_t vw__peak_rss(void);
 /* transport/mpi.c (stubs in world.c without MPI). vw__mpi_attach decides the engine at
    create: it sets rank, nprocs and w->transport when the world runs under MPI. */
 vw_status vw__mpi_attach(vw_world *w);
+/* Collective over the world's processes: the lowest rank whose v differs from rank 0's,
+   or -1 when all agree (always -1 without MPI). */
+int vw__mpi_first_differing(vw_world *w, uint64_t v);
 
 double vw__now(void);
 

@@ -84,6 +84,17 @@ MPI_Comm vw__mpi_world_comm(const vw_world *w)
     return w->transport ? ((const mpi_tp *)w->transport)->comm : MPI_COMM_NULL;
 }
 
+int vw__mpi_first_differing(vw_world *w, uint64_t v)
+{
+    MPI_Comm c = vw__mpi_world_comm(w);
+    if (c == MPI_COMM_NULL) return -1;
+    uint64_t v0 = v;
+    MPI_Bcast(&v0, 1, MPI_UINT64_T, 0, c);
+    int mine = v == v0 ? w->nprocs : w->rank, first = w->nprocs;
+    MPI_Allreduce(&mine, &first, 1, MPI_INT, MPI_MIN, c);
+    return first < w->nprocs ? first : -1;
+}
+
 static void fatal(vw_world *w, const char *what)
 {
     char msg[600];

@@ -142,7 +142,9 @@ static void on_output(void *user, const void *msg)
 
 static const vw_msg_kind kinds[NKINDS] = {
     [MSG_TOKEN] = {"token", sizeof(token), on_token, on_output},
-    [MSG_POSTED] = {"posted", sizeof(int64_t), on_posted, NULL},
+    /* Independent (any copy may count it: copies add up to their cell), so a cell can
+       be duplicated (test_mismatch). */
+    [MSG_POSTED] = {"posted", sizeof(int64_t), on_posted, NULL, VW_MSG_INDEPENDENT},
 };
 static const char *const counters[NCOUNTERS] = {"received", "sum", "corrupt", "output", "posted"};
 static const vw_module storm_module = {
@@ -179,6 +181,50 @@ static void test_agree(int bad)
     CHECK_EQ_INT(vw_engine_agree(VW_OK, NULL, 0), VW_OK);
 }
 
+/* A world given differently to one process (the last) fails to commit on every process,
+   with a message naming it, instead of running on and meeting packets it cannot read:
+   other walls, another mapping, or other copies. The same world commits. */
+static void test_mismatch(int workers)
+{
+    int rank = vw_engine_rank(), size = vw_engine_size(), bad = size - 1;
+    vw_box box = {{0, 0, 0}, {1, 1, 1}};
+    static const char *const what_name[] = {"same", "walls", "mapping", "copies"};
+    for (int what = 0; what < 4; what++) {
+        int differs = what > 0 && rank == bad && size > 1;
+        int dims[3] = {2, 2, differs && what == 1 ? 1 : 2};
+        vw_decomp *d;
+        CHECK_EQ_INT(vw_decomp_create_grid(&box, dims, &d), VW_OK);
+        int nc = vw_decomp_cell_count(d), gw = size * workers;
+        int *map = malloc(sizeof(int) * (size_t)nc);
+        for (int c = 0; c < nc; c++) map[c] = c % gw;
+        if (differs && what == 2) map[0] = 1 % gw, map[1] = 0;
+        storm st = {1, nc, 0, 0, -1};
+        vw_config cfg;
+        vw_config_init(&cfg);
+        cfg.workers = workers;
+        cfg.cell_worker = map;
+        vw_world *w;
+        CHECK_EQ_INT(vw_world_create(&storm_module, &st, d, &cfg, &w), VW_OK);
+        if (differs && what == 3) {
+            int other = (map[0] + 1) % gw;
+            CHECK_EQ_INT(vw_world_set_replicas(w, 0, &other, 1), VW_OK);
+        }
+        vw_status got = vw_world_commit(w);
+        if (what == 0 || size == 1 || gw < 2) {
+            EXPECT(got == VW_OK, "%s: commit %d: %s", what_name[what], (int)got, vw_world_errmsg(w));
+        } else {
+            char want[64];
+            snprintf(want, sizeof want, "process %d was given another world", bad);
+            EXPECT(got == VW_E_STATE && strstr(vw_world_errmsg(w), want),
+                   "rank %d, %s: commit %d: '%s'", rank, what_name[what], (int)got,
+                   vw_world_errmsg(w));
+        }
+        vw_world_free(w);
+        vw_decomp_free(d);
+        free(map);
+    }
+}
+
 int main(int argc, char **argv)
 {
     int workers = 2, seeds = 3, agree = 0, kill_rank = -1, exit_rank = -1;
@@ -201,9 +247,10 @@ int main(int argc, char **argv)
     int rank = vw_engine_rank();
     if (agree) {
         for (int bad = 0; bad <= vw_engine_size(); bad++) test_agree(bad);
-        if (rank == 0) printf("agreement: %d checks passed\n", vw_test_checks);
+        test_mismatch(workers);
+        if (rank == 0) printf("agreement: %d checks, %d failed\n", vw_test_checks, vw_test_failures);
         vw_engine_finish();
-        return 0;
+        return vw_test_failures ? 1 : 0;
     }
     vw_box box = {{0, 0, 0}, {1, 1, 1}};
     const char *layouts[] = {"1", "2x2", "3x1x2", "2x2x2", "4x4x2"};

@@ -23,15 +23,9 @@ set_tests_properties(balance_identical_spheres balance_identical_mixed balance_c
 
 # The command line: PNG bytes equal for every --balance and --map, under the threads
 # engine and (when the build has MPI) under mpirun -np 2.
-# (This file is included before mpi.cmake, so it finds the launcher flags itself.)
 set(_vw_bal_mpi "")
 if(VW_HAVE_MPI AND MPIEXEC_EXECUTABLE)
-  set(_vw_bal_pre ${MPIEXEC_PREFLAGS})
-  execute_process(COMMAND ${MPIEXEC_EXECUTABLE} --version OUTPUT_VARIABLE _vw_bal_ver ERROR_QUIET)
-  if(_vw_bal_ver MATCHES "Open MPI|OpenRTE")
-    list(APPEND _vw_bal_pre --oversubscribe)
-  endif()
-  string(REPLACE ";" "|" _vw_bal_pre "${_vw_bal_pre}")
+  string(REPLACE ";" "|" _vw_bal_pre "${VW_MPI_PREFLAGS}")
   set(_vw_bal_mpi -DMPIRUN=${MPIEXEC_EXECUTABLE} -DNPFLAG=${MPIEXEC_NUMPROC_FLAG}
       "-DPREFLAGS=${_vw_bal_pre}")
 endif()
@@ -41,4 +35,4 @@ add_test(NAME balance_cli
           -DWORK=${CMAKE_CURRENT_BINARY_DIR}/balance_cli ${_vw_bal_mpi}
           -P ${PROJECT_SOURCE_DIR}/tests/balance/cli.cmake)
 set_tests_properties(balance_cli PROPERTIES LABELS "balance;mpi" TIMEOUT 300 PROCESSORS 2
-  ENVIRONMENT "OMPI_ALLOW_RUN_AS_ROOT=1;OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1;${VW_BAL_TSAN}")
+  ENVIRONMENT "${VW_MPI_ENV};${VW_BAL_TSAN}")

@@ -24,19 +24,13 @@ add_test(NAME dynamic_cli
   COMMAND sh ${PROJECT_SOURCE_DIR}/tests/dynamic/cli.sh $<TARGET_FILE:vwalls_tool>
           ${CMAKE_CURRENT_BINARY_DIR}/dynamic_cli)
 
-# Under mpirun -np 2. This file is included before mpi.cmake (alphabetical order), so it
-# works out Open MPI's flags itself, as mpi.cmake does.
+# Under mpirun -np 2 (launcher flags: cmake/mpi_launcher.cmake).
 if(VW_HAVE_MPI AND MPIEXEC_EXECUTABLE)
-  set(_vw_dyn_pre ${MPIEXEC_PREFLAGS})
-  execute_process(COMMAND ${MPIEXEC_EXECUTABLE} --version OUTPUT_VARIABLE _vw_dyn_ver ERROR_QUIET)
-  if(_vw_dyn_ver MATCHES "Open MPI|OpenRTE")
-    list(APPEND _vw_dyn_pre --oversubscribe)
-  endif()
   foreach(t placement decisions frame)
     add_test(NAME dynamic_mpi_${t}
-             COMMAND ${MPIEXEC_EXECUTABLE} ${MPIEXEC_NUMPROC_FLAG} 2 ${_vw_dyn_pre}
+             COMMAND ${MPIEXEC_EXECUTABLE} ${MPIEXEC_NUMPROC_FLAG} 2 ${VW_MPI_PREFLAGS}
                      $<TARGET_FILE:test_dynamic> ${t} 2 --workers 1 ${MPIEXEC_POSTFLAGS})
     set_tests_properties(dynamic_mpi_${t} PROPERTIES LABELS "mpi" TIMEOUT 180 PROCESSORS 2
-                         ENVIRONMENT "OMPI_ALLOW_RUN_AS_ROOT=1;OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1")
+                         ENVIRONMENT "${VW_MPI_ENV}")
   endforeach()
 endif()

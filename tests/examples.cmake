@@ -43,7 +43,7 @@ endforeach()
 
 # Under mpirun: cells spread over processes, labels cross process boundaries.
 if(VW_HAVE_MPI)
-  set(_vw_ex_env "OMPI_ALLOW_RUN_AS_ROOT=1;OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1;OMPI_MCA_rmaps_base_oversubscribe=1")
+  set(_vw_ex_env "${VW_MPI_ENV};OMPI_MCA_rmaps_base_oversubscribe=1")
   foreach(np 2 3)
     foreach(w 1 2)
       add_test(NAME example_components_mpi_np${np}_w${w}

@@ -13,7 +13,7 @@ add_test(NAME experiments_smoke
           ${PROJECT_SOURCE_DIR}/bench/experiments.sh ${CMAKE_CURRENT_BINARY_DIR}/experiments_smoke
           $<TARGET_FILE_DIR:vwalls_tool> ${VW_EXP_DIR}/check.awk)
 set_tests_properties(experiments_smoke PROPERTIES LABELS "bench;mpi" TIMEOUT 120 PROCESSORS 2
-  ENVIRONMENT "OMPI_ALLOW_RUN_AS_ROOT=1;OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1")
+  ENVIRONMENT "${VW_MPI_ENV}")
 
 # The checker itself: it must accept a good CSV and reject each deliberately bad one.
 add_test(NAME experiments_checker

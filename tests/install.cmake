@@ -36,7 +36,7 @@ add_test(NAME install_out_of_tree
 # instrumented library.
 set_tests_properties(install_out_of_tree PROPERTIES LABELS "install;nosan" TIMEOUT 300 PROCESSORS 2
   RESOURCE_LOCK vw_docs
-  ENVIRONMENT "OMPI_ALLOW_RUN_AS_ROOT=1;OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1;OMPI_MCA_rmaps_base_oversubscribe=1")
+  ENVIRONMENT "${VW_MPI_ENV};OMPI_MCA_rmaps_base_oversubscribe=1")
 
 # The man page documents every subcommand and every option their --help shows.
 add_test(NAME install_man_options

@@ -8,17 +8,7 @@ if(NOT VW_HAVE_MPI)
   return()
 endif()
 
-# Open MPI needs --oversubscribe to start more processes than cores (MPICH does not
-# know the flag), and refuses root unless told it is fine.
-set(VW_MPI_PREFLAGS ${MPIEXEC_PREFLAGS})
-set(VW_MPI_FLAVOUR mpich)
-execute_process(COMMAND ${MPIEXEC_EXECUTABLE} --version OUTPUT_VARIABLE _vw_mpiexec_version
-                ERROR_QUIET)
-if(_vw_mpiexec_version MATCHES "Open MPI|OpenRTE")
-  set(VW_MPI_FLAVOUR openmpi)
-  list(APPEND VW_MPI_PREFLAGS --oversubscribe)
-endif()
-set(VW_MPI_ENV "OMPI_ALLOW_RUN_AS_ROOT=1;OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1")
+# The launcher flags (VW_MPI_PREFLAGS, VW_MPI_FLAVOUR, VW_MPI_ENV): cmake/mpi_launcher.cmake.
 
 add_executable(test_mpi_storm ${PROJECT_SOURCE_DIR}/tests/mpi/test_mpi_storm.c)
 target_include_directories(test_mpi_storm PRIVATE ${PROJECT_SOURCE_DIR}/tests)

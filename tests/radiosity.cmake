@@ -27,8 +27,7 @@ add_test(NAME radiosity_cli
                  $<TARGET_FILE:test_radiosity>)
 set_tests_properties(radiosity_cli PROPERTIES LABELS "radiosity;threads;slow" TIMEOUT 60)
 
-# Under mpirun -np 2 and 4 (tests/mpi.cmake, included before this file, sets the
-# launcher flags): 2x2x2 and 4x4x4 with 1 and 2 workers per process against the one-cell
+# Under mpirun -np 2 and 4 (launcher flags: cmake/mpi_launcher.cmake): 2x2x2 and 4x4x4 with 1 and 2 workers per process against the one-cell
 # threads solution (<= 1 % RMS, ledger <= 1e-9), outputs from rank 0 only, and
 # --checkpoint-every / --resume under MPI.
 if(VW_HAVE_MPI)

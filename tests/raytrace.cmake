@@ -41,8 +41,8 @@ if(EXISTS ${PROJECT_SOURCE_DIR}/bench/embree_raw.c)
   target_link_libraries(vw_bench_embree_raw PRIVATE vwalls_apps)
 endif()
 
-# Under mpirun (when the build has MPI; mpi.cmake, included before this file, sets the
-# launcher flags): the same PNG bytes as the threads engine.
+# Under mpirun (when the build has MPI; launcher flags: cmake/mpi_launcher.cmake): the
+# same PNG bytes as the threads engine.
 if(VW_HAVE_MPI AND MPIEXEC_EXECUTABLE)
   string(REPLACE ";" "|" _vw_rt_pre "${VW_MPI_PREFLAGS}")
   add_test(NAME raytrace_mpi

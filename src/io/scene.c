@@ -106,9 +106,10 @@ static int decimal_fast(const char *s, size_t n, double *out)
 
 int vw__parse_double(const char *s, size_t n, double *out)
 {
-    if (decimal_fast(s, n, out)) return 1;
     char buf[128];
-    if (n == 0 || n >= sizeof buf || memchr(s, '\0', n)) return 0;
+    if (n == 0 || n >= sizeof buf) return 0;
+    if (decimal_fast(s, n, out)) return 1;
+    if (memchr(s, '\0', n)) return 0;
     memcpy(buf, s, n);
     buf[n] = '\0';
     char *endp;

@@ -53,6 +53,18 @@ int main(void)
         "1.00000000000000000000000", "3.0827000141143799", "0.80000001192092896"};
     for (size_t i = 0; i < sizeof fixed / sizeof *fixed; i++) same(fixed[i]);
 
+    /* Longer than 127 bytes: not a number, fast path or not. */
+    {
+        char longnum[200];
+        memset(longnum, '0', sizeof longnum);
+        longnum[198] = '1';
+        longnum[199] = '\0';
+        double v = 0;
+        CHECK_EQ_INT(vw__parse_double(longnum, 199, &v), 0);
+        CHECK_EQ_INT(vw__parse_double(longnum + 72, 127, &v), 1);
+        CHECK(v == 1.0);
+    }
+
     char buf[96];
     /* Random doubles of every magnitude the fast path covers and beyond, printed with
        6 to 20 significant digits. */

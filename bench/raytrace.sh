@@ -9,6 +9,8 @@
 #      workers run the cells mapped onto them (--farm none: rays cross between workers
 #      as messages) and farmed (--farm all: each worker holds a copy of every cell);
 #      1 cell on 2 workers is farmed by default (--farm idle);
+#      The compute-phase ratios are also given within each round (median and range):
+#      a round runs every configuration back to back, at the machine's speed of the moment;
 #  (d) 2x2x2 against 1 cell by instruction count (callgrind): free of the noise.
 # Whole processes are timed with date +%s.%N: best of REPEAT runs, the configurations
 # interleaved (one run of each per round: the shared machine's speed drifts).
@@ -136,6 +138,18 @@ print("    compute phase only (best of %d, interleaved):" % n)
 print("      1 cell : 1 worker %.3f s, 2 workers %.3f s (speedup %.2f, farm idle)" % (one, one2, one / one2))
 print("      2x2x2  : 1 worker %.3f s (x%.2f of 1 cell), 2 workers %.3f s (speedup %.2f, farm none),"
       " %.3f s (speedup %.2f, farm all)" % (c8, c8 / one, c8w2, c8 / c8w2, c8f, c8 / c8f))
+# Each round ran the configurations back to back: a round's ratios share the machine's
+# speed of the moment, so their median and range say more than a ratio of two bests
+# (which may come from different rounds).
+def paired(a, b):
+    r = sorted(x["time_s"]["compute"] / y["time_s"]["compute"] for x, y in zip(runs(*a), runs(*b)))
+    m = r[len(r) // 2] if len(r) % 2 else (r[len(r) // 2 - 1] + r[len(r) // 2]) / 2
+    return "median %.2f (%.2f-%.2f)" % (m, r[0], r[-1])
+print("    compute phase, ratios within each round (%d rounds):" % n)
+print("      2x2x2/1 cell, 1 worker: %s" % paired(("2x2x2", 1, "none"), ("1", 1, "idle")))
+print("      2 workers vs 1: 1 cell %s; 2x2x2 farm all %s, farm none %s" % (
+    paired(("1", 1, "idle"), ("1", 2, "idle")), paired(("2x2x2", 1, "none"), ("2x2x2", 2, "all")),
+    paired(("2x2x2", 1, "none"), ("2x2x2", 2, "none"))))
 b1 = sum(w["busy_s"] for w in runs("2x2x2", 1, "none")[-1]["workers"])
 for f in ("none", "all"):
     j = runs("2x2x2", 2, f)[-1]

@@ -6,6 +6,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "cli.h"
 #include "commands.h"
@@ -23,7 +24,8 @@ static void help(void)
            "Emission comes from MTL 'Ke' (NFF: '#vw Ke r g b' after an 'f'), reflectance\n"
            "from 'Kd' (NFF: colour * Kd).\n"
            "  -o FILE.ply          vertex-coloured mesh of the solution\n"
-           "  --cells L            layout of cells, like 2x2x2 (default 1)\n"
+           "  --cells L            layout of cells, like 2x2x2 (default: 1 on one worker, else\n"
+           "                       at least 4 cells a worker: 2x2x2 for 2 workers)\n"
            "  --workers W          worker threads per process (default: number of cores)\n"
            "  --sf X               stop when max unshot power / emitted < X (default 1e-3)\n"
            "  --hemicube RES       hemicube resolution, even, <= %d (default 64)\n"
@@ -140,7 +142,7 @@ int vw_cmd_radiosity(int argc, char **argv)
     run_ctx r;
     memset(&r, 0, sizeof r);
     const char *scene_path = NULL, *view = NULL, *trace = NULL;
-    int W = 0, H = 0;
+    int W = 0, H = 0, cells_given = 0;
     long lv;
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i], *v;
@@ -156,6 +158,7 @@ int vw_cmd_radiosity(int argc, char **argv)
         } else if (!strcmp(a, "--cells")) {
             VALUE();
             if (vw_cli_layout(CMD, a, v, o.dims)) return VW_EXIT_USAGE;
+            cells_given = 1;
         } else if (!strcmp(a, "--workers")) {
             VALUE();
             if (vw_cli_int(CMD, a, v, 1, 1024, &lv)) return VW_EXIT_USAGE;
@@ -255,6 +258,23 @@ int vw_cmd_radiosity(int argc, char **argv)
     if (view && parse_view(view, &cam_view)) {
         vw_cli_error(CMD, "--view: bad value '%s' (expected fx,fy,fz,ax,ay,az[,fov])", view);
         return VW_EXIT_USAGE;
+    }
+
+    /* A radiosity cell cannot be shared by workers (a shot's bitmaps depend on the order
+       of the cells, so its messages are not independent): a worker without a cell has
+       nothing to do. Without --cells, one worker keeps the single cell (the solution of
+       reference); more get at least 4 cells each, so the mapping by element count can
+       even them out (room, 2x2x2 on 2 workers: lambda 1.01). */
+    long cores = sysconf(_SC_NPROCESSORS_ONLN);
+    int gw = (o.workers > 0 ? o.workers : cores > 0 ? (int)cores : 1) * vw_engine_size();
+    if (!cells_given)
+        for (int a = 0; gw > 1 && o.dims[0] * o.dims[1] * o.dims[2] < 4 * gw; a = (a + 1) % 3)
+            o.dims[a] *= 2;
+    else if (o.dims[0] * o.dims[1] * o.dims[2] < gw && !o.quiet && vw_cli_is_output()) {
+        int nc = o.dims[0] * o.dims[1] * o.dims[2];
+        fprintf(stderr, "vwalls radiosity: warning: %d cell%s for %d workers: %d of them will "
+                "idle (a radiosity cell cannot be shared); give --cells with at least %d cells\n",
+                nc, nc == 1 ? "" : "s", gw, gw - nc, gw);
     }
 
     double t0 = vw_cli_now();

@@ -38,4 +38,14 @@ wait $pid 2>/dev/null
 ls "$T" | grep -q "tmp\." && fail "temporary file left behind"
 "$V" radiosity "$T/cornell.nff" $opts --csv "$T/resumed.csv" --resume "$T/ck" 2>/dev/null || fail "resume"
 "$TR" csvcmp "$T/full.csv" "$T/resumed.csv" 0.01 || fail "resumed differs"
+
+# Without --cells: one cell for one worker, at least 4 a worker for more; fewer cells
+# than workers given: a warning (radiosity cells cannot be shared).
+layout() { sed -n 's/.*"layout": "\([0-9x]*\)".*/\1/p' "$1" | head -n 1; }
+"$V" radiosity "$T/cornell.nff" -o "$T/d1.ply" --workers 1 --sf 1e-2 --quiet --stats "$T/d1.json" || fail "default cells, 1 worker"
+[ "$(layout "$T/d1.json")" = 1x1x1 ] || fail "default cells for 1 worker: $(layout "$T/d1.json")"
+"$V" radiosity "$T/cornell.nff" -o "$T/d2.ply" --workers 2 --sf 1e-2 --quiet --stats "$T/d2.json" || fail "default cells, 2 workers"
+[ "$(layout "$T/d2.json")" = 2x2x2 ] || fail "default cells for 2 workers: $(layout "$T/d2.json")"
+"$V" radiosity "$T/cornell.nff" -o "$T/d3.ply" --workers 2 --cells 1 --sf 1e-2 2>"$T/err" >/dev/null || fail "1 cell, 2 workers"
+grep -q "warning: 1 cell for 2 workers: 1 of them will idle" "$T/err" || fail "no idle warning: $(cat "$T/err")"
 echo "ok"

@@ -132,7 +132,9 @@ static int do_frame(vw_anim_session *s)
         uint8_t *rgb = malloc((size_t)w * h * 3);
         if (!rgb) return s->failed = 1;
         rt_job_rgb8(job, rgb);
-        rc = vw_image_write_png(path, w, h, rgb, err, sizeof err);
+        /* Compressed on as many threads as the process has workers (idle now). */
+        rc = vw_image_write_png_threads(path, w, h, rgb, vw_world_workers(rt_job_world(job)), err,
+                                        sizeof err);
         free(rgb);
         if (rc != VW_OK) {
             vw_cli_error(s->cmd, "%s", err);

@@ -455,7 +455,7 @@ int vw_cmd_render(int argc, char **argv)
                 rc = VW_EXIT_FAIL;
             } else {
                 rt_job_rgb8(job, img);
-                if (vw_image_write_png(out, W, H, img, err, sizeof err) != VW_OK) {
+                if (vw_image_write_png_threads(out, W, H, img, vw_world_workers(w), err, sizeof err) != VW_OK) {
                     vw_cli_error(CMD, "%s", err);
                     rc = VW_EXIT_FAIL;
                 }
@@ -469,7 +469,7 @@ int vw_cmd_render(int argc, char **argv)
                     rt_job_overlay_workers(job, img);
                 else
                     rt_job_overlay(job, img);
-                if (vw_image_write_png(overlay, W, H, img, err, sizeof err) != VW_OK) {
+                if (vw_image_write_png_threads(overlay, W, H, img, vw_world_workers(w), err, sizeof err) != VW_OK) {
                     vw_cli_error(CMD, "%s", err);
                     rc = VW_EXIT_FAIL;
                 }

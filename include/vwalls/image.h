@@ -19,6 +19,11 @@ extern "C" {
    err gets "path: reason". */
 VW_API vw_status vw_image_write_png(const char *path, int w, int h, const uint8_t *rgb8,
                                     char *err, size_t errlen);
+/* The same, compressed on up to `threads` threads (blocks of 64 rows each; a serial
+   phase of every render, so the command line passes its worker count). The file's
+   bytes do not depend on the number of threads. */
+VW_API vw_status vw_image_write_png_threads(const char *path, int w, int h, const uint8_t *rgb8,
+                                            int threads, char *err, size_t errlen);
 /* Portable float map: header "PF\n<w> <h>\n-1.0\n" (negative scale: little-endian),
    then rows bottom first, as the format prescribes. */
 VW_API vw_status vw_image_write_pfm(const char *path, int w, int h, const float *rgb,

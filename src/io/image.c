@@ -101,8 +101,9 @@ static void deflate_block(png_block *b)
     deflateEnd(&z);
     free(row);
     if (ok) {
-        b->out = out;
         b->n = cap - z.avail_out;
+        unsigned char *fit = realloc(out, b->n ? b->n : 1); /* give back the bound's slack */
+        b->out = fit ? fit : out;
     } else {
         free(out);
     }
@@ -120,10 +121,10 @@ static void *deflate_blocks(void *arg)
     return NULL;
 }
 
-/* The image's zlib stream in *out (malloc'ed), compressed on up to `threads` threads;
-   0 when out of memory. */
-static int compress_image(int w, int h, const uint8_t *rgb8, int threads, unsigned char **out,
-                          size_t *n)
+/* The image's blocks (*out, nb of them), compressed on up to `threads` threads, and the
+   Adler-32 of the whole stream; 0 when out of memory (nothing allocated then). */
+static int compress_image(int w, int h, const uint8_t *rgb8, int threads, png_block **out,
+                          int *nblocks, uLong *adler)
 {
     int nb = (h + PNG_BLOCK_ROWS - 1) / PNG_BLOCK_ROWS;
     png_block *b = calloc((size_t)nb, sizeof *b);
@@ -150,38 +151,27 @@ static int compress_image(int w, int h, const uint8_t *rgb8, int threads, unsign
         else
             deflate_blocks(&crew[t]); /* no thread: this one does its blocks */
     }
-    size_t total = 2 + 4;
     int ok = 1;
+    *adler = adler32(0L, Z_NULL, 0);
     for (int i = 0; i < nb; i++) {
         ok &= b[i].out != NULL;
-        total += b[i].n;
+        *adler = adler32_combine(*adler, b[i].adler, (z_off_t)b[i].raw);
     }
-    unsigned char *z = ok ? malloc(total) : NULL;
-    if (z) {
-        /* zlib header: deflate, 32 KB window, "fast" level class, check bits */
-        z[0] = 0x78;
-        z[1] = 0x5e;
-        size_t at = 2;
-        uLong adler = adler32(0L, Z_NULL, 0);
-        for (int i = 0; i < nb; i++) {
-            memcpy(z + at, b[i].out, b[i].n);
-            at += b[i].n;
-            adler = adler32_combine(adler, b[i].adler, (z_off_t)b[i].raw);
-        }
-        for (int k = 0; k < 4; k++) z[at++] = (unsigned char)(adler >> (24 - 8 * k));
-        *out = z;
-        *n = at;
+    if (!ok) {
+        for (int i = 0; i < nb; i++) free(b[i].out);
+        free(b);
+        return 0;
     }
-    for (int i = 0; i < nb; i++) free(b[i].out);
-    free(b);
-    return z != NULL;
+    *out = b;
+    *nblocks = nb;
+    return 1;
 }
 
 /* The libpng part lives in its own function so that only its locals cross the
    setjmp; nothing here is modified after setjmp and read after longjmp. libpng frames
    the file (signature, IHDR, chunk lengths and CRCs); the image data is compressed
-   beforehand (compress_image) and written as IDAT chunks. */
-static int encode_png(FILE *f, int w, int h, const unsigned char *zdata, size_t zn,
+   beforehand (compress_image) and written as IDAT chunks, one per block. */
+static int encode_png(FILE *f, int w, int h, const png_block *b, int nb, uLong adler,
                       png_ctx *ctx)
 {
     png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, ctx, on_png_error,
@@ -204,9 +194,18 @@ static int encode_png(FILE *f, int w, int h, const unsigned char *zdata, size_t 
     png_set_IHDR(png, info, (png_uint_32)w, (png_uint_32)h, 8, PNG_COLOR_TYPE_RGB,
                  PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
     png_write_info(png, info);
-    for (size_t at = 0; at < zn; at += (size_t)1 << 18) {
-        size_t len = zn - at < (size_t)1 << 18 ? zn - at : (size_t)1 << 18;
-        png_write_chunk(png, (png_const_bytep) "IDAT", zdata + at, len);
+    /* One IDAT chunk per block (a block is at most 64 rows: far below a chunk's 2^31
+       bytes); the zlib header opens the first, the Adler-32 closes the last. */
+    static const unsigned char header[2] = {0x78, 0x5e}; /* deflate, 32 KB window */
+    unsigned char trailer[4];
+    for (int k = 0; k < 4; k++) trailer[k] = (unsigned char)(adler >> (24 - 8 * k));
+    for (int i = 0; i < nb; i++) {
+        size_t len = b[i].n + (i == 0 ? 2 : 0) + (i + 1 == nb ? 4 : 0);
+        png_write_chunk_start(png, (png_const_bytep) "IDAT", (png_uint_32)len);
+        if (i == 0) png_write_chunk_data(png, header, 2);
+        png_write_chunk_data(png, b[i].out, b[i].n);
+        if (i + 1 == nb) png_write_chunk_data(png, trailer, 4);
+        png_write_chunk_end(png);
     }
     png_write_chunk(png, (png_const_bytep) "IEND", NULL, 0);
     png_destroy_write_struct(&png, &info);
@@ -218,21 +217,20 @@ VW_API vw_status vw_image_write_png_threads(const char *path, int w, int h, cons
 {
     if (!check_size(path, w, h, rgb8, err, errlen))
         return VW_E_INVAL;
-    unsigned char *z = NULL;
-    size_t zn = 0;
-    if (!compress_image(w, h, rgb8, threads, &z, &zn)) {
+    png_block *b = NULL;
+    int nb = 0;
+    uLong adler = 0;
+    if (!compress_image(w, h, rgb8, threads, &b, &nb, &adler)) {
         vw__errf(err, errlen, "%s: out of memory compressing the image", path);
         return VW_E_NOMEM;
     }
     vw__atomic_file af;
     vw_status st = vw__atomic_open(&af, path, err, errlen);
-    if (st != VW_OK) {
-        free(z);
-        return st;
-    }
     png_ctx ctx = {""};
-    int ok = encode_png(af.f, w, h, z, zn, &ctx);
-    free(z);
+    int ok = st == VW_OK && encode_png(af.f, w, h, b, nb, adler, &ctx);
+    for (int i = 0; i < nb; i++) free(b[i].out);
+    free(b);
+    if (st != VW_OK) return st;
     if (!ok) {
         vw__atomic_abort(&af);
         vw__errf(err, errlen, "%s: PNG write failed: %s", path, ctx.msg);

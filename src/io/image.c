@@ -52,7 +52,8 @@ static int check_size(const char *path, int w, int h, const void *pix, char *err
 
 /* Rows per independently compressed block. Fixed, so the file's bytes do not depend on
    how many threads compress it; 64 rows of a 512-wide image are 96 KB, three times
-   zlib's window, so starting each block afresh costs ~1 % in size. */
+   zlib's window, so starting each block afresh costs little (the 512x512 sphereflake:
+   255,086 bytes against 254,725 in one stream). */
 #define PNG_BLOCK_ROWS 64
 
 /* One block: its rows Sub-filtered, as a raw deflate stream ending on a byte boundary

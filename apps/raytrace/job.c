@@ -3,7 +3,6 @@
  * and the ray members of the stats JSON. The command line and the tests drive this.
  */
 #include <math.h>
-#include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -44,9 +43,9 @@ typedef struct owners_part {
     int64_t primary;  /* pixels of these rows with an owner */
 } owners_part;
 
-static void *owners_rows(void *arg)
+static void owners_rows(int i, void *arg)
 {
-    owners_part *p = arg;
+    owners_part *p = (owners_part *)arg + i;
     const rt_view *v = &p->j->sh.view;
     int w = v->width, *owner = p->j->owner;
     int64_t primary = 0; /* (not p->primary per pixel: the parts share cache lines) */
@@ -60,7 +59,6 @@ static void *owners_rows(void *arg)
             primary += hitw;
         }
     p->primary = primary;
-    return NULL;
 }
 
 /* The cell owning each pixel's eye ray, by the walk cell_build would do (on the
@@ -87,22 +85,12 @@ static vw_status owners(rt_job *j)
     int nparts = vw_world_workers(j->world);
     nparts = nparts < 1 ? 1 : nparts > MAX_PARTS ? MAX_PARTS : nparts > h ? h : nparts;
     owners_part part[MAX_PARTS];
-    pthread_t th[MAX_PARTS];
-    int started[MAX_PARTS] = {0};
     for (int i = 0; i < nparts; i++)
         part[i] = (owners_part){j, d, (int)((int64_t)h * i / nparts),
                                 (int)((int64_t)h * (i + 1) / nparts), 0};
-    for (int i = 1; i < nparts; i++)
-        started[i] = pthread_create(&th[i], NULL, owners_rows, &part[i]) == 0;
-    owners_rows(&part[0]);
-    j->primary = part[0].primary;
-    for (int i = 1; i < nparts; i++) {
-        if (started[i])
-            pthread_join(th[i], NULL);
-        else
-            owners_rows(&part[i]); /* no thread: this one does the rows */
-        j->primary += part[i].primary;
-    }
+    vw_parallel(nparts, owners_rows, part);
+    j->primary = 0;
+    for (int i = 0; i < nparts; i++) j->primary += part[i].primary;
     vw_status st = vw_decomp_clone(d, &j->owner_decomp);
     if (st != VW_OK) return st;
     j->sh.owner = j->owner;

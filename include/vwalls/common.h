@@ -46,6 +46,12 @@ VW_API const char *vw_status_name(vw_status s);
 VW_API const char *vw_status_message(vw_status s);
 VW_API const char *vw_version(void);
 
+/* Runs fn(i, user) for every i in [0, n), each on a thread of its own (i = 0 on the
+   calling thread), and returns when all have: for a serial phase split over the
+   workers, which are idle then. A part whose thread cannot be started runs on the
+   calling thread; n above 64 runs every part there. */
+VW_API void vw_parallel(int n, void (*fn)(int i, void *user), void *user);
+
 /* A closed axis-aligned box [lo, hi]. */
 typedef struct vw_box {
     double lo[3], hi[3];

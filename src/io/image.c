@@ -6,7 +6,6 @@
  */
 #include <errno.h>
 #include <png.h>
-#include <pthread.h>
 #include <setjmp.h>
 #include <stdlib.h>
 #include <string.h>
@@ -112,14 +111,13 @@ static void deflate_block(png_block *b)
 
 typedef struct png_crew {
     png_block *blocks;
-    int nblocks, stride, first; /* this thread's blocks: first, first + stride, ... */
+    int nblocks, nthreads; /* thread t compresses blocks t, t + nthreads, ... */
 } png_crew;
 
-static void *deflate_blocks(void *arg)
+static void deflate_blocks(int t, void *arg)
 {
     png_crew *c = arg;
-    for (int i = c->first; i < c->nblocks; i += c->stride) deflate_block(&c->blocks[i]);
-    return NULL;
+    for (int i = t; i < c->nblocks; i += c->nthreads) deflate_block(&c->blocks[i]);
 }
 
 /* The image's blocks (*out, nb of them), compressed on up to `threads` threads, and the
@@ -137,21 +135,9 @@ static int compress_image(int w, int h, const uint8_t *rgb8, int threads, png_bl
         b[i].y1 = i + 1 < nb ? (i + 1) * PNG_BLOCK_ROWS : h;
         b[i].last = i + 1 == nb;
     }
-    enum { MAX_THREADS = 64 };
-    int nt = threads < 1 ? 1 : threads > MAX_THREADS ? MAX_THREADS : threads;
-    if (nt > nb) nt = nb;
-    png_crew crew[MAX_THREADS];
-    pthread_t th[MAX_THREADS];
-    int started[MAX_THREADS] = {0};
-    for (int t = 0; t < nt; t++) crew[t] = (png_crew){b, nb, nt, t};
-    for (int t = 1; t < nt; t++) started[t] = pthread_create(&th[t], NULL, deflate_blocks, &crew[t]) == 0;
-    deflate_blocks(&crew[0]);
-    for (int t = 1; t < nt; t++) {
-        if (started[t])
-            pthread_join(th[t], NULL);
-        else
-            deflate_blocks(&crew[t]); /* no thread: this one does its blocks */
-    }
+    int nt = threads < 1 ? 1 : threads > 64 ? 64 : threads;
+    png_crew crew = {b, nb, nt > nb ? nb : nt};
+    vw_parallel(crew.nthreads, deflate_blocks, &crew);
     int ok = 1;
     *adler = adler32(0L, Z_NULL, 0);
     for (int i = 0; i < nb; i++) {

@@ -17,6 +17,12 @@ static int cli_rank = 0;
 
 int vw_cli_is_output(void) { return cli_rank == 0; }
 
+int vw_cli_job_workers(long workers)
+{
+    long cores = sysconf(_SC_NPROCESSORS_ONLN);
+    return (int)(workers > 0 ? workers : cores > 0 ? cores : 1) * vw_engine_size();
+}
+
 void vw_cli_error(const char *cmd, const char *fmt, ...)
 {
     if (!vw_cli_is_output()) return;

@@ -27,6 +27,9 @@ const char *vw_cli_value(const char *cmd, int argc, char **argv, int *i);
 
 /* Is this process the one that prints (rank 0, or no MPI)? Valid after vw_cli_engine_init. */
 int vw_cli_is_output(void);
+/* Workers of the whole job: --workers W (0: the world's default, one per core) times
+   the processes. Valid after vw_cli_engine_init. */
+int vw_cli_job_workers(long workers);
 
 /* MPI set-up for the command line: initialises MPI when the process was started by a
    launcher (and the build has MPI), so the same binary runs with and without mpirun.

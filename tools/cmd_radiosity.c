@@ -6,7 +6,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <unistd.h>
 
 #include "cli.h"
 #include "commands.h"
@@ -265,8 +264,7 @@ int vw_cmd_radiosity(int argc, char **argv)
        nothing to do. Without --cells, one worker keeps the single cell (the solution of
        reference); more get at least 4 cells each, so the mapping by element count can
        even them out (room, 2x2x2 on 2 workers: lambda 1.01). */
-    long cores = sysconf(_SC_NPROCESSORS_ONLN);
-    int gw = (o.workers > 0 ? o.workers : cores > 0 ? (int)cores : 1) * vw_engine_size();
+    int gw = vw_cli_job_workers(o.workers);
     if (!cells_given)
         for (int a = 0; gw > 1 && o.dims[0] * o.dims[1] * o.dims[2] < 4 * gw; a = (a + 1) % 3)
             o.dims[a] *= 2;

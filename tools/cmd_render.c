@@ -10,7 +10,6 @@
 #include <string.h>
 #include <strings.h>
 #include <time.h>
-#include <unistd.h>
 
 #include "cli.h"
 #include "commands.h"
@@ -278,8 +277,7 @@ int vw_cmd_render(int argc, char **argv)
 
     /* Workers of the whole job, for --speeds and --slow (the world's own default when
        --workers is not given: one per core). */
-    long cores = sysconf(_SC_NPROCESSORS_ONLN);
-    int gw = (int)(workers > 0 ? workers : cores > 0 ? cores : 1) * vw_engine_size();
+    int gw = vw_cli_job_workers(workers);
     double *speeds = NULL, *slowdown = NULL;
     if (speeds_s) {
         speeds = malloc(sizeof(double) * (size_t)gw);

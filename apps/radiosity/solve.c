@@ -188,7 +188,8 @@ vw_status rad_solver_create(const rad_mesh *m, const vw_decomp *d, const rad_opt
         } else if (npieces != m->npieces || fp != want) {
             snprintf(err, errlen,
                      "%s: checkpoint of a different scene or meshing (use the same scene, --cells, "
-                     "--patch-size and --elements as the run that wrote it)", o->resume);
+                     "--patch-size and --elements as the run that wrote it; without --cells the "
+                     "layout follows the number of workers)", o->resume);
             st = VW_E_INPUT;
         }
         for (uint64_t i = 0; st == VW_OK && i < np; i++) {

@@ -11,6 +11,7 @@
 #      1 cell on 2 workers is farmed by default (--farm idle);
 #      The compute-phase ratios are also given within each round (median and range):
 #      a round runs every configuration back to back, at the machine's speed of the moment;
+#      the whole processes of those rounds likewise;
 #  (d) 2x2x2 against 1 cell by instruction count (callgrind): free of the noise.
 # Whole processes are timed with date +%s.%N: best of REPEAT runs, the configurations
 # interleaved (one run of each per round: the shared machine's speed drifts).
@@ -124,7 +125,8 @@ printf "    2x2x2    : 1 worker %6.3f s, 2 workers %6.3f s   speedup = %s  (farm
 for i in $(seq "$REPEAT"); do
   for cfg in "1 1 idle" "1 2 idle" "2x2x2 1 none" "2x2x2 2 none" "2x2x2 2 all"; do
     set -- $cfg
-    render --cells "$1" --workers "$2" --farm "$3" --stats "$T/c-$1-$2-$3-$i.json"
+    once render --cells "$1" --workers "$2" --farm "$3" --stats "$T/c-$1-$2-$3-$i.json" \
+      > "$T/c-$1-$2-$3-$i.wall"
   done
 done
 python3 - "$T" "$REPEAT" <<'EOF'
@@ -141,15 +143,24 @@ print("      2x2x2  : 1 worker %.3f s (x%.2f of 1 cell), 2 workers %.3f s (speed
 # Each round ran the configurations back to back: a round's ratios share the machine's
 # speed of the moment, so their median and range say more than a ratio of two bests
 # (which may come from different rounds).
-def paired(a, b):
-    r = sorted(x["time_s"]["compute"] / y["time_s"]["compute"] for x, y in zip(runs(*a), runs(*b)))
+def wall(c, w, f): return [float(open("%s/c-%s-%s-%s-%d.wall" % (t, c, w, f, i)).read()) for i in range(1, n + 1)]
+def median_range(r):
+    r = sorted(r)
     m = r[len(r) // 2] if len(r) % 2 else (r[len(r) // 2 - 1] + r[len(r) // 2]) / 2
     return "median %.2f (%.2f-%.2f)" % (m, r[0], r[-1])
+def paired(a, b):
+    return median_range(x["time_s"]["compute"] / y["time_s"]["compute"] for x, y in zip(runs(*a), runs(*b)))
+def paired_wall(a, b): return median_range(x / y for x, y in zip(wall(*a), wall(*b)))
 print("    compute phase, ratios within each round (%d rounds):" % n)
 print("      2x2x2/1 cell, 1 worker: %s" % paired(("2x2x2", 1, "none"), ("1", 1, "idle")))
 print("      2 workers vs 1: 1 cell %s; 2x2x2 farm all %s, farm none %s" % (
     paired(("1", 1, "idle"), ("1", 2, "idle")), paired(("2x2x2", 1, "none"), ("2x2x2", 2, "all")),
     paired(("2x2x2", 1, "none"), ("2x2x2", 2, "none"))))
+print("    whole process, ratios within each round (%d rounds):" % n)
+print("      2x2x2/1 cell, 1 worker: %s" % paired_wall(("2x2x2", 1, "none"), ("1", 1, "idle")))
+print("      2 workers vs 1: 1 cell %s; 2x2x2 farm all %s, farm none %s" % (
+    paired_wall(("1", 1, "idle"), ("1", 2, "idle")), paired_wall(("2x2x2", 1, "none"), ("2x2x2", 2, "all")),
+    paired_wall(("2x2x2", 1, "none"), ("2x2x2", 2, "none"))))
 b1 = sum(w["busy_s"] for w in runs("2x2x2", 1, "none")[-1]["workers"])
 for f in ("none", "all"):
     j = runs("2x2x2", 2, f)[-1]

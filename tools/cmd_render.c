@@ -52,7 +52,9 @@ static void help(void)
            "                   the copies read one built scene); a process hosting no cell\n"
            "                   farms them all\n"
            "  --map K          block (default) | greedy (by load) | weighted (by --speeds)\n"
-           "  --speeds LIST    relative speed of every worker, like 1,1,2,4\n"
+           "  --speeds LIST    relative speed of every worker, like 1,1,2,4: --map weighted\n"
+           "                   maps by them, and copies of cells take shares of the work\n"
+           "                   in proportion (--slow W:K gives worker W the speed 1/K)\n"
            "  --slow W:K[,..]  worker W does its work K times slower (emulates a slow machine)\n"
            "  --overlay-by B   load (default): each cell by its measured load; worker: each\n"
            "                   pixel by the worker that made its eye ray (farmed cells show\n"
@@ -345,6 +347,7 @@ int vw_cmd_render(int argc, char **argv)
     vw_config cfg;
     vw_config_init(&cfg);
     cfg.worker_slowdown = slowdown;
+    cfg.worker_speeds = speeds; /* the shares of farmed and duplicated cells' copies */
     p.config = &cfg;
     rt_job *job = NULL;
     vw_status st = rt_job_create(scene, &p, &job, err, sizeof err);

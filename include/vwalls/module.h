@@ -98,7 +98,9 @@ VW_API int vw_ctx_replicas(const vw_ctx *ctx);
    into nbatches batches numbered 0, 1, ..., nbatches - 1, and each call returns the
    number of a batch this copy is to make, or nbatches when none is left for it. Within
    one run every number is returned exactly once. Of k copies, copy r (the master is 0)
-   takes its turns r, r + k, r + 2k, ... first, an equal share as the balancer plans,
+   takes its turns r, r + k, r + 2k, ... first, an equal share as the balancer plans (with
+   vw_config.worker_speeds: a share in proportion to its worker's speed, its slots spread
+   evenly over the batch numbers),
    with no message; a copy whose turns are used up then takes the turns not yet taken
    by the other copies in its process, so a copy slowed down (a busy core) leaves its
    rest to the others. Counting restarts at every run; a cell without copies gets

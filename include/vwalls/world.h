@@ -49,6 +49,13 @@ typedef struct vw_config {
        and the per-worker loads and lambda would no longer mean the same on every
        machine. */
     int steal;
+    /* Relative speed of every global worker (processes x workers entries, all > 0;
+       copied at create), or NULL: all equal. The master and copies of a duplicated cell
+       take shares of its turns (vw_ctx_next_batch) and of the messages sent to it
+       (vw_send_cell) in proportion to their workers' speeds, so a copy on a machine
+       three times as fast makes three times the batches, also across processes, where
+       no turns are taken from a slower copy. */
+    const double *worker_speeds;
 } vw_config;
 
 /* Defaults, then the environment's stress switches. */

@@ -60,16 +60,16 @@ vw_status vw_balance_decompose(const vw_decomp *current, const vw_load_field *f,
 }
 
 /* lambda of per-cell loads on the world's current mapping, each duplicated cell's load
-   shared equally by its master and copies (as the runtime shares its rays). */
+   shared by its master and copies as the runtime shares its work (equally, or by the
+   world's worker speeds). */
 static double units_lambda(const vw_world *w, const double *load, const double *speeds)
 {
     double *t = calloc((size_t)w->gworkers, sizeof *t);
     if (!t) return 0;
     for (int c = 0; c < w->ncells; c++) {
         const vw__cell *cl = &w->cells[c];
-        double share = load[c] / (cl->nreps + 1);
-        t[cl->worker] += share;
-        for (int r = 0; r < cl->nreps; r++) t[cl->reps[r].worker] += share;
+        t[cl->worker] += load[c] * vw__unit_share(cl, 0);
+        for (int r = 0; r < cl->nreps; r++) t[cl->reps[r].worker] += load[c] * vw__unit_share(cl, r + 1);
     }
     double max = 0, sum = 0;
     for (int g = 0; g < w->gworkers; g++) {

@@ -292,13 +292,19 @@ int vw_ctx_replicas(const vw_ctx *ctx)
     return ctx->cell >= 0 ? ctx->w->cells[ctx->cell].nreps : 0;
 }
 
-/* The next of unit u's turns, u + k i (i = 0, 1, ...: its counter), or nbatches when they
-   are used up. One atomic add per batch: every value of the counter goes to one taker. */
-static uint64_t take_turn(_Atomic uint64_t *counter, int u, int k, uint64_t nbatches)
+/* The next of unit u's turns: the batch of its i-th slot in the cell's share pattern
+   (i = 0, 1, ...: its counter; u + k i with equal speeds), or nbatches when they are
+   used up. One atomic add per batch: every value of the counter goes to one taker. */
+static uint64_t take_turn(const vw__cell *c, _Atomic uint64_t *counter, int u, uint64_t nbatches)
 {
     uint64_t i = atomic_fetch_add_explicit(counter, 1, memory_order_relaxed);
-    uint64_t b = (uint64_t)u + (uint64_t)k * i;
-    return b < nbatches && b >= i ? b : nbatches; /* (b < i: wrapped) */
+    if (i >= nbatches) return nbatches; /* a unit's i-th slot is never before slot i */
+    if (!c->share_len) return i;        /* no copies: 0, 1, 2, ... */
+    uint64_t L = (uint64_t)c->share_len, n = (uint64_t)(c->share_first[u + 1] - c->share_first[u]);
+    uint64_t q = i / n;
+    if (q > (UINT64_MAX - L) / L) return nbatches;
+    uint64_t b = q * L + (uint64_t)c->share_pos[c->share_first[u] + (int)(i % n)];
+    return b < nbatches ? b : nbatches;
 }
 
 uint64_t vw_ctx_next_batch(vw_ctx *ctx, uint64_t nbatches)
@@ -307,8 +313,8 @@ uint64_t vw_ctx_next_batch(vw_ctx *ctx, uint64_t nbatches)
     vw_world *w = ctx->w;
     vw__cell *c = &w->cells[ctx->cell];
     int k = c->nreps + 1;
-    uint64_t b = take_turn(ctx->rep ? &c->reps[ctx->rep - 1].batches : &c->batches, ctx->rep,
-                           k, nbatches);
+    uint64_t b = take_turn(c, ctx->rep ? &c->reps[ctx->rep - 1].batches : &c->batches, ctx->rep,
+                           nbatches);
     if (b < nbatches || k == 1 || !w->steal) return b;
     /* Its own turns used up, a copy takes the turns the other copies in this process have
        not taken yet (the counters of copies in other processes live there): a copy
@@ -318,7 +324,7 @@ uint64_t vw_ctx_next_batch(vw_ctx *ctx, uint64_t nbatches)
         int u = (ctx->rep + i) % k;
         int worker = u ? c->reps[u - 1].worker : c->worker;
         if (vw__worker_process(w, worker) != w->rank) continue;
-        b = take_turn(u ? &c->reps[u - 1].batches : &c->batches, u, k, nbatches);
+        b = take_turn(c, u ? &c->reps[u - 1].batches : &c->batches, u, nbatches);
         if (b < nbatches) return b;
     }
     return nbatches;
@@ -391,9 +397,11 @@ void vw_send_cell(vw_ctx *ctx, int cell, int kind, const void *msg)
     const vw__cell *c = &w->cells[cell];
     if (c->nreps && kind >= 0 && kind < w->m->nkinds &&
         (w->m->kinds[kind].flags & VW_MSG_INDEPENDENT)) {
-        /* A duplicated cell: the master and its copies in turn. The receiving worker
-           finds its copy by (cell, worker), so the header needs no copy number. */
-        unsigned u = c->rr[(size_t)ctx->wk->local * VW__RR_STRIDE]++ % (unsigned)(c->nreps + 1);
+        /* A duplicated cell: the master and its copies in turn, slot after slot of its
+           share pattern. The receiving worker finds its copy by (cell, worker), so the
+           header needs no copy number. */
+        unsigned x = c->rr[(size_t)ctx->wk->local * VW__RR_STRIDE]++;
+        int u = c->share_seq[x % (unsigned)c->share_len];
         if (u) dest = c->reps[u - 1].worker;
     }
     enqueue(ctx, dest, dest, cell, kind, msg);

@@ -137,11 +137,22 @@ static void write_body(vw_world *w, FILE *f, const char *command, const char *ex
     for (int g = 0; g < w->gworkers; g++) {
         const vw__worker_stats *ws = &w->wstats[g];
         uint64_t rss = vw__worker_process(w, g) == w->rank || !ws->peak_rss ? rss_here : ws->peak_rss;
-        fprintf(f, "    {\"id\": %d, \"process\": %d, \"busy_s\": %.6f, \"peak_rss_bytes\": %llu, \"messages\": %llu, \"bytes\": %llu, \"remote_count\": %llu, \"remote_bytes\": %llu}%s\n",
+        fprintf(f, "    {\"id\": %d, \"process\": %d, \"busy_s\": %.6f, \"peak_rss_bytes\": %llu, \"messages\": %llu, \"bytes\": %llu, \"remote_count\": %llu, \"remote_bytes\": %llu",
                 g, vw__worker_process(w, g), vw_world_worker_busy(w, g), (unsigned long long)rss,
                 (unsigned long long)ws->msgs_sent, (unsigned long long)ws->bytes_sent,
-                (unsigned long long)ws->msgs_remote, (unsigned long long)ws->bytes_remote,
-                g + 1 < w->gworkers ? "," : "");
+                (unsigned long long)ws->msgs_remote, (unsigned long long)ws->bytes_remote);
+        /* The module's counters of the units (cells, copies) on this worker: what each
+           worker made, e.g. a farmed cell's eye rays by copy. */
+        if (w->m->ncounters > 0) {
+            fprintf(f, ", \"counters\": {");
+            for (int k = 0; k < w->m->ncounters; k++) {
+                fprintf(f, "%s", k ? ", " : "");
+                json_string(f, w->m->counters[k]);
+                fprintf(f, ": %lld", (long long)vw_world_worker_counter(w, g, k));
+            }
+            fprintf(f, "}");
+        }
+        fprintf(f, "}%s\n", g + 1 < w->gworkers ? "," : "");
     }
     /* Per process: the sums of its workers (messages sent, and what left the process). */
     fprintf(f, "  ],\n  \"processes\": [\n");

@@ -8,6 +8,7 @@
 #include "core/world_internal.h"
 #include "vwalls/engine.h"
 
+#include <math.h>
 #include <stdarg.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -143,6 +144,7 @@ static void free_cells(vw_world *w)
         for (int r = 0; r < cl->nreps; r++) free_replica(w, &cl->reps[r]);
         free(cl->reps);
         free(cl->rr);
+        free(cl->share_seq);
         free(cl->objs);
         free(cl->counters);
     }
@@ -150,6 +152,22 @@ static void free_cells(vw_world *w)
     free(w->cell_worker);
     w->cells = NULL;
     w->cell_worker = NULL;
+}
+
+/* cfg.worker_speeds, one per global worker, into the world's own copy. */
+static vw_status copy_speeds(vw_world *w)
+{
+    const double *s = w->cfg.worker_speeds;
+    w->cfg.worker_speeds = NULL; /* the caller's array may go; w->speeds stays */
+    if (!s) return VW_OK;
+    for (int g = 0; g < w->gworkers; g++)
+        if (!(s[g] > 0) || !isfinite(s[g]))
+            return vw__world_error(w, VW_E_INVAL, "worker %d has speed %g: speeds must be "
+                                   "positive and finite", g, s[g]);
+    w->speeds = malloc(sizeof(double) * (size_t)w->gworkers);
+    if (!w->speeds) return VW_E_NOMEM;
+    memcpy(w->speeds, s, sizeof(double) * (size_t)w->gworkers);
+    return VW_OK;
 }
 
 vw_status vw_world_create(const vw_module *m, void *user, const vw_decomp *d, const vw_config *c,
@@ -211,6 +229,7 @@ vw_status vw_world_create(const vw_module *m, void *user, const vw_decomp *d, co
         wk->tr_proc = vw__calloc_lines(2 * (size_t)w->nprocs, sizeof *wk->tr_proc);
         if (!wk->out || !wk->tr_proc) st = VW_E_NOMEM;
     }
+    if (st == VW_OK) st = copy_speeds(w);
     if (st == VW_OK) st = map_cells(w, c ? c->cell_worker : NULL);
     if (st != VW_OK) {
         vw_world_free(w);
@@ -226,6 +245,7 @@ void vw_world_free(vw_world *w)
     vw__runtime_stop(w);
     if (w->transport) w->transport->free(w);
     free(w->wstats);
+    free(w->speeds);
     free_cells(w);
     if (w->workers) {
         for (int i = 0; i < w->nworkers; i++) {
@@ -387,6 +407,9 @@ static uint64_t world_fingerprint(const vw_world *w)
         h = fnv1a(h, &cl->nreps, sizeof cl->nreps);
         for (int r = 0; r < cl->nreps; r++)
             h = fnv1a(h, &cl->reps[r].worker, sizeof cl->reps[r].worker);
+        /* The shares (worker speeds): processes that disagreed would make some batches
+           twice and others never. */
+        if (cl->share_len) h = fnv1a(h, cl->share_seq, sizeof(int) * (size_t)cl->share_len);
     }
     const double *F = vw_decomp_frame(w->decomp);
     if (F) h = fnv1a(h, F, 9 * sizeof *F);
@@ -402,7 +425,7 @@ vw_status vw_world_commit(vw_world *w)
         if (r >= 0)
             return vw__world_error(w, VW_E_STATE,
                                    "process %d was given another world than process 0 (walls, "
-                                   "mapping, copies or number of objects differ): every process "
+                                   "mapping, copies, speeds or number of objects differ): every process "
                                    "must run the same command on the same input", r);
     }
     vw_status st = vw__runtime_build(w);
@@ -502,6 +525,90 @@ int vw__cell_rep_of(const vw_world *w, int cell, int worker)
     return -1;
 }
 
+/* The share pattern of a duplicated cell (see vw__cell): of L = 16 k slots for its k
+   units, unit u gets n_u in proportion to its worker's speed (largest remainders; at
+   least one), laid out by smooth weighted round-robin so that each unit's slots are
+   spread evenly. Equal speeds give the plain round-robin: unit u has slots u, u + k,
+   u + 2k, ... */
+static vw_status build_shares(vw_world *w, vw__cell *c)
+{
+    free(c->share_seq);
+    c->share_seq = c->share_pos = c->share_first = NULL;
+    c->share_len = 0;
+    int k = c->nreps + 1;
+    if (k == 1) return VW_OK;
+    int L = 16 * k;
+    int *blk = malloc(sizeof(int) * (size_t)(2 * L + k + 1));
+    double *want = malloc(sizeof(double) * (size_t)k);
+    long *cur = malloc(sizeof(long) * (size_t)k);
+    if (!blk || !want || !cur) {
+        free(blk), free(want), free(cur);
+        return VW_E_NOMEM;
+    }
+    int *seq = blk, *pos = blk + L, *first = blk + 2 * L, *n = first; /* n: counts, then offsets */
+    double total = 0;
+    for (int u = 0; u < k; u++) {
+        int g = u ? c->reps[u - 1].worker : c->worker;
+        want[u] = w->speeds ? w->speeds[g] : 1.0;
+        total += want[u];
+    }
+    int given = 0;
+    for (int u = 0; u < k; u++) {
+        want[u] = L * want[u] / total;
+        n[u] = (int)want[u];
+        want[u] -= n[u];
+        given += n[u];
+    }
+    for (; given < L; given++) { /* the largest remainders (the lowest unit on ties) */
+        int best = 0;
+        for (int u = 1; u < k; u++)
+            if (want[u] > want[best]) best = u;
+        n[best]++;
+        want[best] = -1;
+    }
+    for (int u = 0; u < k; u++)
+        if (n[u] == 0) { /* a very slow worker still gets a slot, from the largest share */
+            int big = 0;
+            for (int v = 1; v < k; v++)
+                if (n[v] > n[big]) big = v;
+            n[big]--;
+            n[u] = 1;
+        }
+    for (int u = 0; u < k; u++) cur[u] = 0;
+    for (int j = 0; j < L; j++) {
+        int best = 0;
+        for (int u = 0; u < k; u++) {
+            cur[u] += n[u];
+            if (cur[u] > cur[best]) best = u;
+        }
+        seq[j] = best;
+        cur[best] -= L;
+    }
+    /* Counts to offsets (in place), then each unit's slots in ascending order. */
+    int off = 0;
+    for (int u = 0; u <= k; u++) {
+        int cnt = u < k ? n[u] : 0;
+        first[u] = off;
+        off += cnt;
+    }
+    for (int u = 0, p = 0; u < k; u++)
+        for (int j = 0; j < L; j++)
+            if (seq[j] == u) pos[p++] = j;
+    free(want);
+    free(cur);
+    c->share_seq = seq;
+    c->share_pos = pos;
+    c->share_first = first;
+    c->share_len = L;
+    return VW_OK;
+}
+
+double vw__unit_share(const vw__cell *c, int u)
+{
+    if (!c->share_len) return 1.0;
+    return (double)(c->share_first[u + 1] - c->share_first[u]) / c->share_len;
+}
+
 vw_status vw_world_set_replicas(vw_world *w, int cell, const int *workers, int n)
 {
     if (!w || cell < 0 || cell >= w->ncells || n < 0 || (n && !workers)) return VW_E_INVAL;
@@ -553,6 +660,8 @@ vw_status vw_world_set_replicas(vw_world *w, int cell, const int *workers, int n
     c->nreps = n;
     if (!n) free(nr);
     w->committed = 0;
+    st = build_shares(w, c);
+    if (st != VW_OK) return st;
     return assign_units(w);
 }
 

@@ -75,6 +75,15 @@ typedef struct vw__cell {
                                 (one counter per sender and cell, so each cell's copies get
                                 equal shares whatever else the sender sends), at
                                 rr[local * VW__RR_STRIDE]: a cache line per sender */
+    /* A duplicated cell's work shared among its units (0 = the master, r = copy
+       reps[r - 1]) in proportion to their workers' speeds (vw_config.worker_speeds;
+       equal without them): a pattern of share_len slots repeated for ever, share_seq[j]
+       the unit of slot j. Unit u's slots, ascending, are share_pos[share_first[u] ..
+       share_first[u + 1]): its i-th turn (vw_ctx_next_batch) is the batch of its i-th
+       slot, and messages sent to the cell go to the units slot after slot
+       (vw_send_cell). All NULL / 0 without copies (build_shares, world.c). */
+    int share_len;
+    int *share_seq, *share_pos, *share_first;
     void *state;             /* the module's cell state */
     int built, dirty;
     size_t *objs;            /* ids of the objects overlapping the cell */
@@ -159,6 +168,7 @@ struct vw_world {
     int nworkers;              /* per process */
     int gworkers;              /* all processes */
     int steal;                 /* cfg.steal decided (vw_ctx_next_batch) */
+    double *speeds;            /* cfg.worker_speeds copied (gworkers), or NULL */
     int ncells;
     vw__cell *cells;
     int *cell_worker;          /* cell -> global worker */
@@ -194,6 +204,9 @@ struct vw_world {
 };
 
 /* world.c */
+/* The fraction of a cell's work that its unit u (0 = the master, r = copy r) takes: 1
+   without copies. */
+double vw__unit_share(const vw__cell *c, int u);
 vw_status vw__world_error(vw_world *w, vw_status st, const char *fmt, ...)
     __attribute__((format(printf, 3, 4)));
 int vw__worker_process(const vw_world *w, int global_worker);

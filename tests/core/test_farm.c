@@ -3,7 +3,8 @@
  * whatever the interleaving. With vw_config.steal off each copy makes exactly its
  * turns (copy r of k: r, r + k, ...); with it on, a copy whose turns are used up takes
  * the turns the others have not taken, so a copy on a slowed-down worker (emulated with
- * vw_config.worker_slowdown) leaves most of its share to the fast one.
+ * vw_config.worker_slowdown) leaves most of its share to the fast one. With worker
+ * speeds (vw_config.worker_speeds) the shares follow them.
  *
  * usage: test_farm [--stress]   (also honours VW_STRESS)
  */
@@ -64,8 +65,8 @@ static const vw_module farm_module = {
 
 /* Runs `runs` times a world of one cell with a copy on every other worker; returns the
    batches worker 0 made per run on average. Every batch is made once in every run. */
-static int64_t farm_runs(int workers, int steal, const double *slowdown, uint64_t nbatches,
-                         int runs, uint64_t stress)
+static int64_t farm_runs(int workers, int steal, const double *slowdown, const double *speeds,
+                         uint64_t nbatches, int runs, uint64_t stress)
 {
     vw_box box = {{0, 0, 0}, {1, 1, 1}};
     int dims[3] = {1, 1, 1};
@@ -78,6 +79,7 @@ static int64_t farm_runs(int workers, int steal, const double *slowdown, uint64_
     cfg.workers = workers;
     cfg.steal = steal;
     cfg.worker_slowdown = slowdown;
+    cfg.worker_speeds = speeds;
     if (stress && !cfg.stress_seed) cfg.stress_seed = stress;
     vw_world *w;
     CHECK_EQ_INT(vw_world_create(&farm_module, &f, d, &cfg, &w), VW_OK);
@@ -108,20 +110,35 @@ int main(int argc, char **argv)
 {
     uint64_t stress = argc > 1 && !strcmp(argv[1], "--stress") ? 7 : 0;
     /* Off: exactly the turns, equal shares (101 batches: the master gets one more). */
-    int64_t mine = farm_runs(2, 0, NULL, 101, 3, stress);
+    int64_t mine = farm_runs(2, 0, NULL, NULL, 101, 3, stress);
     EXPECT(mine == 51, "steal off: worker 0 made %lld of 101 batches a run, not its 51 turns",
            (long long)mine);
     /* On, the copy's worker 8 times slower: the master takes most of the copy's turns. */
     static const double slow[2] = {1.0, 8.0};
-    mine = farm_runs(2, 1, slow, 400, 2, stress);
+    mine = farm_runs(2, 1, slow, NULL, 400, 2, stress);
     EXPECT(mine > 260, "steal on, copy slowed 8x: worker 0 made only %lld of 400 batches",
            (long long)mine);
+    /* Off, with worker speeds 1 and 3: the master's share is exactly a quarter (8 of
+       every 32 slots), and three quarters when the speeds are swapped. */
+    static const double s13[2] = {1.0, 3.0}, s31[2] = {3.0, 1.0};
+    mine = farm_runs(2, 0, NULL, s13, 400, 2, stress);
+    EXPECT(mine == 100, "steal off, speeds 1,3: worker 0 made %lld of 400 batches a run, not 100",
+           (long long)mine);
+    mine = farm_runs(2, 0, NULL, s31, 400, 2, stress);
+    EXPECT(mine == 300, "steal off, speeds 3,1: worker 0 made %lld of 400 batches a run, not 300",
+           (long long)mine);
     /* Many copies, every batch once, under any interleaving (more workers than cores
-       too: the copies race for the turns left). */
+       too: the copies race for the turns left), with equal and with unequal speeds
+       (a very slow worker still gets a slot). */
+    static const double mixed[6] = {1.0, 2.5, 0.001, 7.0, 1.0, 3.0};
     for (int workers = 2; workers <= 6; workers += 2)
-        for (int steal = 0; steal <= 1; steal++) farm_runs(workers, steal, NULL, 997, 3, stress);
+        for (int steal = 0; steal <= 1; steal++) {
+            farm_runs(workers, steal, NULL, NULL, 997, 3, stress);
+            farm_runs(workers, steal, NULL, mixed, 997, 2, stress);
+        }
     /* Fewer batches than copies: most copies get none. */
-    farm_runs(6, 1, NULL, 3, 2, stress);
+    farm_runs(6, 1, NULL, NULL, 3, 2, stress);
+    farm_runs(6, 0, NULL, mixed, 3, 2, stress);
     printf("farm: %d failures\n", vw_test_failures);
     return vw_test_failures ? 1 : 0;
 }

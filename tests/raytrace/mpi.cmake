@@ -11,17 +11,24 @@ if(NOT rc EQUAL 0)
   message(FATAL_ERROR "threads engine: exit ${rc}: ${err}")
 endif()
 # np; cells; workers; farm (copies of cells: none, on idle workers and processes
-# (1 cell on 2 processes), on every worker)
+# (1 cell on 2 processes), on every worker); worker speeds (the copies' shares follow
+# them across processes: checked below)
 foreach(case "2;2x2x2;1;none" "2;4x1x2;2;none" "3;2x2;1;none" "2;1;1;idle" "3;1;2;idle"
-             "2;2x2x2;2;all")
+             "2;2x2x2;2;all" "2;1;1;idle;1,3")
   list(GET case 0 np)
   list(GET case 1 cells)
   list(GET case 2 workers)
   list(GET case 3 farm)
+  set(speeds "")
+  list(LENGTH case ncase)
+  if(ncase GREATER 4)
+    list(GET case 4 sp)
+    set(speeds --speeds ${sp})
+  endif()
   set(out ${WORK}/np${np}_${cells}_${workers}_${farm}.png)
   execute_process(COMMAND ${MPIRUN} ${NPFLAG} ${np} ${pre} ${VWALLS} render ${SCENE} -o ${out}
                           --size 80x60 --cells ${cells} --workers ${workers} --farm ${farm}
-                          --quiet --stats ${WORK}/np${np}.json
+                          ${speeds} --quiet --stats ${WORK}/np${np}.json
                   RESULT_VARIABLE rc ERROR_VARIABLE err TIMEOUT 60)
   if(NOT rc EQUAL 0)
     message(FATAL_ERROR "mpirun -np ${np} --cells ${cells}: exit ${rc}: ${err}")
@@ -36,6 +43,18 @@ foreach(case "2;2x2x2;1;none" "2;4x1x2;2;none" "3;2x2;1;none" "2;1;1;idle" "3;1;
   string(FIND "${json}" "\"processes\": ${np}" at)
   if(at LESS 0)
     message(FATAL_ERROR "stats JSON does not say ${np} processes")
+  endif()
+  if(speeds)
+    # Speeds 1,3: the master on process 0 makes a quarter of the cell's eye rays (8 of
+    # every 32 batches), the copy on process 1 the rest; no turns cross processes.
+    string(JSON p0 GET "${json}" workers 0 counters pixels)
+    string(JSON p1 GET "${json}" workers 1 counters pixels)
+    math(EXPR all "${p0} + ${p1}")
+    math(EXPR lo "${all} / 5")
+    math(EXPR hi "${all} * 3 / 10")
+    if(p0 LESS lo OR p0 GREATER hi)
+      message(FATAL_ERROR "--speeds ${sp}: process 0 made ${p0} of ${all} eye rays, not about a quarter")
+    endif()
   endif()
 endforeach()
 message(STATUS "raytrace_mpi: identical to the threads engine")

@@ -144,9 +144,13 @@ void rad_hemicube_raster(const rad_hemicube *h, const double (*hv)[3], int nv, c
         while (kept > 1 && fabs(X[0] - X[kept - 1]) + fabs(Y[0] - Y[kept - 1]) < 1e-12) kept--;
         np = kept;
         if (np < 3) continue;
+        /* Comparisons, not fmin/fmax: gcc calls libm for those (their NaN rules), ~3 %
+           of a solve; a NaN is skipped either way. */
         for (int i = 0; i < np; i++) {
-            xmin = fmin(xmin, X[i]), xmax = fmax(xmax, X[i]);
-            ymin = fmin(ymin, Y[i]), ymax = fmax(ymax, Y[i]);
+            if (X[i] < xmin) xmin = X[i];
+            if (X[i] > xmax) xmax = X[i];
+            if (Y[i] < ymin) ymin = Y[i];
+            if (Y[i] > ymax) ymax = Y[i];
         }
         for (int i = 0; i < np; i++) {
             int k = (i + 1) % np;

@@ -30,7 +30,7 @@ static void help(void)
            "  --hemicube RES       hemicube resolution, even, <= %d (default 64)\n"
            "  --patch-size S       largest patch side (default: scene extent / 10)\n"
            "  --elements K         receiver elements per patch side (default 2)\n"
-           "  --per-round K        shots per cell between convergence checks (default 4)\n"
+           "  --per-round K        shots per cell between convergence checks (default 16)\n"
            "  --neighbourhood D    a shot reaches only cells within D of the shooter\n"
            "  --subdivide T        split elements whose radiosity varies inside them (or differs\n"
            "                       from a neighbour's by 2T) by more than T relative to the mean\n"

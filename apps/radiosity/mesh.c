@@ -23,7 +23,7 @@ void rad_options_init(rad_options *o)
     o->res = 64;
     o->elem_split = 2;
     o->dims[0] = o->dims[1] = o->dims[2] = 1;
-    o->per_round = 4;
+    o->per_round = 16;
     o->max_level = 3;
     o->checkpoint_every = 60;
 }

@@ -183,13 +183,14 @@ static void test_agree(int bad)
 
 /* A world given differently to one process (the last) fails to commit on every process,
    with a message naming it, instead of running on and meeting packets it cannot read:
-   other walls, another mapping, or other copies. The same world commits. */
+   other walls, another mapping, other copies, or other worker speeds (the copies'
+   shares: every process must agree on who makes which batch). The same world commits. */
 static void test_mismatch(int workers)
 {
     int rank = vw_engine_rank(), size = vw_engine_size(), bad = size - 1;
     vw_box box = {{0, 0, 0}, {1, 1, 1}};
-    static const char *const what_name[] = {"same", "walls", "mapping", "copies"};
-    for (int what = 0; what < 4; what++) {
+    static const char *const what_name[] = {"same", "walls", "mapping", "copies", "speeds"};
+    for (int what = 0; what < 5; what++) {
         int differs = what > 0 && rank == bad && size > 1;
         int dims[3] = {2, 2, differs && what == 1 ? 1 : 2};
         vw_decomp *d;
@@ -203,9 +204,13 @@ static void test_mismatch(int workers)
         vw_config_init(&cfg);
         cfg.workers = workers;
         cfg.cell_worker = map;
+        double *speeds = malloc(sizeof(double) * (size_t)gw);
+        for (int g = 0; g < gw; g++) speeds[g] = differs && what == 4 && g == 0 ? 3.0 : 1.0;
+        cfg.worker_speeds = speeds;
         vw_world *w;
         CHECK_EQ_INT(vw_world_create(&storm_module, &st, d, &cfg, &w), VW_OK);
-        if (differs && what == 3) {
+        free(speeds); /* the world keeps its own copy */
+        if ((differs && what == 3) || (what == 4 && gw > 1)) {
             int other = (map[0] + 1) % gw;
             CHECK_EQ_INT(vw_world_set_replicas(w, 0, &other, 1), VW_OK);
         }

@@ -525,30 +525,26 @@ int vw__cell_rep_of(const vw_world *w, int cell, int worker)
     return -1;
 }
 
-/* The share pattern of a duplicated cell (see vw__cell): of L = 16 k slots for its k
-   units, unit u gets n_u in proportion to its worker's speed (largest remainders; at
-   least one), laid out by smooth weighted round-robin so that each unit's slots are
-   spread evenly. Equal speeds give the plain round-robin: unit u has slots u, u + k,
-   u + 2k, ... */
-static vw_status build_shares(vw_world *w, vw__cell *c)
+/* The share pattern of a cell whose master is on worker `master` with copies on
+   workers[0..k-1) (see vw__cell): of L = 16 k slots, unit u gets n_u in proportion to
+   its worker's speed (largest remainders; at least one), laid out by smooth weighted
+   round-robin so that each unit's slots are spread evenly. Equal speeds give the plain
+   round-robin: unit u has slots u, u + k, u + 2k, ... Returns one block holding
+   share_seq (L), share_pos (L) and share_first (k + 1), or NULL (out of memory). */
+static int *make_shares(const vw_world *w, int master, const int *workers, int k)
 {
-    free(c->share_seq);
-    c->share_seq = c->share_pos = c->share_first = NULL;
-    c->share_len = 0;
-    int k = c->nreps + 1;
-    if (k == 1) return VW_OK;
     int L = 16 * k;
     int *blk = malloc(sizeof(int) * (size_t)(2 * L + k + 1));
     double *want = malloc(sizeof(double) * (size_t)k);
     long *cur = malloc(sizeof(long) * (size_t)k);
     if (!blk || !want || !cur) {
         free(blk), free(want), free(cur);
-        return VW_E_NOMEM;
+        return NULL;
     }
     int *seq = blk, *pos = blk + L, *first = blk + 2 * L, *n = first; /* n: counts, then offsets */
     double total = 0;
     for (int u = 0; u < k; u++) {
-        int g = u ? c->reps[u - 1].worker : c->worker;
+        int g = u ? workers[u - 1] : master;
         want[u] = w->speeds ? w->speeds[g] : 1.0;
         total += want[u];
     }
@@ -596,11 +592,7 @@ static vw_status build_shares(vw_world *w, vw__cell *c)
             if (seq[j] == u) pos[p++] = j;
     free(want);
     free(cur);
-    c->share_seq = seq;
-    c->share_pos = pos;
-    c->share_first = first;
-    c->share_len = L;
-    return VW_OK;
+    return blk;
 }
 
 double vw__unit_share(const vw__cell *c, int u)
@@ -638,9 +630,12 @@ vw_status vw_world_set_replicas(vw_world *w, int cell, const int *workers, int n
     }
     unsigned *rr = n ? vw__calloc_lines((size_t)w->nworkers * VW__RR_STRIDE, sizeof *rr) : NULL;
     if (n && !rr) st = VW_E_NOMEM;
+    int *shares = n && st == VW_OK ? make_shares(w, c->worker, workers, n + 1) : NULL;
+    if (n && !shares) st = VW_E_NOMEM;
     if (st != VW_OK) {
         for (int i = 0; i < n; i++) free(nr[i].counters);
         free(nr);
+        free(rr);
         return st;
     }
     for (int i = 0; i < n; i++)
@@ -659,9 +654,12 @@ vw_status vw_world_set_replicas(vw_world *w, int cell, const int *workers, int n
     c->reps = n ? nr : NULL;
     c->nreps = n;
     if (!n) free(nr);
+    free(c->share_seq);
+    c->share_len = n ? 16 * (n + 1) : 0;
+    c->share_seq = shares;
+    c->share_pos = shares ? shares + c->share_len : NULL;
+    c->share_first = shares ? shares + 2 * c->share_len : NULL;
     w->committed = 0;
-    st = build_shares(w, c);
-    if (st != VW_OK) return st;
     return assign_units(w);
 }
 

@@ -73,7 +73,7 @@ typedef struct vw__cell {
     int farmed;              /* every worker of this process holds a copy (set per run) */
     unsigned *rr;            /* duplicated cells: per local worker, the next copy to send to
                                 (one counter per sender and cell, so each cell's copies get
-                                equal shares whatever else the sender sends), at
+                                their shares whatever else the sender sends), at
                                 rr[local * VW__RR_STRIDE]: a cache line per sender */
     /* A duplicated cell's work shared among its units (0 = the master, r = copy
        reps[r - 1]) in proportion to their workers' speeds (vw_config.worker_speeds;
@@ -81,7 +81,7 @@ typedef struct vw__cell {
        the unit of slot j. Unit u's slots, ascending, are share_pos[share_first[u] ..
        share_first[u + 1]): its i-th turn (vw_ctx_next_batch) is the batch of its i-th
        slot, and messages sent to the cell go to the units slot after slot
-       (vw_send_cell). All NULL / 0 without copies (build_shares, world.c). */
+       (vw_send_cell). All NULL / 0 without copies (make_shares, world.c). */
     int share_len;
     int *share_seq, *share_pos, *share_first;
     void *state;             /* the module's cell state */

@@ -11,7 +11,8 @@
 #      1 cell on 2 workers is farmed by default (--farm idle);
 #      The compute-phase ratios are also given within each round (median and range):
 #      a round runs every configuration back to back, at the machine's speed of the moment;
-#      the whole processes of those rounds likewise;
+#      the whole processes of those rounds likewise, and the phases of the one-cell runs
+#      (what does not shrink with a second worker bounds the whole-process speedup);
 #  (d) 2x2x2 against 1 cell by instruction count (callgrind): free of the noise.
 # Whole processes are timed with date +%s.%N: best of REPEAT runs, the configurations
 # interleaved (one run of each per round: the shared machine's speed drifts).
@@ -161,6 +162,17 @@ print("      2x2x2/1 cell, 1 worker: %s" % paired_wall(("2x2x2", 1, "none"), ("1
 print("      2 workers vs 1: 1 cell %s; 2x2x2 farm all %s, farm none %s" % (
     paired_wall(("1", 1, "idle"), ("1", 2, "idle")), paired_wall(("2x2x2", 1, "none"), ("2x2x2", 2, "all")),
     paired_wall(("2x2x2", 1, "none"), ("2x2x2", 2, "none"))))
+# Where the whole process goes besides the compute phase (medians over the rounds, ms):
+# the phases that do not shrink with a second worker bound the whole-process speedup.
+def phases(c, w, f):
+    js, walls = runs(c, w, f), wall(c, w, f)
+    med = lambda xs: sorted(xs)[len(xs) // 2]
+    ph = ["load", "build", "compute", "write"]
+    out = ", ".join("%s %.1f" % (p, 1e3 * med([j["time_s"][p] for j in js])) for p in ph)
+    rest = med([wl - j["time_s"]["total"] for j, wl in zip(js, walls)])
+    return "%s, outside them (start, exit) %.1f" % (out, 1e3 * rest)
+print("    phases, 1 cell (medians, ms): 1 worker: %s" % phases("1", 1, "idle"))
+print("                                 2 workers: %s" % phases("1", 2, "idle"))
 b1 = sum(w["busy_s"] for w in runs("2x2x2", 1, "none")[-1]["workers"])
 for f in ("none", "all"):
     j = runs("2x2x2", 2, f)[-1]

@@ -169,8 +169,18 @@ vw_status rt_cell_geo_build(void *device, const rt_object *objects, size_t n, rt
     if (!g->obj || !g->sph_map || !g->tri_map || !g->cone_map) return VW_E_NOMEM;
     if (n) memcpy(g->obj, objects, n * sizeof *g->obj);
     g->nobj = n;
+    for (int a = 0; a < 3; a++) {
+        g->bounds.lo[a] = INFINITY;
+        g->bounds.hi[a] = -INFINITY;
+    }
     size_t ns = 0, nt = 0, nc = 0;
     for (size_t i = 0; i < n; i++) {
+        vw_box b;
+        rt_object_bounds(&g->obj[i], 0, &b);
+        for (int a = 0; a < 3; a++) {
+            if (b.lo[a] < g->bounds.lo[a]) g->bounds.lo[a] = b.lo[a];
+            if (b.hi[a] > g->bounds.hi[a]) g->bounds.hi[a] = b.hi[a];
+        }
         switch (g->obj[i].kind) {
         case RT_SPHERE: g->sph_map[ns++] = (uint32_t)i; break;
         case RT_TRIANGLE: g->tri_map[nt++] = (uint32_t)i; break;

@@ -12,6 +12,8 @@ typedef struct rt_cell_geo {
     size_t nobj;
     uint32_t *sph_map, *tri_map, *cone_map; /* Embree primID -> index in obj */
     int geom_kind[3];            /* Embree geomID -> rt_kind */
+    vw_box bounds;               /* of the objects (world coordinates); empty (lo > hi)
+                                    without any */
 } rt_cell_geo;
 
 typedef struct rt_hit {

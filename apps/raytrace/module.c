@@ -60,6 +60,11 @@ typedef struct rt_cell {
        cell's step() before its worker goes idle, so none is left at the run's end. */
     int64_t tally[RT_NCOUNTERS];
     unsigned frame;       /* the run eye_done describes */
+    /* The reach of the cell's objects: their bounds (world coordinates) with a margin
+       for Embree's float arithmetic (cell_reach). A segment that misses it cannot hit
+       anything here, so Embree is not called; tested only when `bounded`. */
+    vw_box reach;
+    int bounded;
 } rt_cell;
 
 static const char *const counter_names[RT_NCOUNTERS] = {
@@ -318,6 +323,20 @@ static void shade(vw_ctx *ctx, rt_cell *c, const rt_ray *r, const rt_hit *h)
     }
 }
 
+/* Whether the box around the ray's segment [tn, t1] (its two ends' bounds) meets the
+   reach of the cell's objects: if not, no point of the segment does. Six multiply-adds
+   and comparisons, so it costs far less than the Embree call it can spare. A NaN
+   anywhere counts as a meeting, so Embree decides. */
+static inline int meets_reach(const rt_cell *c, const rt_ray *r, double tn)
+{
+    for (int a = 0; a < 3; a++) {
+        double p = r->org[a] + tn * r->dir[a], q = r->org[a] + r->t1 * r->dir[a];
+        double lo = p < q ? p : q, hi = p < q ? q : p;
+        if (hi < c->reach.lo[a] || lo > c->reach.hi[a]) return 0;
+    }
+    return 1;
+}
+
 /* Search this cell's segment [t0, t1] of the ray; on a miss pass the ray on to the next
    cell of its walk (restarted at t1, which splits the interval exactly as the full walk
    does), or end it when the walk leaves the world. A next cell on this same worker is
@@ -334,7 +353,9 @@ static int walk_ray(vw_ctx *ctx, rt_cell *c, rt_ray *r)
            gcc keeps the call, whose NaN rules maxsd does not follow. */
         double tn = r->t0 > c->sh->eps ? r->t0 : c->sh->eps;
         rt_hit h;
-        if (r->kind == RT_SHADOW) {
+        if (c->bounded && !meets_reach(c, r, tn)) {
+            /* nothing of this cell on the segment: on to the next cell */
+        } else if (r->kind == RT_SHADOW) {
             if (rt_cell_geo_occluded(c->geo, r->org, r->dir, tn, r->t1)) {
                 c->tally[RT_C_ENDED]++;
                 return entered;
@@ -469,6 +490,55 @@ static void cell_free(void *state, void *user)
     free(c);
 }
 
+/* The reach of the cell's objects (see rt_cell), and whether it leaves a tenth of the
+   cell's volume or more empty (the test is not worth its cost for less).
+   The margin: Embree intersects in floats, the ray and the objects rounded to 24 bits,
+   so a hit it reports can lie about 1e-7 of the magnitudes involved (the origin's
+   coordinates, t, the objects' coordinates) off the double-precision ray. Every ray
+   starts at the eye or inside the world box, so those magnitudes are at most three
+   times the larger of the eye's and the world corners' coordinate sums (1-norms); the
+   margin is 1e-5 of that, a hundred times the error. */
+static void cell_reach(vw_ctx *ctx, rt_cell *c)
+{
+    const vw_decomp *d = vw_ctx_decomp(ctx);
+    vw_box w = vw_decomp_world(d), b = vw_ctx_cell_box(ctx);
+    const double *F = vw_decomp_frame(d);
+    const double *eye = c->sh->view.eye;
+    double m = fabs(eye[0]) + fabs(eye[1]) + fabs(eye[2]);
+    vw_box cell = {{INFINITY, INFINITY, INFINITY}, {-INFINITY, -INFINITY, -INFINITY}};
+    for (int i = 0; i < 8; i++) {
+        const vw_box *boxes[2] = {&b, &w};
+        for (int k = 0; k < 2; k++) {
+            const vw_box *x = boxes[k];
+            double q[3] = {(i & 1) ? x->hi[0] : x->lo[0], (i & 2) ? x->hi[1] : x->lo[1],
+                           (i & 4) ? x->hi[2] : x->lo[2]};
+            double p[3], norm = 0;
+            for (int a = 0; a < 3; a++) { /* frame -> world: p = F^T q */
+                p[a] = F ? F[0 * 3 + a] * q[0] + F[1 * 3 + a] * q[1] + F[2 * 3 + a] * q[2] : q[a];
+                norm += fabs(p[a]);
+            }
+            if (k == 1) {
+                if (norm > m) m = norm;
+                continue;
+            }
+            for (int a = 0; a < 3; a++) {
+                if (p[a] < cell.lo[a]) cell.lo[a] = p[a];
+                if (p[a] > cell.hi[a]) cell.hi[a] = p[a];
+            }
+        }
+    }
+    double pad = 1e-5 * 3 * m;
+    double vcell = 1, vboth = 1;
+    for (int a = 0; a < 3; a++) {
+        c->reach.lo[a] = c->geo->bounds.lo[a] - pad;
+        c->reach.hi[a] = c->geo->bounds.hi[a] + pad;
+        double lo = fmax(c->reach.lo[a], cell.lo[a]), hi = fmin(c->reach.hi[a], cell.hi[a]);
+        vcell *= cell.hi[a] - cell.lo[a];
+        vboth *= hi > lo ? hi - lo : 0;
+    }
+    c->bounded = isfinite(pad) && vboth < 0.9 * vcell;
+}
+
 static vw_status cell_build(vw_ctx *ctx, const void *objects, size_t n, void **state)
 {
     /* Whole cache lines: cells of different workers never share one (the package and
@@ -479,7 +549,10 @@ static vw_status cell_build(vw_ctx *ctx, const void *objects, size_t n, void **s
     memset(c, 0, bytes);
     c->sh = vw_ctx_user(ctx);
     vw_status st = rt_geo_acquire(c->sh->geo_cache, c->sh->device, objects, n, &c->geo);
-    if (st == VW_OK) st = primary_pixels(ctx, c);
+    if (st == VW_OK) {
+        cell_reach(ctx, c);
+        st = primary_pixels(ctx, c);
+    }
     if (st != VW_OK) {
         cell_free(c, NULL);
         return st;

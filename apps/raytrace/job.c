@@ -16,6 +16,7 @@ struct rt_job {
     int *owner;          /* cell of each pixel's eye ray, -1 = misses (every process:
                             cell_build reads it, see rt_shared.owner) */
     vw_decomp *owner_decomp; /* the decomposition owner[] was computed on */
+    int *owner_first, *owner_pixels; /* owner[] by cell (rt_shared.owner_first) */
     int64_t primary;     /* pixels with an owner */
     int ran;
 };
@@ -31,6 +32,8 @@ void rt_job_free(rt_job *j)
     free(j->sh.accum);
     free(j->sh.eye_worker);
     free(j->owner);
+    free(j->owner_first);
+    free(j->owner_pixels);
     vw_decomp_free(j->owner_decomp);
     free(j);
 }
@@ -73,12 +76,15 @@ static vw_status owners(rt_job *j)
     int w = j->sh.view.width, h = j->sh.view.height;
     j->sh.owner = NULL;
     j->sh.owner_decomp = NULL;
+    j->sh.owner_first = j->sh.owner_pixels = NULL;
     vw_decomp_free(j->owner_decomp);
     j->owner_decomp = NULL;
-    if (!j->owner) {
-        j->owner = malloc((size_t)w * (size_t)h * sizeof *j->owner);
-        if (!j->owner) return VW_E_NOMEM;
-    }
+    free(j->owner_first);
+    j->owner_first = malloc(((size_t)vw_decomp_cell_count(d) + 1) * sizeof *j->owner_first);
+    if (!j->owner_first) return VW_E_NOMEM;
+    if (!j->owner) j->owner = malloc((size_t)w * (size_t)h * sizeof *j->owner);
+    if (!j->owner_pixels) j->owner_pixels = malloc((size_t)w * (size_t)h * sizeof *j->owner_pixels);
+    if (!j->owner || !j->owner_pixels) return VW_E_NOMEM;
     /* A serial phase of every render (~15 ms at 512x512 here): the rows are shared
        among as many threads as the process has workers (which are idle now). */
     enum { MAX_PARTS = 64 };
@@ -91,10 +97,25 @@ static vw_status owners(rt_job *j)
     vw_parallel(nparts, owners_rows, part);
     j->primary = 0;
     for (int i = 0; i < nparts; i++) j->primary += part[i].primary;
+    /* Sorted by cell (a counting sort, which keeps each cell's pixels in order): every
+       cell takes its own slice, where each would otherwise scan the whole map. */
+    int ncells = vw_decomp_cell_count(d);
+    int *first = j->owner_first;
+    size_t npix = (size_t)w * (size_t)h;
+    memset(first, 0, ((size_t)ncells + 1) * sizeof *first);
+    for (size_t i = 0; i < npix; i++)
+        if (j->owner[i] >= 0) first[j->owner[i] + 1]++;
+    for (int c = 0; c < ncells; c++) first[c + 1] += first[c];
+    for (size_t i = 0; i < npix; i++)
+        if (j->owner[i] >= 0) j->owner_pixels[first[j->owner[i]]++] = (int)i;
+    for (int c = ncells; c > 0; c--) first[c] = first[c - 1]; /* back to the starts */
+    first[0] = 0;
     vw_status st = vw_decomp_clone(d, &j->owner_decomp);
     if (st != VW_OK) return st;
     j->sh.owner = j->owner;
     j->sh.owner_decomp = j->owner_decomp;
+    j->sh.owner_first = j->owner_first;
+    j->sh.owner_pixels = j->owner_pixels;
     return VW_OK;
 }
 

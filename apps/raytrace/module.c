@@ -433,6 +433,15 @@ static vw_status primary_pixels(vw_ctx *ctx, rt_cell *c)
     const int *owner = c->sh->owner;
     if (owner && vw_decomp_equal(c->sh->owner_decomp, d)) {
         /* The job's map, made by the same walk once per process: no walk here. */
+        if (sample == 1) { /* this cell's slice of the map sorted by cell */
+            const int *first = c->sh->owner_first;
+            size_t n = (size_t)(first[me + 1] - first[me]);
+            c->pixels = malloc((n ? n : 1) * sizeof *c->pixels);
+            if (!c->pixels) return VW_E_NOMEM;
+            if (n) memcpy(c->pixels, c->sh->owner_pixels + first[me], n * sizeof *c->pixels);
+            c->npixels = n;
+            return VW_OK;
+        }
         for (int y = 0; y < v->height; y += sample)
             for (int x = 0; x < v->width; x += sample) {
                 if (owner[(size_t)y * v->width + x] != me) continue;

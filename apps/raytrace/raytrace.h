@@ -103,6 +103,9 @@ typedef struct rt_shared {
        walks the pixels itself otherwise. NULL when not computed. */
     const int *owner;
     const vw_decomp *owner_decomp;
+    /* The same map sorted by cell: cell c's pixels, in increasing order, are
+       owner_pixels[owner_first[c] .. owner_first[c + 1]) (set with owner). */
+    const int *owner_first, *owner_pixels;
     /* Every process: record which worker makes each eye ray (rt_job_record_eye_workers):
        the cell sends it to the output process with the pixel's contributions. */
     int record_eye_workers;

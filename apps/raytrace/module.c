@@ -353,7 +353,9 @@ static int walk_ray(vw_ctx *ctx, rt_cell *c, rt_ray *r)
            gcc keeps the call, whose NaN rules maxsd does not follow. */
         double tn = r->t0 > c->sh->eps ? r->t0 : c->sh->eps;
         rt_hit h;
-        if (c->bounded && !meets_reach(c, r, tn)) {
+        /* (A segment from the ray's origin is not tested: a secondary ray starts on an
+           object of the cell that spawned it, so its first segment meets the reach.) */
+        if (c->bounded && r->t0 > 0 && !meets_reach(c, r, tn)) {
             /* nothing of this cell on the segment: on to the next cell */
         } else if (r->kind == RT_SHADOW) {
             if (rt_cell_geo_occluded(c->geo, r->org, r->dir, tn, r->t1)) {

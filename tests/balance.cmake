@@ -6,6 +6,8 @@
 
 add_executable(vw_test_balance ${PROJECT_SOURCE_DIR}/tests/balance/bal_test.c)
 target_link_libraries(vw_test_balance PRIVATE vwalls_apps)
+# (the duplication planner is tested on its own: src/balance/balance_internal.h)
+target_include_directories(vw_test_balance PRIVATE ${PROJECT_SOURCE_DIR}/src)
 
 set(VW_BAL_TSAN "TSAN_OPTIONS=suppressions=${PROJECT_SOURCE_DIR}/tests/raytrace/tsan.supp")
 add_test(NAME balance_identical_spheres COMMAND vw_test_balance identical spheres:0.5:2 48x48)

@@ -43,7 +43,8 @@ vw_status vw__balance_staggered(const vw_decomp *cur, const vw_load_field *f,
                                 const vw_balance_params *p, const int dims[3], vw_decomp **out);
 /* Duplication plan on the current cells (load per cell, its master's worker): npairs
    copies (pair_cell[i] gets a copy on pair_worker[i]; arrays of max_extra entries) and
-   the predicted lambda with each cell's load shared equally by its copies. */
+   the predicted lambda with each cell's load shared by its copies in proportion to
+   their workers' speeds (equally when speeds is NULL), as the runtime shares it. */
 vw_status vw__balance_duplicate_plan(const double *load, const int *cell_worker, int ncells,
                                      int gworkers, const double *speeds, double tolerance,
                                      int max_extra, int *pair_cell, int *pair_worker, int *npairs,

@@ -4,11 +4,17 @@
  * and the neighbourhood do not change; only the duplicated cells' objects move.
  *
  * Plan: k_c copies of cell c (1: the master alone). Each round gives one more copy to
- * the cell with the largest share L_c / k_c, then places all the non-master shares
- * afresh, largest first, each on the least loaded worker that holds no share of its cell
- * yet (masters stay where they are). Placing afresh, not adding to the last placement,
- * lets a round undo an earlier round's choice. The best placement seen is kept; rounds
- * end at lambda <= 1 + tolerance or after max_extra copies.
+ * the cell whose copies take longest, then places all the non-master shares afresh,
+ * largest first, each on the worker that holds no share of its cell yet and would be
+ * done first (masters stay where they are). Placing afresh, not adding to the last
+ * placement, lets a round undo an earlier round's choice. The best placement seen is
+ * kept; rounds end at lambda <= 1 + tolerance or after max_extra copies.
+ * A placement is judged as the runtime will run it: the copies of a cell share its work
+ * in proportion to their workers' speeds (vw_config.worker_speeds, the same speeds), so
+ * each copy of cell c takes L_c / S_c, S_c the sum of its copies' speeds (L_c / k_c with
+ * equal speeds), and a worker's time is the sum of that over the cells it holds. The
+ * placement itself sizes shares as L_c / k_c: the speeds of the copies still to place
+ * are not known yet.
  * Cost: O(max_extra * (S log S + S * workers)) for S shares, plus cells * workers bytes.
  */
 #include "balance/balance_internal.h"
@@ -42,8 +48,10 @@ vw_status vw__balance_duplicate_plan(const double *load, const int *cell_worker,
     int *pc = malloc(sizeof(int) * (size_t)(max_extra > 0 ? max_extra : 1));
     int *pw = malloc(sizeof(int) * (size_t)(max_extra > 0 ? max_extra : 1));
     unsigned char *holds = malloc((size_t)ncells * (size_t)gworkers);
-    if (!t || !k || !sh || !pc || !pw || !holds) {
-        free(t), free(k), free(sh), free(pc), free(pw), free(holds);
+    double *span = malloc(sizeof(double) * (size_t)ncells); /* L_c / S_c, see above */
+    double *time = malloc(sizeof(double) * (size_t)gworkers);
+    if (!t || !k || !sh || !pc || !pw || !holds || !span || !time) {
+        free(t), free(k), free(sh), free(pc), free(pw), free(holds), free(span), free(time);
         return VW_E_NOMEM;
     }
     for (int c = 0; c < ncells; c++) k[c] = 1;
@@ -75,11 +83,21 @@ vw_status vw__balance_duplicate_plan(const double *load, const int *cell_worker,
             pc[i] = c;
             pw[i] = gmin;
         }
+        /* The placement as the runtime runs it: shares by speed. */
+        for (int g = 0; g < gworkers; g++) time[g] = 0;
+        for (int c = 0; c < ncells; c++) {
+            const unsigned char *h = &holds[(size_t)c * gworkers];
+            double S = 0;
+            for (int g = 0; g < gworkers; g++)
+                if (h[g]) S += speeds ? speeds[g] : 1.0;
+            span[c] = S > 0 ? load[c] / S : 0;
+            for (int g = 0; g < gworkers; g++)
+                if (h[g]) time[g] += span[c];
+        }
         double max = 0, sum = 0;
         for (int g = 0; g < gworkers; g++) {
-            double x = speeds ? t[g] / speeds[g] : t[g];
-            sum += x;
-            if (x > max) max = x;
+            sum += time[g];
+            if (time[g] > max) max = time[g];
         }
         double lam = sum > 0 ? max / (sum / gworkers) : 1.0;
         if (best < 0 || lam < best - 1e-12) {
@@ -89,16 +107,16 @@ vw_status vw__balance_duplicate_plan(const double *load, const int *cell_worker,
             memcpy(pair_worker, pw, sizeof(int) * (size_t)ns);
         }
         if (lam <= 1.0 + tolerance || extra >= max_extra) break;
-        /* One more copy for the cell with the largest share that can still have one. */
+        /* One more copy for the cell whose copies take longest that can still have one. */
         int heavy = -1;
         for (int c = 0; c < ncells; c++)
-            if (load[c] > 0 && k[c] < gworkers && (heavy < 0 || load[c] / k[c] > load[heavy] / k[heavy]))
+            if (load[c] > 0 && k[c] < gworkers && (heavy < 0 || span[c] > span[heavy]))
                 heavy = c;
         if (heavy < 0) break;
         k[heavy]++;
         extra++;
     }
     *lambda = best;
-    free(t), free(k), free(sh), free(pc), free(pw), free(holds);
+    free(t), free(k), free(sh), free(pc), free(pw), free(holds), free(span), free(time);
     return VW_OK;
 }

@@ -22,6 +22,7 @@
 #include <string.h>
 
 #include "../vw_test.h"
+#include "balance/balance_internal.h"
 #include "raytrace/raytrace.h"
 #include "vwalls/gen.h"
 #include "vwalls/vwalls.h"
@@ -503,8 +504,51 @@ static int t_map(void)
 
 /* ---- duplicate ------------------------------------------------------------------------- */
 
+/* The plan alone (vw__balance_duplicate_plan), on loads whose best plan and lambda are
+   known: a copy's share of its cell follows its worker's speed, as the runtime's does. */
+static void duplicate_plans(void)
+{
+    int pc[8], pw[8], np;
+    double lam;
+    /* One cell (load 4) on worker 0 of two with speeds 1 and 3: one copy on worker 1;
+       the copies take 1 and 3 of the 4 and are done together (lambda 1). With equal
+       shares (2 and 2) the plan would have predicted 1.5. */
+    {
+        double load[1] = {4}, speeds[2] = {1, 3};
+        int cw[1] = {0};
+        EXPECT(vw__balance_duplicate_plan(load, cw, 1, 2, speeds, 0.03, 8, pc, pw, &np, &lam) == VW_OK,
+               "plan");
+        EXPECT(np == 1 && pc[0] == 0 && pw[0] == 1, "speeds 1,3: %d copies", np);
+        EXPECT(fabs(lam - 1.0) < 1e-12, "speeds 1,3: lambda %.6f, expected 1", lam);
+    }
+    /* Two cells of load 3 on the two workers (speeds 1, 3): lambda 3 / 2 before; the
+       slow worker's cell gets a copy (1.75 / 1.25 = 1.4), then the other one (1). */
+    {
+        double load[2] = {3, 3}, speeds[2] = {1, 3};
+        int cw[2] = {0, 1};
+        EXPECT(vw__balance_duplicate_plan(load, cw, 2, 2, speeds, 0.03, 8, pc, pw, &np, &lam) == VW_OK,
+               "plan");
+        EXPECT(np == 2, "two cells, speeds 1,3: %d copies, expected 2", np);
+        EXPECT(fabs(lam - 1.0) < 1e-12, "two cells, speeds 1,3: lambda %.6f, expected 1", lam);
+        EXPECT(vw__balance_duplicate_plan(load, cw, 2, 2, speeds, 0.03, 1, pc, pw, &np, &lam) == VW_OK,
+               "plan");
+        EXPECT(np == 1 && pc[0] == 0 && pw[0] == 1 && fabs(lam - 1.4) < 1e-12,
+               "one copy at most: cell %d on worker %d, lambda %.6f, expected cell 0 on 1, 1.4",
+               np ? pc[0] : -1, np ? pw[0] : -1, lam);
+    }
+    /* Equal speeds (NULL): loads 6 and 2 -> copies of both, lambda 1. */
+    {
+        double load[2] = {6, 2};
+        int cw[2] = {0, 1};
+        EXPECT(vw__balance_duplicate_plan(load, cw, 2, 2, NULL, 0.03, 8, pc, pw, &np, &lam) == VW_OK,
+               "plan");
+        EXPECT(np == 2 && fabs(lam - 1.0) < 1e-12, "loads 6,2: %d copies, lambda %.6f", np, lam);
+    }
+}
+
 static int t_duplicate(void)
 {
+    duplicate_plans();
     /* The runtime: copies are built from the cell's objects (the load() checksum of a
        cell with n copies is (n + 1) times its objects' sum, also after an object moved),
        and bad copy lists are refused. */

@@ -45,7 +45,7 @@ for scene in uniform cluster50 cluster100 oblique; do
     for s in none tensor rotate staggered divide duplicate; do
       # Deterministic: one worker per cell, loads = counted ray-cell visits.
       "$VWALLS" render "$OUT/$scene.nff" -o "$OUT/img.png" --size "$SIZE" --cells "$L" \
-        --workers "$cells" --balance "$s" --balance-load segments --quiet \
+        --workers "$cells" --farm none --balance "$s" --balance-load segments --quiet \
         --stats "$OUT/w.json"
       read -r lw mig nb < <(json "$OUT/w.json" "['balance_detail']['imbalance_work']" \
         "['balance_detail']['migrated_objects']" "['balance_detail']['max_neighbours']")
@@ -53,7 +53,7 @@ for scene in uniform cluster50 cluster100 oblique; do
       best=""; lb=""
       for _ in 1 2 3; do
         "$VWALLS" render "$OUT/$scene.nff" -o "$OUT/img.png" --size "$SIZE" --cells "$L" \
-          --workers 2 --balance "$s" --quiet --stats "$OUT/b.json"
+          --workers 2 --farm none --balance "$s" --quiet --stats "$OUT/b.json"
         read -r c l < <(json "$OUT/b.json" "['time_s']['compute']" "['balance']['imbalance']")
         if [ -z "$best" ] || awk -v a="$c" -v b="$best" 'BEGIN { exit !(a < b) }'; then best=$c; lb=$l; fi
       done
@@ -104,7 +104,7 @@ cat "$MOVING"
 # Walls before and after for the 50% clustered scene (8 cells, staggered), and the
 # mapping of 16 cells onto 2 workers.
 "$VWALLS" render "$OUT/cluster50.nff" -o "$OUT/img.png" --size 384x384 --cells 2x2x2 --workers 8 \
-  --quiet --overlay "$OUT/walls_before.png"
+  --farm none --quiet --overlay "$OUT/walls_before.png"
 "$VWALLS" render "$OUT/cluster50.nff" -o "$OUT/img.png" --size 384x384 --cells 2x2x2 --workers 8 \
   --balance staggered --balance-load segments --quiet --overlay "$OUT/walls_staggered.png"
 "$VWALLS" render "$OUT/cluster50.nff" -o "$OUT/img.png" --size 384x384 --cells 2x2x2 --workers 8 \

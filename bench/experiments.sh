@@ -143,10 +143,13 @@ launch() { # launch ENGINE PROCS COMMAND...: the command itself or under mpirun
   local engine=$1 procs=$2; shift 2
   if [ "$engine" = mpi ]; then "$MPIRUN" -np "$procs" "${MPIFLAGS[@]}" "$@"; else "$@"; fi
 }
+# The paper's setting: cells mapped onto the workers, rays crossing between workers as
+# messages (--farm none; the default would farm the cells among a process's workers).
 render() { # render ENGINE PROCS SCENE LAYOUT WORKERS [options...]
   local engine=$1 procs=$2 scene=$3 layout=$4 workers=$5; shift 5
   launch "$engine" "$procs" "$VW" render "$OUT/scenes/$scene.nff" -o "$T/$scene.png" \
-    --size "${SIZE}x${SIZE}" --depth 5 --cells "$layout" --workers "$workers" --quiet --stats "$J" "$@"
+    --size "${SIZE}x${SIZE}" --depth 5 --cells "$layout" --workers "$workers" --farm none \
+    --quiet --stats "$J" "$@"
 }
 radiosity() { # radiosity ENGINE PROCS LAYOUT WORKERS [options...]
   local engine=$1 procs=$2 layout=$3 workers=$4; shift 4

@@ -8,7 +8,7 @@
 #      the compute phase alone (from the stats) and the two workers' busy time. Two
 #      workers run the cells mapped onto them (--farm none: rays cross between workers
 #      as messages) and farmed (--farm all: each worker holds a copy of every cell);
-#      1 cell on 2 workers is farmed by default (--farm idle);
+#      1 cell on 2 workers is farmed by default (--farm auto: all);
 #      The compute-phase ratios are also given within each round (median and range):
 #      a round runs every configuration back to back, at the machine's speed of the moment;
 #      the whole processes of those rounds likewise, and the phases of the one-cell runs
@@ -138,7 +138,7 @@ def best(c, w, f): return min(j["time_s"]["compute"] for j in runs(c, w, f))
 one, one2 = best("1", 1, "idle"), best("1", 2, "idle")
 c8, c8w2, c8f = best("2x2x2", 1, "none"), best("2x2x2", 2, "none"), best("2x2x2", 2, "all")
 print("    compute phase only (best of %d, interleaved):" % n)
-print("      1 cell : 1 worker %.3f s, 2 workers %.3f s (speedup %.2f, farm idle)" % (one, one2, one / one2))
+print("      1 cell : 1 worker %.3f s, 2 workers %.3f s (speedup %.2f, farm auto)" % (one, one2, one / one2))
 print("      2x2x2  : 1 worker %.3f s (x%.2f of 1 cell), 2 workers %.3f s (speedup %.2f, farm none),"
       " %.3f s (speedup %.2f, farm all)" % (c8, c8 / one, c8w2, c8 / c8w2, c8f, c8 / c8f))
 # Each round ran the configurations back to back: a round's ratios share the machine's

@@ -45,12 +45,14 @@ static void help(void)
            "                     take up to 3 more, stopping when no gain is predicted)\n"
            "  --prepass N      pre-pass traces every N-th row and column (default: about 256\n"
            "                   eye rays per cell, N between 1 and 8)\n"
-           "  --farm F         idle (default) | all | none: the workers of a process share\n"
-           "                   its cells by holding copies; idle: only workers that host no\n"
-           "                   cell get copies (of all the process's cells), all: every worker\n"
-           "                   gets one of every cell (rays cross only to other processes;\n"
-           "                   the copies read one built scene); a process hosting no cell\n"
-           "                   farms them all\n"
+           "  --farm F         auto (default) | all | idle | none: the workers of a process\n"
+           "                   share its cells by holding copies; all: every worker gets one\n"
+           "                   of every cell (rays cross only to other processes; the copies\n"
+           "                   read one built scene); idle: only workers that host no cell get\n"
+           "                   copies (of all the process's cells); none: the mapping alone;\n"
+           "                   auto: all, or idle when --balance or --map is given (even\n"
+           "                   none or block: their plan decides which worker runs which\n"
+           "                   cell); a process hosting no cell farms them all\n"
            "  --map K          block (default) | greedy (by load) | weighted (by --speeds)\n"
            "  --speeds LIST    relative speed of every worker, like 1,1,2,4: --map weighted\n"
            "                   maps by them, and copies of cells take shares of the work\n"
@@ -157,9 +159,9 @@ int vw_cmd_render(int argc, char **argv)
     int has_from = 0, has_at = 0, has_up = 0, has_angle = 0;
     const char *speeds_s = NULL, *slow_s = NULL;
     vw_balance_strategy strategy = VW_BALANCE_NONE;
-    int farm = RT_FARM_IDLE, farm_copies = 0;
+    int farm = -1, farm_copies = 0; /* -1: auto, resolved once the options are read */
     vw_map_kind map = VW_MAP_BLOCK;
-    int map_given = 0, by_worker = 0;
+    int map_given = 0, balance_given = 0, by_worker = 0;
     long iters = 2, prepass = 0; /* 0: rt_prepass_stride() */
     vw_load_spec lspec;
     vw_load_spec_init(&lspec);
@@ -195,6 +197,7 @@ int vw_cmd_render(int argc, char **argv)
                                   "staggered, divide or duplicate)", v);
                 return VW_EXIT_USAGE;
             }
+            balance_given = 1;
         } else if (!strcmp(a, "--balance-load")) {
             if (!(v = vw_cli_value(CMD, argc, argv, &i))) return VW_EXIT_USAGE;
             if (!strcmp(v, "busy")) {
@@ -224,10 +227,11 @@ int vw_cmd_render(int argc, char **argv)
             map_given = 1;
         } else if (!strcmp(a, "--farm")) {
             if (!(v = vw_cli_value(CMD, argc, argv, &i))) return VW_EXIT_USAGE;
-            if ((farm = rt_farm_parse(v)) < 0) {
-                vw_cli_error(CMD, "--farm: bad value '%s' (expected idle, all or none)", v);
+            if (strcmp(v, "auto") && (farm = rt_farm_parse(v)) < 0) {
+                vw_cli_error(CMD, "--farm: bad value '%s' (expected auto, all, idle or none)", v);
                 return VW_EXIT_USAGE;
             }
+            if (!strcmp(v, "auto")) farm = -1;
         } else if (!strcmp(a, "--speeds")) {
             if (!(speeds_s = vw_cli_value(CMD, argc, argv, &i))) return VW_EXIT_USAGE;
         } else if (!strcmp(a, "--slow")) {
@@ -362,6 +366,10 @@ int vw_cmd_render(int argc, char **argv)
     /* The mapping of the initial cells (greedy and weighted refine it by load after the
        pre-pass, when there is one). */
     int balancing = strategy != VW_BALANCE_NONE || map != VW_MAP_BLOCK;
+    /* --farm auto: every worker holds every cell of its process, the fastest on one
+       machine (a ray stays on its worker: no messages, no waiting for another worker),
+       unless a balancer or a mapping was asked for: then their plan runs as planned. */
+    if (farm < 0) farm = balance_given || map_given ? RT_FARM_IDLE : RT_FARM_ALL;
     rt_balance_result bi;
     memset(&bi, 0, sizeof bi);
     if ((map_given || speeds) && rt_job_map(job, map, NULL, speeds, err, sizeof err) != VW_OK) {

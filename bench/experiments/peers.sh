@@ -68,9 +68,9 @@ mem() { # mem ENGINE P W LAYOUT
   local j=$T/mem.json
   rm -f "$j"
   if [ "$1" = mpi ]; then
-    "$MPIRUN" -np "$2" "${MPIFLAGS[@]}" "$VW" render "$big" -o "$T/big.png" --size 128x128 --cells "$4" --workers "$3" --quiet --stats "$j" >/dev/null 2>&1
+    "$MPIRUN" -np "$2" "${MPIFLAGS[@]}" "$VW" render "$big" -o "$T/big.png" --size 128x128 --cells "$4" --workers "$3" --farm none --quiet --stats "$j" >/dev/null 2>&1
   else
-    "$VW" render "$big" -o "$T/big.png" --size 128x128 --cells "$4" --workers "$3" --quiet --stats "$j" >/dev/null 2>&1
+    "$VW" render "$big" -o "$T/big.png" --size 128x128 --cells "$4" --workers "$3" --farm none --quiet --stats "$j" >/dev/null 2>&1
   fi
   [ -s "$j" ] || { echo "peers: memory run $* failed" >&2; return; }
   local mx mn sm
@@ -90,7 +90,7 @@ fi
 rm -f "$OUT"/overlay-*.png
 hard=$OUT/scenes/s1000-c1.nff
 if [ -f "$hard" ]; then
-  "$VW" render "$hard" -o "$T/o.png" --size "${SIZE}x${SIZE}" --cells 2x4 --workers 8 --quiet \
+  "$VW" render "$hard" -o "$T/o.png" --size "${SIZE}x${SIZE}" --cells 2x4 --workers 8 --farm none --quiet \
     --overlay "$OUT/overlay-none.png" --stats "$T/o.json" >/dev/null 2>&1
   if [ "$HAVE_BALANCE" = 1 ]; then
     for b in $BALANCE; do

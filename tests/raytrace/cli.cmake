@@ -15,16 +15,37 @@ function(render out cells workers)
 endfunction()
 
 render(${WORK}/ref.png 1 1 --stats ${WORK}/ref.json --overlay ${WORK}/ref_overlay.png)
+# Each layout farmed (the default, --farm auto: all) and mapped alone (--farm none).
 foreach(case "2;2" "2x4;1" "2x2x2;2" "4x4x4;4" "3x1x2;3")
   list(GET case 0 cells)
   list(GET case 1 workers)
-  render(${WORK}/img_${cells}_${workers}.png ${cells} ${workers})
-  execute_process(COMMAND ${CMAKE_COMMAND} -E compare_files ${WORK}/ref.png
-                          ${WORK}/img_${cells}_${workers}.png RESULT_VARIABLE same)
-  if(NOT same EQUAL 0)
-    message(FATAL_ERROR "--cells ${cells} --workers ${workers}: PNG differs from 1 cell, 1 worker")
+  foreach(farm auto none)
+    render(${WORK}/img_${cells}_${workers}_${farm}.png ${cells} ${workers} --farm ${farm})
+    execute_process(COMMAND ${CMAKE_COMMAND} -E compare_files ${WORK}/ref.png
+                            ${WORK}/img_${cells}_${workers}_${farm}.png RESULT_VARIABLE same)
+    if(NOT same EQUAL 0)
+      message(FATAL_ERROR "--cells ${cells} --workers ${workers} --farm ${farm}: PNG differs "
+                          "from 1 cell, 1 worker")
+    endif()
+  endforeach()
+endforeach()
+
+# --farm auto: all, or idle when --balance or --map is given (even none / block).
+foreach(case "all" "idle;--balance;none" "idle;--map;block" "none;--farm;none")
+  list(GET case 0 want)
+  set(opts ${case})
+  list(REMOVE_AT opts 0)
+  render(${WORK}/farm.png 2x2x2 2 --stats ${WORK}/farm.json ${opts})
+  file(READ ${WORK}/farm.json json)
+  if(NOT json MATCHES "\"farm\": \"${want}\"")
+    message(FATAL_ERROR "--cells 2x2x2 --workers 2 ${opts}: expected farm ${want} in the stats")
   endif()
 endforeach()
+execute_process(COMMAND ${VWALLS} render ${SCENE} -o ${WORK}/farm.png --farm most --quiet
+                RESULT_VARIABLE rc ERROR_VARIABLE err)
+if(NOT rc EQUAL 2 OR NOT err MATCHES "--farm: bad value 'most'")
+  message(FATAL_ERROR "--farm most: exit ${rc}, expected 2 and a message (${err})")
+endif()
 
 # PFM output and the stats JSON.
 render(${WORK}/img.pfm 2x2x2 2 --stats ${WORK}/s.json --overlay ${WORK}/overlay.png)

@@ -85,8 +85,8 @@ pov2=${BEST[pov2]} c8=${BEST[c8]}
 echo "(a) vs POV-Ray 3.7 (whole process: parse + build + render + write)"
 printf "    1 thread : vwalls %6.3f s   povray %6.3f s   povray/vwalls = %s\n" "$vw1" "$pov1" "$(ratio "$pov1" "$vw1")"
 printf "    2 threads: vwalls %6.3f s   povray %6.3f s   povray/vwalls = %s  (vwalls 1 cell)\n" "$vw2" "$pov2" "$(ratio "$pov2" "$vw2")"
-printf "               vwalls %6.3f s (2x2x2 cells)          povray/vwalls = %s\n" "$vw2c" "$(ratio "$pov2" "$vw2c")"
-printf "               vwalls %6.3f s (2x2x2, farm all)      povray/vwalls = %s\n" "$vw2f" "$(ratio "$pov2" "$vw2f")"
+printf "               vwalls %6.3f s (2x2x2, farm none)     povray/vwalls = %s\n" "$vw2c" "$(ratio "$pov2" "$vw2c")"
+printf "               vwalls %6.3f s (2x2x2, farm all: the default) povray/vwalls = %s\n" "$vw2f" "$(ratio "$pov2" "$vw2f")"
 echo
 
 # (b) vs raw Embree: rays/s of vwalls' own compute phase and of the raw loop, best of

@@ -86,7 +86,9 @@ bench/experiments.sh --smoke             # the ctest version (label bench): seco
   the one-worker runs got on average $cpu_share of a core (CPU time / wall time; the rest
   of their wall time went to other jobs)
 - run $(env_ date), commit $(env_ commit), $(env_ seconds) s; images $(env_ size)x$(env_ size),
-  depth 5; radiosity of \`vwalls gen room\` with patch size 0.21 (3614 pieces on 1 cell) stops at
+  depth 5, the cells mapped onto the workers as the paper does (\`--farm none\`: rays cross
+  between workers as messages; \`vwalls render\` by default farms a process's cells among
+  its workers, see docs/balancing.md); radiosity of \`vwalls gen room\` with patch size 0.21 (3614 pieces on 1 cell) stops at
   unshot/emitted < $(env_ rsf)
 
 ## How to read the table

@@ -227,11 +227,12 @@ int vw_cmd_render(int argc, char **argv)
             map_given = 1;
         } else if (!strcmp(a, "--farm")) {
             if (!(v = vw_cli_value(CMD, argc, argv, &i))) return VW_EXIT_USAGE;
-            if (strcmp(v, "auto") && (farm = rt_farm_parse(v)) < 0) {
+            if (!strcmp(v, "auto")) {
+                farm = -1;
+            } else if ((farm = rt_farm_parse(v)) < 0) {
                 vw_cli_error(CMD, "--farm: bad value '%s' (expected auto, all, idle or none)", v);
                 return VW_EXIT_USAGE;
             }
-            if (!strcmp(v, "auto")) farm = -1;
         } else if (!strcmp(a, "--speeds")) {
             if (!(speeds_s = vw_cli_value(CMD, argc, argv, &i))) return VW_EXIT_USAGE;
         } else if (!strcmp(a, "--slow")) {

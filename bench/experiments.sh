@@ -183,6 +183,8 @@ for s in "${SCENES[@]}"; do
   last=${LAYOUTS##* }
   if [ "$(cells_of "$last")" -gt "$NPROC" ] && [ "$NPROC" -gt 1 ]; then
     row raytrace "$s" "$last" threads 1 "$NPROC" none "$REPEAT" -- render threads 1 "$s" "$last" "$NPROC"
+    # and farmed, as `vwalls render` runs by default: every worker holds every cell
+    row raytrace "$s" "$last" threads 1 "$NPROC" farm "$REPEAT" -- render threads 1 "$s" "$last" "$NPROC" --farm all
   fi
   # and on one worker: a sequential candidate too (the paper divides by the fastest one)
   row raytrace "$s" "$last" threads 1 1 none "$REPEAT" -- render threads 1 "$s" "$last" 1

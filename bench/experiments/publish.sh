@@ -24,6 +24,8 @@ q() { awk -F, -v nproc="$(env_ nproc)" "NR == 1 { for (i = 1; i <= NF; i++) c[\$
 
 true_rt=$(q '$1 == "raytrace" && v("scene") ~ /^s1000-/ && v("engine") == "threads" && v("balance") == "none" && v("workers") == nproc && nproc > 1 {
   printf "%s%s on %s cells: %.2f", (n++ ? "; " : ""), v("scene"), v("layout"), v("speedup") }')
+true_farm=$(q '$1 == "raytrace" && v("scene") ~ /^s1000-/ && v("engine") == "threads" && v("balance") == "farm" && nproc > 1 {
+  printf "%s%s on %s cells: %.2f", (n++ ? "; " : ""), v("scene"), v("layout"), v("speedup") }')
 true_rad=$(q '$1 == "radiosity" && v("engine") == "threads" && v("balance") == "none" && v("workers") == nproc && nproc > 1 {
   printf "%s%s cells: %.2f (efficiency %.2f)", (n++ ? "; " : ""), v("layout"), v("speedup"), v("efficiency") }')
 lb8=$(q '$1 == "raytrace" && v("engine") == "threads" && v("cells") == 8 && v("workers") == 8 {
@@ -116,10 +118,14 @@ bench/experiments.sh --smoke             # the ctest version (label bench): seco
   radiosity; **msgs** and **MB sent** are the runtime's messages; **RSS** is peak RSS of
   the largest process and the sum over processes.
 - $bal_note
+- **balance** \`farm\`: no balancing, the cells farmed among the workers (\`--farm all\`);
+  every other row maps the cells onto the workers (\`--farm none\`).
 
 ## Headline figures
 
-- **True speedup on this machine's $(env_ nproc) cores**, ray tracing, 1000 spheres: ${true_rt:-n/a}.
+- **True speedup on this machine's $(env_ nproc) cores**, ray tracing, 1000 spheres, the
+  cells mapped onto the workers: ${true_rt:-n/a}; farmed (\`--farm all\`, every worker
+  holding every cell: what \`vwalls render\` does by default): ${true_farm:-n/a}.
 - **Radiosity, $(env_ nproc) workers**: ${true_rad:-n/a}; on 8 workers: ${rad8:-n/a}
   (sequential: $rad1).
 - **Load-balance efficiency 1/λ on 8 cells** (mean over 100/500/1000 spheres): ${lb8_text:-n/a}.

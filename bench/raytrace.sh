@@ -124,7 +124,7 @@ printf "    2x2x2    : 1 worker %6.3f s, 2 workers %6.3f s   speedup = %s  (farm
 # the stats; and where the time of 2x2x2 on 2 workers goes.
 # Interleaved, so that a drift of the machine's speed hits every configuration alike.
 for i in $(seq "$REPEAT"); do
-  for cfg in "1 1 idle" "1 2 idle" "2x2x2 1 none" "2x2x2 2 none" "2x2x2 2 all"; do
+  for cfg in "1 1 auto" "1 2 auto" "2x2x2 1 none" "2x2x2 2 none" "2x2x2 2 all"; do
     set -- $cfg
     once render --cells "$1" --workers "$2" --farm "$3" --stats "$T/c-$1-$2-$3-$i.json" \
       > "$T/c-$1-$2-$3-$i.wall"
@@ -135,7 +135,7 @@ import json, sys
 t, n = sys.argv[1], int(sys.argv[2])
 def runs(c, w, f): return [json.load(open("%s/c-%s-%s-%s-%d.json" % (t, c, w, f, i))) for i in range(1, n + 1)]
 def best(c, w, f): return min(j["time_s"]["compute"] for j in runs(c, w, f))
-one, one2 = best("1", 1, "idle"), best("1", 2, "idle")
+one, one2 = best("1", 1, "auto"), best("1", 2, "auto")
 c8, c8w2, c8f = best("2x2x2", 1, "none"), best("2x2x2", 2, "none"), best("2x2x2", 2, "all")
 print("    compute phase only (best of %d, interleaved):" % n)
 print("      1 cell : 1 worker %.3f s, 2 workers %.3f s (speedup %.2f, farm auto)" % (one, one2, one / one2))
@@ -153,14 +153,14 @@ def paired(a, b):
     return median_range(x["time_s"]["compute"] / y["time_s"]["compute"] for x, y in zip(runs(*a), runs(*b)))
 def paired_wall(a, b): return median_range(x / y for x, y in zip(wall(*a), wall(*b)))
 print("    compute phase, ratios within each round (%d rounds):" % n)
-print("      2x2x2/1 cell, 1 worker: %s" % paired(("2x2x2", 1, "none"), ("1", 1, "idle")))
+print("      2x2x2/1 cell, 1 worker: %s" % paired(("2x2x2", 1, "none"), ("1", 1, "auto")))
 print("      2 workers vs 1: 1 cell %s; 2x2x2 farm all %s, farm none %s" % (
-    paired(("1", 1, "idle"), ("1", 2, "idle")), paired(("2x2x2", 1, "none"), ("2x2x2", 2, "all")),
+    paired(("1", 1, "auto"), ("1", 2, "auto")), paired(("2x2x2", 1, "none"), ("2x2x2", 2, "all")),
     paired(("2x2x2", 1, "none"), ("2x2x2", 2, "none"))))
 print("    whole process, ratios within each round (%d rounds):" % n)
-print("      2x2x2/1 cell, 1 worker: %s" % paired_wall(("2x2x2", 1, "none"), ("1", 1, "idle")))
+print("      2x2x2/1 cell, 1 worker: %s" % paired_wall(("2x2x2", 1, "none"), ("1", 1, "auto")))
 print("      2 workers vs 1: 1 cell %s; 2x2x2 farm all %s, farm none %s" % (
-    paired_wall(("1", 1, "idle"), ("1", 2, "idle")), paired_wall(("2x2x2", 1, "none"), ("2x2x2", 2, "all")),
+    paired_wall(("1", 1, "auto"), ("1", 2, "auto")), paired_wall(("2x2x2", 1, "none"), ("2x2x2", 2, "all")),
     paired_wall(("2x2x2", 1, "none"), ("2x2x2", 2, "none"))))
 # Where the whole process goes besides the compute phase (medians over the rounds, ms):
 # the phases that do not shrink with a second worker bound the whole-process speedup.
@@ -171,8 +171,8 @@ def phases(c, w, f):
     out = ", ".join("%s %.1f" % (p, 1e3 * med([j["time_s"][p] for j in js])) for p in ph)
     rest = med([wl - j["time_s"]["total"] for j, wl in zip(js, walls)])
     return "%s, outside them (start, exit) %.1f" % (out, 1e3 * rest)
-print("    phases, 1 cell (medians, ms): 1 worker: %s" % phases("1", 1, "idle"))
-print("                                 2 workers: %s" % phases("1", 2, "idle"))
+print("    phases, 1 cell (medians, ms): 1 worker: %s" % phases("1", 1, "auto"))
+print("                                 2 workers: %s" % phases("1", 2, "auto"))
 b1 = sum(w["busy_s"] for w in runs("2x2x2", 1, "none")[-1]["workers"])
 for f in ("none", "all"):
     j = runs("2x2x2", 2, f)[-1]

@@ -141,7 +141,7 @@ static void output_pixels(void *user, const void *msg)
 
 /* ---- tracing ------------------------------------------------------------------------- */
 
-static void trace(vw_ctx *ctx, rt_cell *c, rt_ray *r);
+static void trace(vw_ctx *ctx, rt_cell *c, rt_ray *r, vw_walk *w);
 
 /* The ray left the world or reached its light without a hit. */
 static void finish_free(vw_ctx *ctx, rt_cell *c, const rt_ray *r)
@@ -156,7 +156,7 @@ static void finish_free(vw_ctx *ctx, rt_cell *c, const rt_ray *r)
     c->tally[RT_C_ENDED]++;
 }
 
-/* A new ray from a point inside the world: find the cell of its first segment. */
+/* A new ray from a point inside the world, or the eye: find the cell of its first segment. */
 static void spawn(vw_ctx *ctx, rt_cell *c, rt_ray *r)
 {
     static const int counter_of[4] = {RT_C_EYE, RT_C_REFLECT, RT_C_REFRACT, RT_C_SHADOW};
@@ -167,20 +167,19 @@ static void spawn(vw_ctx *ctx, rt_cell *c, rt_ray *r)
         c->rays_pending = 0;
     }
     /* Clipped once here, the ray's interval needs no clipping at any wall it crosses. */
-    const vw_decomp *d = vw_ctx_decomp(ctx);
-    double t0 = 0.0;
-    vw_segment s;
-    if (!vw_decomp_clip(d, r->org, r->dir, &t0, &r->tmax) ||
-        !vw_decomp_next_segment(d, r->org, r->dir, t0, r->tmax, &s)) {
+    vw_walk w;
+    int me = vw_ctx_cell(ctx);
+    if (!vw_walk_start(vw_ctx_decomp(ctx), &w, r->org, r->dir, 0.0, r->tmax)) {
         finish_free(ctx, c, r);
         return;
     }
-    r->t0 = s.t0;
-    r->t1 = s.t1;
-    if (s.cell == vw_ctx_cell(ctx))
-        trace(ctx, c, r);
+    r->tmax = w.tmax;
+    r->t0 = w.seg.t0;
+    r->t1 = w.seg.t1;
+    if (w.seg.cell == me)
+        trace(ctx, c, r, &w);
     else
-        vw_send_cell(ctx, s.cell, RT_K_RAY, r);
+        vw_send_cell(ctx, w.seg.cell, RT_K_RAY, r);
 }
 
 /* Unit geometric normal (outward) and shading normal at hit point p. */
@@ -338,15 +337,15 @@ static inline int meets_reach(const rt_cell *c, const rt_ray *r, double tn)
 }
 
 /* Search this cell's segment [t0, t1] of the ray; on a miss pass the ray on to the next
-   cell of its walk (restarted at t1, which splits the interval exactly as the full walk
-   does), or end it when the walk leaves the world. A next cell on this same worker is
-   entered inline (vw_ctx_enter): the ray goes on in this loop, with no message.
-   Returns whether it did so (the context is then another cell's). */
-static int walk_ray(vw_ctx *ctx, rt_cell *c, rt_ray *r)
+   cell of its walk (w: its segments are those of the full walk, bit for bit), or end it
+   when the walk leaves the world. A next cell on this same worker is entered inline
+   (vw_ctx_enter): the ray goes on in this loop, with no message. w is NULL for a ray
+   received in a message, whose walk is resumed only if it leaves this cell.
+   Returns whether it entered another cell (the context is then that cell's). */
+static int walk_ray(vw_ctx *ctx, rt_cell *c, rt_ray *r, vw_walk *w)
 {
     int entered = 0;
-    const vw_decomp *d = vw_ctx_decomp(ctx);
-    int me = vw_ctx_cell(ctx);
+    vw_walk resumed;
     for (;;) {
         c->tally[RT_C_SEGMENTS]++;
         /* max(eps, t0), as fmax gives it (eps for a NaN t0), without fmax's libm call:
@@ -367,21 +366,22 @@ static int walk_ray(vw_ctx *ctx, rt_cell *c, rt_ray *r)
             shade(ctx, c, r, &h);
             return entered;
         }
-        vw_segment s;
-        /* s.t1 > r->t1: the walk must make progress, or a ray could circle forever. */
-        if (r->t1 < r->tmax && vw_decomp_next_segment(d, r->org, r->dir, r->t1, r->tmax, &s) &&
-            s.t1 > r->t1) {
-            r->t0 = s.t0;
-            r->t1 = s.t1;
-            if (s.cell == me) continue;
-            rt_cell *next = vw_ctx_enter(ctx, s.cell, RT_K_RAY);
+        const vw_decomp *d = vw_ctx_decomp(ctx);
+        if (!w) {
+            vw_segment seg = {vw_ctx_cell(ctx), r->t0, r->t1};
+            vw_walk_resume(d, &resumed, r->org, r->dir, &seg, r->tmax);
+            w = &resumed;
+        }
+        if (vw_walk_next(d, w)) {
+            r->t0 = w->seg.t0;
+            r->t1 = w->seg.t1;
+            rt_cell *next = vw_ctx_enter(ctx, w->seg.cell, RT_K_RAY);
             if (next) {
                 c = next;
-                me = s.cell;
                 entered = 1;
                 continue;
             }
-            vw_send_cell(ctx, s.cell, RT_K_RAY, r);
+            vw_send_cell(ctx, w->seg.cell, RT_K_RAY, r);
             return entered;
         }
         finish_free(ctx, c, r);
@@ -390,17 +390,17 @@ static int walk_ray(vw_ctx *ctx, rt_cell *c, rt_ray *r)
 }
 
 /* The ray in this cell and on; the context is this cell's again afterwards. */
-static void trace(vw_ctx *ctx, rt_cell *c, rt_ray *r)
+static void trace(vw_ctx *ctx, rt_cell *c, rt_ray *r, vw_walk *w)
 {
     int cell = vw_ctx_cell(ctx), replica = vw_ctx_replica(ctx);
-    if (walk_ray(ctx, c, r)) vw_ctx_restore(ctx, cell, replica);
+    if (walk_ray(ctx, c, r, w)) vw_ctx_restore(ctx, cell, replica);
 }
 
 static void handle_ray(vw_ctx *ctx, void *state, const void *msg)
 {
     rt_ray r;
     memcpy(&r, msg, sizeof r);
-    trace(ctx, state, &r);
+    trace(ctx, state, &r, NULL);
 }
 
 /* ---- cells ---------------------------------------------------------------------------- */

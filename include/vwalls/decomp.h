@@ -110,6 +110,31 @@ VW_API int vw_decomp_clip(const vw_decomp *d, const double o[3], const double di
 VW_API int vw_decomp_next_segment(const vw_decomp *d, const double o[3], const double dir[3],
                                   double t0, double t1, vw_segment *out);
 
+/* A ray walk carried by its caller, one cell at a time: the incremental form of
+   vw_decomp_walk, for a ray that is searched cell by cell (the ray tracer). It keeps,
+   per axis, where the ray leaves the current cell through an inner wall, so crossing
+   into a neighbour that has the same extent on the other two axes (every face of a
+   grid) costs one division; other crossings descend from the root. Every segment is,
+   bit for bit, the one vw_decomp_walk gives. */
+typedef struct vw_walk {
+    double q[3], v[3]; /* the ray in frame coordinates */
+    double exit[3];    /* per axis: the parameter of the cell's far wall, INFINITY when
+                          that wall is the world's or the ray runs parallel to it */
+    double tmax;       /* the end of the walk, clipped to the world */
+    vw_segment seg;    /* the current segment */
+} vw_walk;
+/* Starts the walk of o + t dir over [t0, t1] (world coordinates; t1 may be INFINITY):
+   clips it and finds its first segment. Returns 0 when the ray misses the world. */
+VW_API int vw_walk_start(const vw_decomp *d, vw_walk *w, const double o[3],
+                         const double dir[3], double t0, double t1);
+/* Resumes a walk whose current segment `seg` is known (a ray received in a message: its
+   segment, and tmax, come from a walk of the same decomposition). */
+VW_API void vw_walk_resume(const vw_decomp *d, vw_walk *w, const double o[3],
+                           const double dir[3], const vw_segment *seg, double tmax);
+/* Steps to the segment after the current one; 0 when the walk is over (w->seg is then
+   unchanged). */
+VW_API int vw_walk_next(const vw_decomp *d, vw_walk *w);
+
 /* Faces: 0 -x, 1 +x, 2 -y, 3 +y, 4 -z, 5 +z (in frame coordinates). */
 #define VW_FACE_AXIS(f) ((f) >> 1)
 #define VW_FACE_SIGN(f) (((f) & 1) ? 1 : -1)

@@ -6,6 +6,15 @@
 
 #include "vwalls/decomp.h"
 
+/* A face a carried walk crosses in one step: it has one neighbour, flush with the cell on
+   the other two axes (so the ray's exits along them stay the same); wall is that
+   neighbour's far wall on the face's axis, in the face's direction, inner unless it is
+   the world's. next is -1 for any other face. */
+typedef struct vw_face_step {
+    int next, inner;
+    double wall;
+} vw_face_step;
+
 struct vw_decomp {
     vw_decomp_kind kind;
     vw_box world;          /* in frame coordinates */
@@ -21,6 +30,7 @@ struct vw_decomp {
     int *nb_start;         /* 6*ncells+1 offsets into nb, per (cell, face) */
     int *nb;
     int max_nb;
+    vw_face_step *face_step; /* per (cell, face): the step of a carried walk (vw_walk_next) */
 };
 
 #endif

@@ -251,6 +251,7 @@ void vw_decomp_free(vw_decomp *d)
     free(d->cell_leaf);
     free(d->nb_start);
     free(d->nb);
+    free(d->face_step);
     for (int a = 0; a < 3; a++) free(d->walls[a]);
     free(d);
 }
@@ -402,16 +403,23 @@ static int clip(const vw_decomp *d, const double q[3], const double v[3], double
     return t0 < t1;
 }
 
+/* The walk of the ray q + t v given in frame coordinates. */
+static int walk_frame(const vw_decomp *d, const double q[3], const double v[3], double t0,
+                      double t1, vw_segment_fn fn, void *user)
+{
+    if (!clip(d, q, v, &t0, &t1)) return 0;
+    walk_state w = {d, q, v, fn, user, 0, 0};
+    walk(&w, 0, t0, t1);
+    return w.count;
+}
+
 int vw_decomp_walk(const vw_decomp *d, const double o[3], const double dir[3], double t0,
                    double t1, vw_segment_fn fn, void *user)
 {
     double q[3], v[3];
     vw_decomp_to_frame(d, o, q);
     vw_decomp_to_frame(d, dir, v);
-    if (!clip(d, q, v, &t0, &t1)) return 0;
-    walk_state w = {d, q, v, fn, user, 0, 0};
-    walk(&w, 0, t0, t1);
-    return w.count;
+    return walk_frame(d, q, v, t0, t1, fn, user);
 }
 
 static int first_fn(const vw_segment *s, void *user)
@@ -443,8 +451,8 @@ static void ray_to_frame(const vw_decomp *d, const double o[3], const double dir
    Inlined into its two callers: the call alone was ~1% of a 2x2x2 render's
    instructions. */
 static inline __attribute__((always_inline)) int
-descend(const vw_decomp *d, const double o[3], const double dir[3], const double q[3],
-        const double v[3], double t0, double t1, vw_segment *out)
+descend(const vw_decomp *d, const double q[3], const double v[3], double t0, double t1,
+        vw_segment *out, double exit[3])
 {
     const double t0_in = t0, t1_in = t1;
     const vw_kd_node *nodes = d->nodes, *n = &nodes[0];
@@ -458,14 +466,15 @@ descend(const vw_decomp *d, const double o[3], const double dir[3], const double
         if (t0 < ts) {
             n = &nodes[v[a] > 0 ? n->left : n->right];
             t1 = t1 < ts ? t1 : ts;
+            if (exit && ts < exit[a]) exit[a] = ts;
         } else if (ts < t1) {
             n = &nodes[v[a] > 0 ? n->right : n->left];
             t0 = t0 > ts ? t0 : ts;
         } else {
-            return vw_decomp_walk(d, o, dir, t0_in, t1_in, first_fn, out) > 0;
+            return walk_frame(d, q, v, t0_in, t1_in, first_fn, out) > 0 ? 2 : 0;
         }
     }
-    if (!(t0 < t1)) return vw_decomp_walk(d, o, dir, t0_in, t1_in, first_fn, out) > 0;
+    if (!(t0 < t1)) return walk_frame(d, q, v, t0_in, t1_in, first_fn, out) > 0 ? 2 : 0;
     out->cell = n->cell;
     out->t0 = t0;
     out->t1 = t1;
@@ -478,7 +487,7 @@ int vw_decomp_first_segment(const vw_decomp *d, const double o[3], const double 
     double q[3], v[3];
     ray_to_frame(d, o, dir, q, v);
     if (!clip(d, q, v, &t0, &t1)) return 0;
-    return descend(d, o, dir, q, v, t0, t1, out);
+    return descend(d, q, v, t0, t1, out, NULL) != 0;
 }
 
 int vw_decomp_clip(const vw_decomp *d, const double o[3], const double dir[3], double *t0,
@@ -496,10 +505,92 @@ int vw_decomp_next_segment(const vw_decomp *d, const double o[3], const double d
                            double t0, double t1, vw_segment *out)
 {
     if (!(t0 < t1)) return 0;
-    if (!d->has_frame) return descend(d, o, dir, o, dir, t0, t1, out); /* it runs per wall */
+    if (!d->has_frame) return descend(d, o, dir, t0, t1, out, NULL) != 0; /* it runs per wall */
     double q[3], v[3];
     ray_to_frame(d, o, dir, q, v);
-    return descend(d, o, dir, q, v, t0, t1, out);
+    return descend(d, q, v, t0, t1, out, NULL) != 0;
+}
+
+/* ---- the carried walk (vw_walk) ------------------------------------------------------ */
+
+/* The ray's exits from `cell` along each axis: (wall - q[a]) / v[a], the walk's own
+   arithmetic, on the far wall; INFINITY where that wall is the world's (the walk's end
+   is clipped to it already) or the ray runs parallel to the axis. A descent's t1 is the
+   least of them and the clipped end: the far walls are splits on the cell's path, taken
+   on their near side, and any other split ahead on the path lies beyond. */
+static void cell_exits(const vw_decomp *d, int cell, vw_walk *w)
+{
+    const vw_box *b = &d->cell_box[cell];
+    for (int a = 0; a < 3; a++) {
+        double v = w->v[a];
+        double wall = v > 0 ? b->hi[a] : b->lo[a];
+        int inner = v > 0 ? wall != d->world.hi[a] : v < 0 && wall != d->world.lo[a];
+        w->exit[a] = inner ? (wall - w->q[a]) / v : INFINITY;
+    }
+}
+
+int vw_walk_start(const vw_decomp *d, vw_walk *w, const double o[3], const double dir[3],
+                  double t0, double t1)
+{
+    ray_to_frame(d, o, dir, w->q, w->v);
+    if (!clip(d, w->q, w->v, &t0, &t1)) return 0;
+    w->tmax = t1;
+    /* The descent's near sides give the exits: on each axis the nearest split ahead on
+       the path is the cell's far wall (a walk of the whole tree gives none). */
+    w->exit[0] = w->exit[1] = w->exit[2] = INFINITY;
+    switch (descend(d, w->q, w->v, t0, t1, &w->seg, w->exit)) {
+    case 0: return 0;
+    case 2: cell_exits(d, w->seg.cell, w);
+    }
+    return 1;
+}
+
+void vw_walk_resume(const vw_decomp *d, vw_walk *w, const double o[3], const double dir[3],
+                    const vw_segment *seg, double tmax)
+{
+    ray_to_frame(d, o, dir, w->q, w->v);
+    w->tmax = tmax;
+    w->seg = *seg;
+    cell_exits(d, seg->cell, w);
+}
+
+/* The next cell is across the one wall the ray leaves by: the face's neighbour, flush
+   with the cell on the other two axes. Then the descent to it would take the same
+   sides of every split as it did to this cell, except the crossed wall's, so the new
+   segment is [this exit, least of its exits], only one of them new. A ray leaving by
+   an edge or a corner (two exits equal), a face with other neighbours, or a NaN goes by
+   the descent. */
+int vw_walk_next(const vw_decomp *d, vw_walk *w)
+{
+    double te = w->seg.t1;
+    if (!(te < w->tmax)) return 0;
+    double *e = w->exit;
+    int a = e[0] == te ? 0 : e[1] == te ? 1 : 2;
+    const vw_face_step *f = &d->face_step[6 * w->seg.cell + 2 * a + (w->v[a] > 0)];
+    if (f->next >= 0 && e[a] == te) {
+        double ea = f->inner ? (f->wall - w->q[a]) / w->v[a] : INFINITY, old = e[a];
+        e[a] = ea;
+        double t1 = w->tmax;
+        t1 = e[0] < t1 ? e[0] : t1;
+        t1 = e[1] < t1 ? e[1] : t1;
+        t1 = e[2] < t1 ? e[2] : t1;
+        if (te < t1) { /* not so when another exit equals te: an edge or corner */
+            w->seg.cell = f->next;
+            w->seg.t0 = te;
+            w->seg.t1 = t1;
+            return 1;
+        }
+        e[a] = old;
+    }
+    vw_segment s;
+    double x[3] = {INFINITY, INFINITY, INFINITY};
+    switch (descend(d, w->q, w->v, te, w->tmax, &s, x)) {
+    case 0: return 0;
+    case 1: memcpy(w->exit, x, sizeof x); break;
+    case 2: cell_exits(d, s.cell, w);
+    }
+    w->seg = s;
+    return 1;
 }
 
 /* ---- overlap queries, neighbours, front-to-back ------------------------------------ */
@@ -575,6 +666,27 @@ static void build_neighbours(vw_decomp *d)
         if (total > d->max_nb) d->max_nb = total;
     }
     d->nb_start[6 * n] = used;
+    /* The faces a walk crosses in one step (vw_walk_next): one neighbour, flush with
+       the cell on the two other axes, so the ray's exits along them stay the same. */
+    d->face_step = malloc(sizeof *d->face_step * (size_t)(6 * n));
+    if (!d->face_step) goto fail;
+    for (int c = 0; c < n; c++)
+        for (int f = 0; f < 6; f++) {
+            int s = d->nb_start[6 * c + f], a = VW_FACE_AXIS(f), up = VW_FACE_SIGN(f) > 0;
+            vw_face_step *st = &d->face_step[6 * c + f];
+            st->next = -1;
+            st->inner = 0;
+            st->wall = 0;
+            if (d->nb_start[6 * c + f + 1] - s != 1) continue;
+            const vw_box *p = &d->cell_box[c], *q = &d->cell_box[d->nb[s]];
+            int flush = 1;
+            for (int k = 0; k < 3; k++)
+                if (k != a && (p->lo[k] != q->lo[k] || p->hi[k] != q->hi[k])) flush = 0;
+            if (!flush) continue;
+            st->next = d->nb[s];
+            st->wall = up ? q->hi[a] : q->lo[a];
+            st->inner = st->wall != (up ? d->world.hi[a] : d->world.lo[a]);
+        }
     free(tmp);
     return;
 fail:

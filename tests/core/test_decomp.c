@@ -161,6 +161,41 @@ static void check_decomp(const vw_decomp *d)
                 CHECK(f.cell == walk_a.s[s].cell && f.t0 == walk_a.s[s].t0 &&
                       f.t1 == walk_a.s[s].t1);
         }
+        /* The carried walk steps through the same segments, bit for bit, from the start
+           and resumed at any segment (as a ray received in a message); and from a point
+           inside each segment, as a secondary ray leaves a hit. */
+        for (int resume = 0; resume < 2; resume++) {
+            vw_walk w;
+            int got = vw_walk_start(d, &w, o, dir, 0, INFINITY);
+            CHECK_EQ_INT(got, walk_a.n > 0);
+            for (int s = 0; got && s < walk_a.n; s++) {
+                CHECK_EQ_INT(w.seg.cell, walk_a.s[s].cell);
+                CHECK(memcmp(&w.seg.t0, &walk_a.s[s].t0, sizeof w.seg.t0) == 0);
+                CHECK(memcmp(&w.seg.t1, &walk_a.s[s].t1, sizeof w.seg.t1) == 0);
+                if (resume) {
+                    vw_walk r;
+                    vw_walk_resume(d, &r, o, dir, &walk_a.s[s], w.tmax);
+                    w = r;
+                }
+                CHECK_EQ_INT(vw_walk_next(d, &w), s + 1 < walk_a.n);
+            }
+        }
+        for (int s = 0; s < walk_a.n; s++) {
+            double mid = 0.5 * (walk_a.s[s].t0 + walk_a.s[s].t1), p[3];
+            if (!isfinite(mid)) continue;
+            for (int a = 0; a < 3; a++) p[a] = o[a] + mid * dir[a];
+            walk_b.n = 0;
+            vw_decomp_walk(d, p, dir, 0, INFINITY, collect, &walk_b);
+            vw_walk w;
+            int got = vw_walk_start(d, &w, p, dir, 0, INFINITY);
+            CHECK_EQ_INT(got, walk_b.n > 0);
+            for (int k = 0; got && k < walk_b.n; k++) {
+                CHECK_EQ_INT(w.seg.cell, walk_b.s[k].cell);
+                CHECK(memcmp(&w.seg.t0, &walk_b.s[k].t0, sizeof w.seg.t0) == 0);
+                CHECK(memcmp(&w.seg.t1, &walk_b.s[k].t1, sizeof w.seg.t1) == 0);
+                CHECK_EQ_INT(vw_walk_next(d, &w), k + 1 < walk_b.n);
+            }
+        }
         vw_decomp_to_frame(d, o, qo);
         vw_decomp_to_frame(d, dir, qd);
         for (int s = 0; s < walk_a.n; s++) {

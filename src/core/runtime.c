@@ -30,6 +30,10 @@ struct vw_ctx {
     vw__worker *wk;
     int cell;
     int rep; /* which copy of the cell: 0 = the master */
+    /* The unit the runtime called the module for: the module hands off inline from it
+       (vw_ctx_enter) and restores it, which then needs no check that this worker
+       hosts it. */
+    int home_cell, home_rep;
 };
 
 /* The figures and state of copy rep of a cell (0: the master itself). */
@@ -239,22 +243,24 @@ static void meter_charge(vw__worker *wk, double now)
     }
     wk->busy_s += dt;
     double share = wk->nmetered > 1 ? dt / wk->nmetered : dt;
-    for (int i = 0; i < wk->nmetered; i++) {
-        int cell = wk->metered[i].cell, rep = wk->metered[i].rep;
-        if (cell < 0) continue;
-        if (rep) w->cells[cell].reps[rep - 1].busy_s += share;
-        else w->cells[cell].busy_s += share;
-    }
+    for (int i = 0; i < wk->nmetered; i++)
+        if (wk->metered[i]) *wk->metered[i] += share;
     wk->mark = now;
     wk->nmetered = 0;
+}
+
+/* The busy time of unit (cell, rep), or NULL for no unit (cell < 0). */
+static double *unit_busy(vw_world *w, int cell, int rep)
+{
+    if (cell < 0) return NULL;
+    return rep ? &w->cells[cell].reps[rep - 1].busy_s : &w->cells[cell].busy_s;
 }
 
 /* The worker starts running unit (cell, rep): what ran before is charged. */
 static void meter_switch(vw__worker *wk, int cell, int rep)
 {
     meter_charge(wk, vw__now());
-    wk->metered[0].cell = cell;
-    wk->metered[0].rep = rep;
+    wk->metered[0] = unit_busy(wk->w, cell, rep);
     wk->nmetered = 1;
 }
 
@@ -262,20 +268,18 @@ static void meter_switch(vw__worker *wk, int cell, int rep)
 static void meter_start(vw__worker *wk, int cell, int rep)
 {
     wk->mark = vw__now();
-    wk->metered[0].cell = cell;
-    wk->metered[0].rep = rep;
+    wk->metered[0] = unit_busy(wk->w, cell, rep);
     wk->nmetered = 1;
 }
 
 static void meter_stop(vw__worker *wk) { meter_charge(wk, vw__now()); }
 
-/* An inline hand-off to unit (cell, rep): noted, timed with the next clock read. */
-static void meter_note(vw__worker *wk, int cell, int rep)
+/* An inline hand-off to the unit whose busy time is `busy`: noted, timed with the next
+   clock read. */
+static void meter_note(vw__worker *wk, double *busy)
 {
     if (wk->nmetered == VW__METER_N) meter_charge(wk, vw__now());
-    wk->metered[wk->nmetered].cell = cell;
-    wk->metered[wk->nmetered].rep = rep;
-    wk->nmetered++;
+    wk->metered[wk->nmetered++] = busy;
 }
 
 /* ---- the module's side: vw_ctx ------------------------------------------------------ */
@@ -330,37 +334,51 @@ uint64_t vw_ctx_next_batch(vw_ctx *ctx, uint64_t nbatches)
     return nbatches;
 }
 
+/* A module's misuse of the context is a bug in the module: it stops the process. */
+static void __attribute__((noreturn, noinline, cold))
+misuse(const vw_ctx *ctx, const char *fmt, int a, int b)
+{
+    fprintf(stderr, "vwalls: module '%s' ", ctx->w->m->name);
+    fprintf(stderr, fmt, a, b);
+    fprintf(stderr, " (worker %d)\n", ctx->wk->global);
+    abort();
+}
+
+/* Which copy of duplicated cell c this worker may hand a message of `kind` to inline,
+   or -1. When every worker of this process holds one (farming), this worker's own copy
+   takes it, and a ray stays on the worker it started on; otherwise the copies share
+   what is sent to the cell in turn, the equal shares the balancer planned. */
+static int __attribute__((noinline)) enter_copy(const vw_ctx *ctx, int cell, int kind)
+{
+    const vw_world *w = ctx->w;
+    if (!w->cells[cell].farmed || !(w->m->kinds[kind].flags & VW_MSG_INDEPENDENT)) return -1;
+    return vw__cell_rep_of(w, cell, ctx->wk->global);
+}
+
 void *vw_ctx_enter(vw_ctx *ctx, int cell, int kind)
 {
     vw_world *w = ctx->w;
-    vw__worker *wk = ctx->wk;
-    if (cell < 0 || cell >= w->ncells || kind < 0 || kind >= w->m->nkinds) {
-        fprintf(stderr, "vwalls: module '%s' entered cell %d of %d with kind %d\n", w->m->name,
-                cell, w->ncells, kind);
-        abort();
-    }
+    if ((unsigned)cell >= (unsigned)w->ncells || (unsigned)kind >= (unsigned)w->m->nkinds)
+        misuse(ctx, "entered cell %d with message kind %d: no such cell or kind", cell, kind);
     vw__cell *c = &w->cells[cell];
     int rep = 0;
     if (c->nreps) {
-        /* A duplicated cell: any copy may take an independent message. When every
-           worker of this process holds one (farming), this worker's own copy takes it,
-           and a ray stays on the worker it started on; otherwise the copies share what
-           is sent to the cell in turn, the equal shares the balancer planned. */
-        if (!c->farmed || !(w->m->kinds[kind].flags & VW_MSG_INDEPENDENT)) return NULL;
-        rep = vw__cell_rep_of(w, cell, wk->global);
+        rep = enter_copy(ctx, cell, kind);
         if (rep < 0) return NULL;
-    } else if (w->cell_worker[cell] != wk->global) {
+    } else if (w->cell_worker[cell] != ctx->wk->global) {
         return NULL;
     }
     /* Stress: refuse half the hand-offs, so both paths run under every interleaving. */
-    if (w->cfg.stress_seed && (vw__rng_next(&wk->rng) & 1)) return NULL;
-    if (cell != ctx->cell || ctx->rep != rep) meter_note(wk, cell, rep);
+    if (w->cfg.stress_seed && (vw__rng_next(&ctx->wk->rng) & 1)) return NULL;
     void *state;
+    int noted = cell != ctx->cell || ctx->rep != rep;
     if (rep) {
         vw__replica *r = &c->reps[rep - 1];
+        if (noted) meter_note(ctx->wk, &r->busy_s);
         r->messages_in++;
         state = r->state;
     } else {
+        if (noted) meter_note(ctx->wk, &c->busy_s);
         c->messages_in++;
         state = c->state;
     }
@@ -372,16 +390,14 @@ void *vw_ctx_enter(vw_ctx *ctx, int cell, int kind)
 void vw_ctx_restore(vw_ctx *ctx, int cell, int replica)
 {
     if (cell == ctx->cell && replica == ctx->rep) return;
-    vw_world *w = ctx->w;
-    int hosted = cell >= 0 && cell < w->ncells &&
-                 (replica == 0 ? w->cell_worker[cell] == ctx->wk->global
-                               : vw__cell_rep_of(w, cell, ctx->wk->global) == replica);
-    if (!hosted) {
-        fprintf(stderr, "vwalls: module '%s' restored cell %d copy %d, which worker %d does not "
-                "host\n", w->m->name, cell, replica, ctx->wk->global);
-        abort();
+    if (cell != ctx->home_cell || replica != ctx->home_rep) {
+        vw_world *w = ctx->w;
+        int hosted = cell >= 0 && cell < w->ncells &&
+                     (replica == 0 ? w->cell_worker[cell] == ctx->wk->global
+                                   : vw__cell_rep_of(w, cell, ctx->wk->global) == replica);
+        if (!hosted) misuse(ctx, "restored cell %d copy %d, which it does not host", cell, replica);
     }
-    meter_note(ctx->wk, cell, replica);
+    meter_note(ctx->wk, unit_busy(ctx->w, cell, replica));
     ctx->cell = cell;
     ctx->rep = replica;
 }
@@ -475,11 +491,11 @@ static void handle_packet(vw__worker *wk, vw_ctx *ctx, vw__packet *p)
             msgs_in = rep ? &c->reps[rep - 1].messages_in : &c->messages_in;
         } else if (ctx->cell != cur || ctx->rep != rep) {
             /* The last handler handed off inline and came back: this unit runs again. */
-            meter_note(wk, cur, rep);
+            meter_note(wk, unit_busy(w, cur, rep));
         }
         (*msgs_in)++;
-        ctx->cell = h->cell;
-        ctx->rep = rep;
+        ctx->cell = ctx->home_cell = h->cell;
+        ctx->rep = ctx->home_rep = rep;
         const vw_msg_kind *k = &w->m->kinds[h->kind];
         if (k->handle) k->handle(ctx, state, p->data + off + sizeof *h);
         off += msg_stride(h->size);
@@ -500,8 +516,8 @@ static int run_step(vw__worker *wk, vw_ctx *ctx)
     for (int tries = 0; tries < wk->ncells; tries++) {
         int cell = wk->cells[wk->step_cursor], rep = wk->cell_rep[wk->step_cursor];
         wk->step_cursor = (wk->step_cursor + 1) % wk->ncells;
-        ctx->cell = cell;
-        ctx->rep = rep;
+        ctx->cell = ctx->home_cell = cell;
+        ctx->rep = ctx->home_rep = rep;
         meter_start(wk, cell, rep);
         int did = w->m->step(ctx, *unit_state(w, cell, rep));
         meter_stop(wk);
@@ -535,7 +551,7 @@ static void stress_pause(vw__worker *wk)
 static void worker_run(vw__worker *wk)
 {
     vw_world *w = wk->w;
-    vw_ctx ctx = {w, wk, -1, 0};
+    vw_ctx ctx = {w, wk, -1, 0, -1, 0};
     for (;;) {
         pthread_mutex_lock(&wk->mu);
         vw__packet *p = take(wk);
@@ -742,7 +758,7 @@ static vw_status build_unit(vw_world *w, int cell, int rep, vw__worker *wk)
 {
     vw__cell *c = &w->cells[cell];
     vw__replica *rp = rep ? &c->reps[rep - 1] : NULL;
-    vw_ctx ctx = {w, wk, cell, rep};
+    vw_ctx ctx = {w, wk, cell, rep, cell, rep};
     size_t osz = w->m->object_size;
     unsigned char *objs = NULL;
     if (c->nobjs) {
@@ -783,13 +799,13 @@ vw_status vw__world_build_replica(vw_world *w, int cell, int rep, vw__worker *wk
 double vw__cell_load(vw_world *w, int cell)
 {
     vw__cell *c = &w->cells[cell];
-    vw_ctx ctx = {w, &w->workers[c->worker - w->rank * w->nworkers], cell, 0};
+    vw_ctx ctx = {w, &w->workers[c->worker - w->rank * w->nworkers], cell, 0, cell, 0};
     return w->m->load(&ctx, c->state);
 }
 
 double vw__replica_load(vw_world *w, int cell, int rep)
 {
     vw__replica *rp = &w->cells[cell].reps[rep - 1];
-    vw_ctx ctx = {w, &w->workers[rp->worker - w->rank * w->nworkers], cell, rep};
+    vw_ctx ctx = {w, &w->workers[rp->worker - w->rank * w->nworkers], cell, rep, cell, rep};
     return w->m->load(&ctx, rp->state);
 }

@@ -120,8 +120,9 @@ typedef struct vw__worker {
     uint64_t rng;              /* stress switch */
     double busy_s;
     /* The meter (runtime.c): the units (cell, copy) that ran since the clock was last
-       read at `mark`; that time is shared evenly among them when it is next read. */
-    struct { int cell, rep; } metered[VW__METER_N];
+       read at `mark`, as their busy_s (NULL for none); that time is shared evenly among
+       them when it is next read. */
+    double *metered[VW__METER_N];
     int nmetered;
     double mark;
     uint64_t msgs_sent, bytes_sent, packets_sent;

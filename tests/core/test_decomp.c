@@ -36,6 +36,27 @@ static int collect(const vw_segment *s, void *user)
     return 1;
 }
 
+/* vw_walk from o (and, with resume, restarted from each segment as a received ray is)
+   gives exactly the segments of `want`, vw_decomp_walk's walk of the same ray. */
+static void check_carried(const vw_decomp *d, const double o[3], const double dir[3],
+                          const segs *want, int resume)
+{
+    vw_walk w;
+    int got = vw_walk_start(d, &w, o, dir, 0, INFINITY);
+    CHECK_EQ_INT(got, want->n > 0);
+    for (int s = 0; got && s < want->n; s++) {
+        CHECK_EQ_INT(w.seg.cell, want->s[s].cell);
+        CHECK(memcmp(&w.seg.t0, &want->s[s].t0, sizeof w.seg.t0) == 0);
+        CHECK(memcmp(&w.seg.t1, &want->s[s].t1, sizeof w.seg.t1) == 0);
+        if (resume) {
+            vw_walk r;
+            vw_walk_resume(d, &r, o, dir, &want->s[s], w.tmax);
+            w = r;
+        }
+        CHECK_EQ_INT(vw_walk_next(d, &w), s + 1 < want->n);
+    }
+}
+
 /* Does the ray cross box b (frame coordinates) over an interval of positive length
    within [t0, t1]? Brute force slab test, with a tolerance that only admits
    grazing contacts the walk may legitimately skip. */
@@ -164,37 +185,15 @@ static void check_decomp(const vw_decomp *d)
         /* The carried walk steps through the same segments, bit for bit, from the start
            and resumed at any segment (as a ray received in a message); and from a point
            inside each segment, as a secondary ray leaves a hit. */
-        for (int resume = 0; resume < 2; resume++) {
-            vw_walk w;
-            int got = vw_walk_start(d, &w, o, dir, 0, INFINITY);
-            CHECK_EQ_INT(got, walk_a.n > 0);
-            for (int s = 0; got && s < walk_a.n; s++) {
-                CHECK_EQ_INT(w.seg.cell, walk_a.s[s].cell);
-                CHECK(memcmp(&w.seg.t0, &walk_a.s[s].t0, sizeof w.seg.t0) == 0);
-                CHECK(memcmp(&w.seg.t1, &walk_a.s[s].t1, sizeof w.seg.t1) == 0);
-                if (resume) {
-                    vw_walk r;
-                    vw_walk_resume(d, &r, o, dir, &walk_a.s[s], w.tmax);
-                    w = r;
-                }
-                CHECK_EQ_INT(vw_walk_next(d, &w), s + 1 < walk_a.n);
-            }
-        }
+        check_carried(d, o, dir, &walk_a, 0);
+        check_carried(d, o, dir, &walk_a, 1);
         for (int s = 0; s < walk_a.n; s++) {
             double mid = 0.5 * (walk_a.s[s].t0 + walk_a.s[s].t1), p[3];
             if (!isfinite(mid)) continue;
             for (int a = 0; a < 3; a++) p[a] = o[a] + mid * dir[a];
             walk_b.n = 0;
             vw_decomp_walk(d, p, dir, 0, INFINITY, collect, &walk_b);
-            vw_walk w;
-            int got = vw_walk_start(d, &w, p, dir, 0, INFINITY);
-            CHECK_EQ_INT(got, walk_b.n > 0);
-            for (int k = 0; got && k < walk_b.n; k++) {
-                CHECK_EQ_INT(w.seg.cell, walk_b.s[k].cell);
-                CHECK(memcmp(&w.seg.t0, &walk_b.s[k].t0, sizeof w.seg.t0) == 0);
-                CHECK(memcmp(&w.seg.t1, &walk_b.s[k].t1, sizeof w.seg.t1) == 0);
-                CHECK_EQ_INT(vw_walk_next(d, &w), k + 1 < walk_b.n);
-            }
+            check_carried(d, p, dir, &walk_b, 0);
         }
         vw_decomp_to_frame(d, o, qo);
         vw_decomp_to_frame(d, dir, qd);

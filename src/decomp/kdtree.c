@@ -564,10 +564,11 @@ int vw_walk_next(const vw_decomp *d, vw_walk *w)
 {
     double te = w->seg.t1;
     if (!(te < w->tmax)) return 0;
+    /* te < tmax, so te is the least exit: the ray leaves by axis a. */
     double *e = w->exit;
     int a = e[0] == te ? 0 : e[1] == te ? 1 : 2;
     const vw_face_step *f = &d->face_step[6 * w->seg.cell + 2 * a + (w->v[a] > 0)];
-    if (f->next >= 0 && e[a] == te) {
+    if (f->next >= 0) {
         double ea = f->inner ? (f->wall - w->q[a]) / w->v[a] : INFINITY, old = e[a];
         e[a] = ea;
         double t1 = w->tmax;

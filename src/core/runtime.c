@@ -347,7 +347,7 @@ misuse(const vw_ctx *ctx, const char *fmt, int a, int b)
 /* Which copy of duplicated cell c this worker may hand a message of `kind` to inline,
    or -1. When every worker of this process holds one (farming), this worker's own copy
    takes it, and a ray stays on the worker it started on; otherwise the copies share
-   what is sent to the cell in turn, the equal shares the balancer planned. */
+   what is sent to the cell in turns, the shares the balancer planned. */
 static int __attribute__((noinline)) enter_copy(const vw_ctx *ctx, int cell, int kind)
 {
     const vw_world *w = ctx->w;

@@ -559,7 +559,7 @@ void vw_walk_resume(const vw_decomp *d, vw_walk *w, const double o[3], const dou
    sides of every split as it did to this cell, except the crossed wall's, so the new
    segment is [this exit, least of its exits], only one of them new. A ray leaving by
    an edge or a corner (two exits equal), a face with other neighbours, or a NaN goes by
-   the descent. */
+   the descent. Either way the new segment ends beyond te: the walk always advances. */
 int vw_walk_next(const vw_decomp *d, vw_walk *w)
 {
     double te = w->seg.t1;

@@ -345,6 +345,7 @@ static inline int meets_reach(const rt_cell *c, const rt_ray *r, double tn)
 static int walk_ray(vw_ctx *ctx, rt_cell *c, rt_ray *r, vw_walk *w)
 {
     int entered = 0;
+    const vw_decomp *d = vw_ctx_decomp(ctx); /* every cell's: the world's one */
     vw_walk resumed;
     for (;;) {
         c->tally[RT_C_SEGMENTS]++;
@@ -366,7 +367,6 @@ static int walk_ray(vw_ctx *ctx, rt_cell *c, rt_ray *r, vw_walk *w)
             shade(ctx, c, r, &h);
             return entered;
         }
-        const vw_decomp *d = vw_ctx_decomp(ctx);
         if (!w) {
             vw_segment seg = {vw_ctx_cell(ctx), r->t0, r->t1};
             vw_walk_resume(d, &resumed, r->org, r->dir, &seg, r->tmax);

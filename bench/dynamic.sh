@@ -36,10 +36,12 @@ for f in range(frames):
     print("frame")
 PY
 
+# --farm idle in every run: the cells stay mapped onto the workers, as with --balance
+# (whose runs farm only idle workers), so lambda and the render times compare.
 run() { # name args...
   local name=$1; shift
   "$VWALLS" animate "$OUT/scene.nff" "$OUT/edits.txt" -o "$OUT/$name-%04d.png" --cells "$CELLS" \
-    --workers "$WORKERS" --size "$SIZE" --quiet --keep-going --stats "$OUT/$name.json" "$@"
+    --workers "$WORKERS" --size "$SIZE" --quiet --keep-going --farm idle --stats "$OUT/$name.json" "$@"
   python3 - "$OUT/$name.json" "$name" <<'PY'
 import json, sys
 s = json.load(open(sys.argv[1]))

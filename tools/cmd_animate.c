@@ -32,6 +32,7 @@ struct vw_anim_session {
     rt_anim *anim;
     int check, sweep, keep_going, interactive, quiet;
     double threshold;            /* rebalance when lambda > 1 + threshold */
+    rt_farm farm;                /* how the workers share the cells (--farm) */
     FILE *log;                   /* every edit's outcome (output process), or NULL */
     vw_edit batch[MAX_BATCH];
     size_t nbatch;
@@ -253,6 +254,8 @@ static void help(const char *cmd)
            "  --depth D        maximum ray depth (default 5)\n"
            "  --balance S      none|tensor|rotate|staggered|divide: rebalance between frames\n"
            "                   when lambda exceeds 1 + --threshold (default 0.1)\n"
+           "  --farm F         auto (default) | all | idle | none, as for render: auto is all\n"
+           "                   (every worker holds every cell), or idle with --balance\n"
            "  --margin F       the world box is the scene bounds grown by F x diagonal on\n"
            "                   every side (default 0.25); objects cannot leave it\n"
            "  --keep-going     (animate) report bad lines and go on instead of stopping\n"
@@ -271,8 +274,9 @@ static char *frames_json(const vw_anim_session *s)
     if (!j) return NULL;
     size_t n = (size_t)snprintf(j, cap,
                                 "\"animation\": {\"frames\": %zu, \"accepted\": %zu, \"collisions\": %zu, "
-                                "\"sweeps\": %zu, \"invalid\": %zu, \"per_frame\": [",
-                                s->nframes, s->total_acc, s->total_coll, s->total_sweep, s->total_invalid);
+                                "\"sweeps\": %zu, \"invalid\": %zu, \"farm\": \"%s\", \"per_frame\": [",
+                                s->nframes, s->total_acc, s->total_coll, s->total_sweep, s->total_invalid,
+                                rt_farm_name(s->farm));
     for (size_t i = 0; i < s->nframes && n < cap; i++) {
         const frame_rec *f = &s->frames[i];
         n += (size_t)snprintf(j + n, cap - n,
@@ -301,7 +305,7 @@ int vw_anim_main(const char *cmd, int argc, char **argv)
     rt_anim_params p;
     memset(&p, 0, sizeof p);
     long workers = 0, depth = 0;
-    int rc = VW_EXIT_USAGE;
+    int rc = VW_EXIT_USAGE, farm = -1; /* -1: auto, resolved once the options are read */
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i], *v;
         if (!strcmp(a, "--help") || !strcmp(a, "-h")) {
@@ -320,6 +324,12 @@ int vw_anim_main(const char *cmd, int argc, char **argv)
             if (!(v = vw_cli_value(cmd, argc, argv, &i)) || vw_cli_int(cmd, a, v, 1, 64, &depth)) goto done;
         } else if (!strcmp(a, "--balance")) {
             if (!(s->strategy = vw_cli_value(cmd, argc, argv, &i))) goto done;
+        } else if (!strcmp(a, "--farm")) {
+            if (!(v = vw_cli_value(cmd, argc, argv, &i))) goto done;
+            if (strcmp(v, "auto") && (farm = rt_farm_parse(v)) < 0) {
+                vw_cli_error(cmd, "--farm: bad value '%s' (expected auto, all, idle or none)", v);
+                goto done;
+            }
         } else if (!strcmp(a, "--threshold")) {
             if (!(v = vw_cli_value(cmd, argc, argv, &i)) || vw_cli_double(cmd, a, v, 0, 100, &s->threshold)) goto done;
         } else if (!strcmp(a, "--margin")) {
@@ -361,6 +371,10 @@ int vw_anim_main(const char *cmd, int argc, char **argv)
     }
     p.workers = (int)workers;
     p.depth = (int)depth;
+    /* --farm auto, as render's: every worker holds every cell (a ray stays on its worker),
+       unless a balancer is asked for, whose plan then runs as mapped. */
+    p.farm = farm >= 0 ? (rt_farm)farm : s->strategy ? RT_FARM_IDLE : RT_FARM_ALL;
+    s->farm = p.farm;
     FILE *in = stdin;
     s->name = "stdin";
     if (edits_path) {
@@ -403,8 +417,9 @@ int vw_anim_main(const char *cmd, int argc, char **argv)
     if (!s->failed) flush(s);
     if (in != stdin) fclose(in);
     say(s, "%s: %zu accepted, %zu rejected at the destination, %zu rejected along the path, "
-           "%zu invalid; %zu frames\n",
-        cmd, s->total_acc, s->total_coll, s->total_sweep, s->total_invalid, s->nframes);
+           "%zu invalid; %zu frames (farm %s)\n",
+        cmd, s->total_acc, s->total_coll, s->total_sweep, s->total_invalid, s->nframes,
+        rt_farm_name(s->farm));
     if (stats && s->failed != 1) {
         char *extra = frames_json(s);
         vw_world *w = rt_job_world(rt_anim_job(s->anim));

@@ -20,6 +20,7 @@ struct rt_anim {
     vw_box world;
     double scale;
     int full_rebuild;
+    rt_farm farm;
     double last_lambda;
     rt_object *rec;       /* the records as last placed in the render world, by slot */
     size_t nrec, caprec;
@@ -69,6 +70,7 @@ vw_status rt_anim_create(vw_scene *s, const rt_anim_params *p, rt_anim **out, ch
         return VW_E_NOMEM;
     }
     a->full_rebuild = p->full_rebuild;
+    a->farm = p->farm;
     double lo[3], hi[3], diag = 0;
     vw_scene_bounds(s, lo, hi);
     for (int k = 0; k < 3; k++) diag += (hi[k] - lo[k]) * (hi[k] - lo[k]);
@@ -247,9 +249,9 @@ vw_status rt_anim_render(rt_anim *a, rt_anim_stats *rs, char *err, size_t errlen
     }
     st = rt_job_reset(a->job); /* cells keep their state; run() restarts eye rays */
     double t0 = now();
-    /* Workers without a cell (fewer cells than workers) farm the cells; copies follow
-       the objects' edits (they rebuild with their cell) and go with a new layout. */
-    if (st == VW_OK) st = rt_job_farm(a->job, RT_FARM_IDLE, NULL, err, errlen);
+    /* The workers share the cells as a->farm says; copies follow the objects' edits
+       (they read their cell's scene, rebuilt once) and go with a new layout. */
+    if (st == VW_OK) st = rt_job_farm(a->job, a->farm, NULL, err, errlen);
     if (st == VW_OK) st = rt_job_commit(a->job, err, errlen);
     double t1 = now();
     if (st == VW_OK) st = rt_job_run(a->job, err, errlen);

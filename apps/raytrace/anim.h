@@ -24,6 +24,8 @@ typedef struct rt_anim_params {
     int brute_force;            /* decide collisions with the O(n^2) reference */
     int full_rebuild;           /* benchmark: re-place every object and rebuild every
                                    cell at every frame instead of the touched ones */
+    rt_farm farm;               /* how the workers of a process share its cells at every
+                                   frame (rt_job_farm); 0 = RT_FARM_IDLE */
     vw_config *config;          /* may be NULL */
 } rt_anim_params;
 

@@ -25,6 +25,23 @@ grep -q '"animation"' s.json || fail "no animation member in the stats"
 grep -q '"command": "animate"' s.json || fail "stats command"
 grep -q "accepted" out.txt || fail "no summary"
 [ "$(wc -l < log.txt)" -eq 2 ] || fail "log should list both edits"
+# --farm: auto is all (every worker holds every cell), idle with --balance; every mode
+# gives the same frames.
+grep -q '"farm": "all"' s.json || fail "default farm is not all: $(grep -o '"farm": "[a-z]*"' s.json)"
+grep -q "(farm all)" out.txt || fail "the summary does not name the farm mode"
+for f in idle none; do
+  "$V" animate scene.nff ok.txt -o "$f%02d.png" --cells 2x2x1 --workers 2 --farm $f --quiet \
+    --stats $f.json || fail "--farm $f status $?"
+  grep -q "\"farm\": \"$f\"" $f.json || fail "--farm $f not in the stats"
+  cmp -s f00.png ${f}00.png && cmp -s f01.png ${f}01.png || fail "frames differ with --farm $f"
+done
+"$V" animate scene.nff ok.txt -o 't%02d.png' --cells 2x2x1 --workers 2 --balance tensor --quiet \
+  --stats t.json || fail "--balance tensor status $?"
+grep -q '"farm": "idle"' t.json || fail "--balance should farm idle workers only"
+"$V" animate scene.nff ok.txt -o 'x%02d.png' --farm most 2> xerr.txt; rc=$?
+[ $rc -eq 2 ] || fail "--farm most: status $rc, expected 2"
+grep -q "farm: bad value 'most'" xerr.txt || fail "--farm most message: $(cat xerr.txt)"
+[ -e x00.png ] && fail "a frame was rendered with a bad --farm"
 # One cell on two workers: the idle worker farms it (a copy, rebuilt with the cell
 # after the edits); the frames are the same bytes.
 "$V" animate scene.nff ok.txt -o 'g%02d.png' --cells 1 --workers 2 > gout.txt \

@@ -12,9 +12,17 @@ install(TARGETS vwalls vwalls_static
   LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}
   ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
   INCLUDES DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
-# The command is statically linked with the library, so it needs no rpath; it is not
-# part of the export set (nobody links against it).
+# The command is statically linked with the library, so it needs no rpath to it; it is
+# not part of the export set (nobody links against it).
 install(TARGETS vwalls_tool RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
+# The installed binaries are built with their installed RUNPATH (the directories of the
+# libraries they link outside the build tree: MPI's), so the install copies them as they
+# are. Otherwise CMake pads the build tree's RUNPATH with ':' for the install to rewrite
+# it in place, and that empty entry makes the loader search the current directory for
+# libpng, zlib, MPI and Embree: any library of those names there would be loaded.
+# (tests/install/runpath.sh checks.)
+set_target_properties(vwalls vwalls_tool PROPERTIES BUILD_WITH_INSTALL_RPATH ON
+                      INSTALL_RPATH_USE_LINK_PATH ON)
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/include/vwalls DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}
         FILES_MATCHING PATTERN "*.h")
 install(FILES ${PROJECT_BINARY_DIR}/include/vwalls/version.h

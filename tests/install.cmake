@@ -10,6 +10,12 @@ add_test(NAME install_symbols
 # nosan: a sanitizer build exports its instrumentation too; the contract is the plain build.
 set_tests_properties(install_symbols PROPERTIES LABELS "install;nosan")
 
+# No binary of the build tree searches the current directory for its libraries.
+add_test(NAME install_runpath
+         COMMAND sh ${PROJECT_SOURCE_DIR}/tests/install/runpath.sh $<TARGET_FILE:vwalls_tool>
+                 $<TARGET_FILE:vwalls>)
+set_tests_properties(install_runpath PROPERTIES LABELS "install")
+
 # vw_version() (from the generated header) is the CMake project version.
 add_test(NAME install_version COMMAND vwalls_tool --version)
 set_tests_properties(install_version PROPERTIES LABELS "install"

@@ -19,6 +19,8 @@ for f in bin/vwalls "$libdir/libvwalls.so" "$libdir/libvwalls.a" "$libdir/pkgcon
          "$docdir/examples/components.c" "$docdir/tutorial/hello_cells.c" "$docdir/tutorial.md"; do
   [ -e "$prefix/$f" ] || fail "not installed: $f"
 done
+# The installed binaries do not search the current directory for their libraries.
+sh "$here/runpath.sh" "$prefix/bin/vwalls" "$prefix/$libdir/libvwalls.so" >/dev/null
 # Internal headers stay internal.
 [ -z "$(find "$prefix/include" -name '*internal*')" ] || fail "internal headers installed"
 

@@ -7,7 +7,7 @@ set -euo pipefail
 want=()
 for what in "${@:-build}"; do
   case "$what" in
-    # python3: tests/radiosity/mpi.sh reads the stats JSON with it (radiosity_mpi_np*).
+    # python3: tests read the stats JSON with it (radiosity_mpi_np*, dynamic_cli).
     build) want+=(gcc libc6-dev make cmake pkg-config libembree-dev libpng-dev zlib1g-dev
                   libopenmpi-dev openmpi-bin openssh-client iproute2 python3) ;;
     bench) want+=(povray gnuplot-nox time python3 valgrind) ;;

@@ -153,3 +153,24 @@ void vw_progress_end(vw_progress *p)
     fprintf(stderr, "\r\033[K");
     fflush(stderr);
 }
+
+int vw_cli_appendf(char **buf, size_t *len, size_t *cap, const char *fmt, ...)
+{
+    for (;;) {
+        va_list ap;
+        va_start(ap, fmt);
+        int k = vsnprintf(*buf ? *buf + *len : NULL, *buf ? *cap - *len : 0, fmt, ap);
+        va_end(ap);
+        if (k < 0) return 0;
+        if (*buf && *len + (size_t)k < *cap) {
+            *len += (size_t)k;
+            return 1;
+        }
+        size_t ncap = 2 * *cap + (size_t)k + 1;
+        char *nb = realloc(*buf, ncap);
+        if (!nb) return 0;
+        if (!*buf) nb[0] = 0;
+        *buf = nb;
+        *cap = ncap;
+    }
+}

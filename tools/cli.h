@@ -51,4 +51,10 @@ void vw_progress_end(vw_progress *p);
 
 double vw_cli_now(void);
 
+/* Appends printf output to the string *buf (length *len, capacity *cap; *buf may start
+   NULL with both 0), growing it as needed. Returns 0 when out of memory, and then leaves
+   the string as it was. */
+int vw_cli_appendf(char **buf, size_t *len, size_t *cap, const char *fmt, ...)
+    __attribute__((format(printf, 4, 5)));
+
 #endif

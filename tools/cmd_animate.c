@@ -23,7 +23,7 @@ typedef struct vw_anim_session vw_anim_session;
 typedef struct frame_rec {
     int frame;
     size_t edits, accepted, rejected, records, cells;
-    double apply_s, update_s, build_s, render_s, lambda, balance_s;
+    double apply_s, update_s, build_s, render_s, lambda, work_lambda, balance_s;
     int balanced;
 } frame_rec;
 
@@ -162,10 +162,11 @@ static int do_frame(vw_anim_session *s)
     f->build_s = st.build_s;
     f->render_s = st.render_s;
     f->lambda = rt_anim_imbalance(s->anim);
+    f->work_lambda = rt_anim_work_imbalance(s->anim);
     say(s, "frame %d: %zu edits (%zu accepted), %zu records, %zu cells rebuilt; decide %.3f s, "
-           "update %.3f s, build %.3f s, render %.3f s, lambda %.3f\n",
+           "update %.3f s, build %.3f s, render %.3f s, lambda %.3f (work %.3f)\n",
         s->frame, f->edits, f->accepted, f->records, f->cells, f->apply_s, f->update_s, f->build_s,
-        f->render_s, f->lambda);
+        f->render_s, f->lambda, f->work_lambda);
     memset(&s->acc, 0, sizeof s->acc);
     s->frame++;
     /* Between frames: rebalance when the frame just rendered was uneven enough. */
@@ -269,26 +270,29 @@ static void help(const char *cmd)
 
 static char *frames_json(const vw_anim_session *s)
 {
-    size_t cap = 512 + s->nframes * 320;
-    char *j = malloc(cap);
-    if (!j) return NULL;
-    size_t n = (size_t)snprintf(j, cap,
-                                "\"animation\": {\"frames\": %zu, \"accepted\": %zu, \"collisions\": %zu, "
-                                "\"sweeps\": %zu, \"invalid\": %zu, \"farm\": \"%s\", \"per_frame\": [",
-                                s->nframes, s->total_acc, s->total_coll, s->total_sweep, s->total_invalid,
-                                rt_farm_name(s->farm));
-    for (size_t i = 0; i < s->nframes && n < cap; i++) {
+    char *j = NULL;
+    size_t n = 0, cap = 0;
+    int ok = vw_cli_appendf(&j, &n, &cap,
+                            "\"animation\": {\"frames\": %zu, \"accepted\": %zu, \"collisions\": %zu, "
+                            "\"sweeps\": %zu, \"invalid\": %zu, \"farm\": \"%s\", \"per_frame\": [",
+                            s->nframes, s->total_acc, s->total_coll, s->total_sweep, s->total_invalid,
+                            rt_farm_name(s->farm));
+    for (size_t i = 0; ok && i < s->nframes; i++) {
         const frame_rec *f = &s->frames[i];
-        n += (size_t)snprintf(j + n, cap - n,
-                              "%s\n    {\"frame\": %d, \"edits\": %zu, \"accepted\": %zu, \"records\": %zu, "
-                              "\"cells_rebuilt\": %zu, \"decide_s\": %.6f, \"update_s\": %.6f, "
-                              "\"build_s\": %.6f, \"render_s\": %.6f, \"lambda\": %.4f, \"balanced\": %d, "
-                              "\"balance_s\": %.6f}",
-                              i ? "," : "", f->frame, f->edits, f->accepted, f->records, f->cells,
-                              f->apply_s, f->update_s, f->build_s, f->render_s, f->lambda, f->balanced,
-                              f->balance_s);
+        ok = vw_cli_appendf(&j, &n, &cap,
+                            "%s\n    {\"frame\": %d, \"edits\": %zu, \"accepted\": %zu, \"records\": %zu, "
+                            "\"cells_rebuilt\": %zu, \"decide_s\": %.6f, \"update_s\": %.6f, "
+                            "\"build_s\": %.6f, \"render_s\": %.6f, \"lambda\": %.4f, "
+                            "\"work_lambda\": %.4f, \"balanced\": %d, \"balance_s\": %.6f}",
+                            i ? "," : "", f->frame, f->edits, f->accepted, f->records, f->cells,
+                            f->apply_s, f->update_s, f->build_s, f->render_s, f->lambda,
+                            f->work_lambda, f->balanced, f->balance_s);
     }
-    if (n < cap) snprintf(j + n, cap - n, "]}");
+    if (ok) ok = vw_cli_appendf(&j, &n, &cap, "]}");
+    if (!ok) {
+        free(j);
+        return NULL;
+    }
     return j;
 }
 
@@ -423,7 +427,10 @@ int vw_anim_main(const char *cmd, int argc, char **argv)
     if (stats && s->failed != 1) {
         char *extra = frames_json(s);
         vw_world *w = rt_job_world(rt_anim_job(s->anim));
-        if (vw_world_write_stats(w, stats, cmd, extra) != VW_OK) {
+        if (!extra) {
+            vw_cli_error(cmd, "out of memory for the stats");
+            if (!s->failed) s->failed = 1;
+        } else if (vw_world_write_stats(w, stats, cmd, extra) != VW_OK) {
             vw_cli_error(cmd, "cannot write '%s'", stats);
             if (!s->failed) s->failed = 1;
         }

@@ -71,17 +71,9 @@ static void on_progress(void *user, double ratio, int64_t shots)
     run_ctx *r = user;
     char note[96];
     snprintf(note, sizeof note, "unshot %.2e / sf %.0e, %lld shots", ratio, r->sf, (long long)shots);
-    char line[96];
-    int k = snprintf(line, sizeof line, "%.6f %lld %.9g\n", vw_cli_now() - r->t_start, (long long)shots, ratio);
-    if (k > 0 && r->ntrace + (size_t)k + 1 > r->captrace) {
-        size_t nc = r->captrace ? 2 * r->captrace : 4096;
-        char *nt = realloc(r->trace, nc);
-        if (nt) r->trace = nt, r->captrace = nc;
-    }
-    if (k > 0 && r->ntrace + (size_t)k + 1 <= r->captrace) {
-        memcpy(r->trace + r->ntrace, line, (size_t)k);
-        r->ntrace += (size_t)k;
-    }
+    /* (Out of memory, the line is left out.) */
+    vw_cli_appendf(&r->trace, &r->ntrace, &r->captrace, "%.6f %lld %.9g\n", vw_cli_now() - r->t_start,
+                   (long long)shots, ratio);
     double frac = ratio <= r->sf ? 1 : ratio >= 1 ? 0 : log(ratio) / log(r->sf);
     vw_progress_update(&r->bar, frac, note);
 }

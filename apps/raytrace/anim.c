@@ -21,7 +21,7 @@ struct rt_anim {
     double scale;
     int full_rebuild;
     rt_farm farm;
-    double last_lambda;
+    double last_lambda, last_work_lambda;
     rt_object *rec;       /* the records as last placed in the render world, by slot */
     size_t nrec, caprec;
 };
@@ -261,10 +261,12 @@ vw_status rt_anim_render(rt_anim *a, rt_anim_stats *rs, char *err, size_t errlen
         rs->render_s = t2 - t1;
     }
     a->last_lambda = vw_world_imbalance(w);
+    a->last_work_lambda = rt_job_work_imbalance(a->job, NULL);
     return st;
 }
 
 double rt_anim_imbalance(rt_anim *a) { return a->last_lambda; }
+double rt_anim_work_imbalance(rt_anim *a) { return a->last_work_lambda; }
 
 vw_status rt_anim_balance(rt_anim *a, const char *strategy, double *before, double *predicted,
                           char *err, size_t errlen)

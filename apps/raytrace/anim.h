@@ -62,5 +62,8 @@ vw_status rt_anim_balance(rt_anim *a, const char *strategy, double *lambda_befor
                           double *lambda_predicted, char *err, size_t errlen);
 /* Lambda (max/mean worker busy time) of the last frame. */
 double rt_anim_imbalance(rt_anim *a);
+/* Lambda of the last frame's counted work (ray segments per worker): the same on every
+   run and every machine, where busy time varies with the machine's load. */
+double rt_anim_work_imbalance(rt_anim *a);
 
 #endif

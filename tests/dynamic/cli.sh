@@ -29,6 +29,12 @@ grep -q "accepted" out.txt || fail "no summary"
 # gives the same frames.
 grep -q '"farm": "all"' s.json || fail "default farm is not all: $(grep -o '"farm": "[a-z]*"' s.json)"
 grep -q "(farm all)" out.txt || fail "the summary does not name the farm mode"
+# Every frame has its counted-work lambda (ray segments per worker): at least 1.
+python3 - s.json <<'PY' || fail "work_lambda per frame"
+import json, sys
+fr = json.load(open(sys.argv[1]))["animation"]["per_frame"]
+assert len(fr) == 2 and all(f["work_lambda"] >= 1.0 for f in fr), fr
+PY
 for f in idle none; do
   "$V" animate scene.nff ok.txt -o "$f%02d.png" --cells 2x2x1 --workers 2 --farm $f --quiet \
     --stats $f.json || fail "--farm $f status $?"

@@ -168,7 +168,10 @@ int vw_cli_appendf(char **buf, size_t *len, size_t *cap, const char *fmt, ...)
         }
         size_t ncap = 2 * *cap + (size_t)k + 1;
         char *nb = realloc(*buf, ncap);
-        if (!nb) return 0;
+        if (!nb) {
+            if (*buf) (*buf)[*len] = 0; /* (the try above may have written past it) */
+            return 0;
+        }
         if (!*buf) nb[0] = 0;
         *buf = nb;
         *cap = ncap;

@@ -42,7 +42,11 @@ ls "$T" | grep -q "tmp\." && fail "temporary file left behind"
 # Without --cells: one cell for one worker, at least 4 a worker for more; fewer cells
 # than workers given: a warning (radiosity cells cannot be shared).
 layout() { sed -n 's/.*"layout": "\([0-9x]*\)".*/\1/p' "$1" | head -n 1; }
-"$V" radiosity "$T/cornell.nff" -o "$T/d1.ply" --workers 1 --sf 1e-2 --quiet --stats "$T/d1.json" || fail "default cells, 1 worker"
+"$V" radiosity "$T/cornell.nff" -o "$T/d1.ply" --workers 1 --sf 1e-2 --quiet --stats "$T/d1.json" \
+  --trace "$T/d1.trace" || fail "default cells, 1 worker"
+# --trace: a line "seconds shots unshot_ratio" per round, the last ratio at or below sf.
+awk 'NF != 3 || $2 < 0 { bad = 1 } END { exit bad || NR < 1 || $3 > 0.01 }' "$T/d1.trace" \
+  || fail "--trace: $(head -n 3 "$T/d1.trace")"
 [ "$(layout "$T/d1.json")" = 1x1x1 ] || fail "default cells for 1 worker: $(layout "$T/d1.json")"
 "$V" radiosity "$T/cornell.nff" -o "$T/d2.ply" --workers 2 --sf 1e-2 --quiet --stats "$T/d2.json" || fail "default cells, 2 workers"
 [ "$(layout "$T/d2.json")" = 2x2x2 ] || fail "default cells for 2 workers: $(layout "$T/d2.json")"

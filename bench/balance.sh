@@ -67,9 +67,10 @@ done
 
 # A moving cluster over 20 frames (vwalls animate): 600 spheres spread over the box and a
 # cluster of 400 that travels along x from one side to the other; between frames the
-# balancer runs on the last frame's counted work when lambda (busy time) exceeds 1.1.
-# 8 cells, 8 workers on 2 cores: the per-frame busy-time lambda is noisy; the counted
-# work's (ray segments per worker) is the same on every run given the same rebalances.
+# balancer runs on the last frame's counted work when that work's lambda exceeds 1.1
+# (--trigger work). 8 cells, 8 workers on 2 cores: the per-frame busy-time lambda is
+# noise; the counted work's (ray segments per worker), and so the rebalances, are the
+# same on every run.
 awk 'BEGIN {
   print "v\nfrom 0.5 -2.2 0.9\nat 0.5 0.5 0.5\nup 0 0 1\nangle 35\nhither 0.01\nresolution 160 160";
   print "b 0.1 0.1 0.1\nl 2 -3 3\nl -1 -2 2\nf 0.8 0.8 0.8 0.8 0.2 10 0 1";
@@ -91,7 +92,7 @@ MOVING="$OUT/moving.md"
 for s in none tensor staggered divide; do
   mkdir -p "$OUT/frames"
   "$VWALLS" animate "$OUT/moving.nff" "$OUT/moving.edits" -o "$OUT/frames/$s-%04d.png" --cells 2x2x2 \
-    --workers 8 --balance "$s" --quiet --stats "$OUT/anim.json"
+    --workers 8 --balance "$s" --trigger work --quiet --stats "$OUT/anim.json"
   python3 - "$OUT/anim.json" "$s" >> "$MOVING" <<'PY'
 import json, sys
 fr = json.load(open(sys.argv[1]))["animation"]["per_frame"]

@@ -32,6 +32,7 @@ struct vw_anim_session {
     rt_anim *anim;
     int check, sweep, keep_going, interactive, quiet;
     double threshold;            /* rebalance when lambda > 1 + threshold */
+    int trigger_work;            /* that lambda is the counted work's, not busy time's */
     rt_farm farm;                /* how the workers share the cells (--farm) */
     FILE *log;                   /* every edit's outcome (output process), or NULL */
     vw_edit batch[MAX_BATCH];
@@ -170,7 +171,8 @@ static int do_frame(vw_anim_session *s)
     memset(&s->acc, 0, sizeof s->acc);
     s->frame++;
     /* Between frames: rebalance when the frame just rendered was uneven enough. */
-    if (s->strategy && strcmp(s->strategy, "none") && f->lambda > 1.0 + s->threshold) {
+    double lam = s->trigger_work ? f->work_lambda : f->lambda;
+    if (s->strategy && strcmp(s->strategy, "none") && lam > 1.0 + s->threshold) {
         double before = 0, pred = 0, t0 = vw_cli_now();
         rc = rt_anim_balance(s->anim, s->strategy, &before, &pred, err, sizeof err);
         f->balance_s = vw_cli_now() - t0;
@@ -255,6 +257,8 @@ static void help(const char *cmd)
            "  --depth D        maximum ray depth (default 5)\n"
            "  --balance S      none|tensor|rotate|staggered|divide: rebalance between frames\n"
            "                   when lambda exceeds 1 + --threshold (default 0.1)\n"
+           "  --trigger T      busy (default) | work: that lambda is of the workers' busy time,\n"
+           "                   or of their counted work (ray segments: the same on every run)\n"
            "  --farm F         auto (default) | all | idle | none, as for render: auto is all\n"
            "                   (every worker holds every cell), or idle with --balance\n"
            "  --margin F       the world box is the scene bounds grown by F x diagonal on\n"
@@ -334,6 +338,13 @@ int vw_anim_main(const char *cmd, int argc, char **argv)
                 vw_cli_error(cmd, "--farm: bad value '%s' (expected auto, all, idle or none)", v);
                 goto done;
             }
+        } else if (!strcmp(a, "--trigger")) {
+            if (!(v = vw_cli_value(cmd, argc, argv, &i))) goto done;
+            if (strcmp(v, "busy") && strcmp(v, "work")) {
+                vw_cli_error(cmd, "--trigger: bad value '%s' (expected busy or work)", v);
+                goto done;
+            }
+            s->trigger_work = !strcmp(v, "work");
         } else if (!strcmp(a, "--threshold")) {
             if (!(v = vw_cli_value(cmd, argc, argv, &i)) || vw_cli_double(cmd, a, v, 0, 100, &s->threshold)) goto done;
         } else if (!strcmp(a, "--margin")) {

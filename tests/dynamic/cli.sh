@@ -44,6 +44,20 @@ done
 "$V" animate scene.nff ok.txt -o 't%02d.png' --cells 2x2x1 --workers 2 --balance tensor --quiet \
   --stats t.json || fail "--balance tensor status $?"
 grep -q '"farm": "idle"' t.json || fail "--balance should farm idle workers only"
+# --trigger work: the counted work decides the rebalances, so two runs agree on them.
+for r in 1 2; do
+  "$V" animate scene.nff ok.txt -o "w$r-%02d.png" --cells 2x2x1 --workers 2 --balance tensor \
+    --threshold 0.2 --trigger work --quiet --stats w$r.json || fail "--trigger work status $?"
+done
+python3 - w1.json w2.json <<'PY' || fail "--trigger work: runs differ"
+import json, sys
+a, b = ([(f["work_lambda"], f["balanced"]) for f in json.load(open(x))["animation"]["per_frame"]]
+        for x in sys.argv[1:])
+assert a == b and all(bal == (lam > 1.2) for lam, bal in a), (a, b)
+PY
+"$V" animate scene.nff ok.txt -o 'y%02d.png' --trigger most 2> yerr.txt; rc=$?
+[ $rc -eq 2 ] || fail "--trigger most: status $rc, expected 2"
+grep -q "trigger: bad value 'most'" yerr.txt || fail "--trigger most message: $(cat yerr.txt)"
 "$V" animate scene.nff ok.txt -o 'x%02d.png' --farm most 2> xerr.txt; rc=$?
 [ $rc -eq 2 ] || fail "--farm most: status $rc, expected 2"
 grep -q "farm: bad value 'most'" xerr.txt || fail "--farm most message: $(cat xerr.txt)"

@@ -333,11 +333,7 @@ int vw_anim_main(const char *cmd, int argc, char **argv)
         } else if (!strcmp(a, "--balance")) {
             if (!(s->strategy = vw_cli_value(cmd, argc, argv, &i))) goto done;
         } else if (!strcmp(a, "--farm")) {
-            if (!(v = vw_cli_value(cmd, argc, argv, &i))) goto done;
-            if (strcmp(v, "auto") && (farm = rt_farm_parse(v)) < 0) {
-                vw_cli_error(cmd, "--farm: bad value '%s' (expected auto, all, idle or none)", v);
-                goto done;
-            }
+            if (!(v = vw_cli_value(cmd, argc, argv, &i)) || vw_cli_farm(cmd, v, &farm)) goto done;
         } else if (!strcmp(a, "--trigger")) {
             if (!(v = vw_cli_value(cmd, argc, argv, &i))) goto done;
             if (strcmp(v, "busy") && strcmp(v, "work")) {
@@ -386,9 +382,7 @@ int vw_anim_main(const char *cmd, int argc, char **argv)
     }
     p.workers = (int)workers;
     p.depth = (int)depth;
-    /* --farm auto, as render's: every worker holds every cell (a ray stays on its worker),
-       unless a balancer is asked for, whose plan then runs as mapped. */
-    p.farm = farm >= 0 ? (rt_farm)farm : s->strategy ? RT_FARM_IDLE : RT_FARM_ALL;
+    p.farm = (rt_farm)vw_cli_farm_resolve(farm, s->strategy != NULL); /* as render's */
     s->farm = p.farm;
     FILE *in = stdin;
     s->name = "stdin";

@@ -150,6 +150,28 @@ static char *with_balance_json(char *rt, rt_job *job, vw_world *w, const vw_traf
     return out;
 }
 
+int vw_cli_farm(const char *cmd, const char *v, int *farm)
+{
+    if (!strcmp(v, "auto")) {
+        *farm = -1;
+        return 0;
+    }
+    if ((*farm = rt_farm_parse(v)) < 0) {
+        vw_cli_error(cmd, "--farm: bad value '%s' (expected auto, all, idle or none)", v);
+        return 1;
+    }
+    return 0;
+}
+
+/* auto: every worker holds every cell of its process, the fastest on one machine (a ray
+   stays on its worker: no messages, no waiting for another worker), unless a balancer
+   or a mapping was asked for: then their plan runs as planned. */
+int vw_cli_farm_resolve(int farm, int planned)
+{
+    if (farm >= 0) return farm;
+    return planned ? RT_FARM_IDLE : RT_FARM_ALL;
+}
+
 int vw_cmd_render(int argc, char **argv)
 {
     const char *scene_path = NULL, *out = NULL, *stats = NULL, *overlay = NULL;
@@ -226,13 +248,8 @@ int vw_cmd_render(int argc, char **argv)
             }
             map_given = 1;
         } else if (!strcmp(a, "--farm")) {
-            if (!(v = vw_cli_value(CMD, argc, argv, &i))) return VW_EXIT_USAGE;
-            if (!strcmp(v, "auto")) {
-                farm = -1;
-            } else if ((farm = rt_farm_parse(v)) < 0) {
-                vw_cli_error(CMD, "--farm: bad value '%s' (expected auto, all, idle or none)", v);
+            if (!(v = vw_cli_value(CMD, argc, argv, &i)) || vw_cli_farm(CMD, v, &farm))
                 return VW_EXIT_USAGE;
-            }
         } else if (!strcmp(a, "--speeds")) {
             if (!(speeds_s = vw_cli_value(CMD, argc, argv, &i))) return VW_EXIT_USAGE;
         } else if (!strcmp(a, "--slow")) {
@@ -367,10 +384,7 @@ int vw_cmd_render(int argc, char **argv)
     /* The mapping of the initial cells (greedy and weighted refine it by load after the
        pre-pass, when there is one). */
     int balancing = strategy != VW_BALANCE_NONE || map != VW_MAP_BLOCK;
-    /* --farm auto: every worker holds every cell of its process, the fastest on one
-       machine (a ray stays on its worker: no messages, no waiting for another worker),
-       unless a balancer or a mapping was asked for: then their plan runs as planned. */
-    if (farm < 0) farm = balance_given || map_given ? RT_FARM_IDLE : RT_FARM_ALL;
+    farm = vw_cli_farm_resolve(farm, balance_given || map_given);
     rt_balance_result bi;
     memset(&bi, 0, sizeof bi);
     if ((map_given || speeds) && rt_job_map(job, map, NULL, speeds, err, sizeof err) != VW_OK) {

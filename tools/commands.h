@@ -17,4 +17,11 @@ int vw_cmd_edit(int argc, char **argv);
 /* The session of animate and edit (cmd_animate.c); cmd is "animate" or "edit". */
 int vw_anim_main(const char *cmd, int argc, char **argv);
 
+/* --farm of render, animate and edit (cmd_render.c): the value v as an rt_farm, or -1 for
+   auto, in *farm; reports a bad value and returns nonzero. */
+int vw_cli_farm(const char *cmd, const char *v, int *farm);
+/* --farm auto resolved: every worker holds every cell (all), unless a balancer or a
+   mapping was asked for (planned), whose plan then runs as mapped (idle). */
+int vw_cli_farm_resolve(int farm, int planned);
+
 #endif

@@ -113,6 +113,10 @@ VW_API vw_status vw_scene_find_object(const vw_scene *s, int id, vw_prim_kind *k
 /* Bounds of one primitive (same rules as vw_scene_bounds). */
 VW_API void vw_scene_object_bounds(const vw_scene *s, vw_prim_kind kind, size_t index,
                                    double lo[3], double hi[3]);
+/* Why the camera gives no view, or NULL when it gives one: a coordinate that is not a
+   finite number, 'from' and 'at' the same point, or 'up' zero or parallel to the view
+   direction. The NFF parser asks it of a 'v' block, the commands of their overrides. */
+VW_API const char *vw_camera_problem(const vw_camera *cam);
 /* A camera that sees the whole scene: for scenes without one (OBJ). It looks at the
    centre of the bounds from the +z side, slightly above (+y up, the OBJ convention),
    with a 45 degree field of view; width and height are kept from *cam when positive,

@@ -160,6 +160,11 @@ static vw_status read_num(nff *P, double *out)
     if (!lex_next(&P->lx, &t, 0))
         return fail(P, P->entity_line, "file ends in the middle of '%s'", P->entity);
     int r = parse_double(&t, out);
+    /* Every number must fit a float, as OBJ's do: Embree keeps geometry in floats, and
+       the world box and the walls are computed from the bounds without overflow. */
+    if (r == 1 && fabs(*out) > FLT_MAX)
+        return fail(P, t.line, "number '%s' out of range in '%s' (at most %g in size)",
+                    show(&t, sb), P->entity, (double)FLT_MAX);
     if (r == 1)
         return VW_OK;
     if (r < 0)
@@ -287,16 +292,9 @@ static vw_status parse_view(nff *P)
                         : !have_angle ? "angle" : !have_res ? "resolution" : NULL;
     if (missing)
         return fail(P, view_line, "'v' block without '%s'", missing);
-    double d[3], c[3];
-    for (int k = 0; k < 3; k++)
-        d[k] = cam->at[k] - cam->from[k];
-    if (d[0] == 0.0 && d[1] == 0.0 && d[2] == 0.0)
-        return fail(P, view_line, "'from' and 'at' are the same point");
-    c[0] = d[1] * cam->up[2] - d[2] * cam->up[1];
-    c[1] = d[2] * cam->up[0] - d[0] * cam->up[2];
-    c[2] = d[0] * cam->up[1] - d[1] * cam->up[0];
-    if (c[0] == 0.0 && c[1] == 0.0 && c[2] == 0.0)
-        return fail(P, view_line, "'up' is zero or parallel to the view direction");
+    const char *problem = vw_camera_problem(cam);
+    if (problem)
+        return fail(P, view_line, "%s", problem);
     cam->valid = 1;
     P->have_v = 1;
     return VW_OK;

@@ -128,6 +128,11 @@ static vw_status parse_double(obj *O, span t, double *out)
         return fail(O, "bad number '%s'", show(t, sb));
     if (r < 0)
         return fail(O, "NaN or infinite number '%s'", show(t, sb));
+    /* Every number must fit a float: Embree keeps geometry in floats, MTL colours are
+       floats, and the world box is computed from the bounds without overflow. */
+    if (fabs(*out) > FLT_MAX)
+        return fail(O, "number '%s' out of range (at most %g in size)", show(t, sb),
+                    (double)FLT_MAX);
     return VW_OK;
 }
 
@@ -163,11 +168,8 @@ static vw_status mtl_color(obj *O, span *line, const char *key, float col[3])
         return fail(O, "wrong number of values for '%s'", key);
     if (n == 1)
         v[1] = v[2] = v[0];   /* "Kd r" means grey */
-    for (int k = 0; k < 3; k++) {
-        if (fabs(v[k]) > FLT_MAX)
-            return fail(O, "number out of range in '%s'", key);
-        col[k] = (float)v[k];
-    }
+    for (int k = 0; k < 3; k++)
+        col[k] = (float)v[k]; /* in range: parse_double checked */
     return VW_OK;
 }
 
@@ -177,9 +179,7 @@ static vw_status mtl_scalar(obj *O, span *line, const char *key, float *out)
     vw_status st = read_numbers(O, line, key, &v, 1, 1, NULL);
     if (st != VW_OK)
         return st;
-    if (fabs(v) > FLT_MAX)
-        return fail(O, "number out of range in '%s'", key);
-    *out = (float)v;
+    *out = (float)v; /* in range: parse_double checked */
     return VW_OK;
 }
 

@@ -602,6 +602,24 @@ VW_API vw_status vw_scene_find_object(const vw_scene *s, int id, vw_prim_kind *k
     return VW_E_INVAL;
 }
 
+VW_API const char *vw_camera_problem(const vw_camera *cam)
+{
+    double d[3], c[3];
+    for (int k = 0; k < 3; k++) {
+        if (!isfinite(cam->from[k]) || !isfinite(cam->at[k]) || !isfinite(cam->up[k]))
+            return "a coordinate of 'from', 'at' or 'up' is not a finite number";
+        d[k] = cam->at[k] - cam->from[k];
+    }
+    if (d[0] == 0.0 && d[1] == 0.0 && d[2] == 0.0)
+        return "'from' and 'at' are the same point";
+    c[0] = d[1] * cam->up[2] - d[2] * cam->up[1];
+    c[1] = d[2] * cam->up[0] - d[0] * cam->up[2];
+    c[2] = d[0] * cam->up[1] - d[1] * cam->up[0];
+    if (c[0] == 0.0 && c[1] == 0.0 && c[2] == 0.0)
+        return "'up' is zero or parallel to the view direction";
+    return NULL;
+}
+
 VW_API void vw_scene_default_camera(const vw_scene *s, vw_camera *cam)
 {
     double lo[3], hi[3], c[3], e[3], emax = 0.0, cmax = 0.0;
@@ -633,14 +651,28 @@ VW_API void vw_scene_default_camera(const vw_scene *s, vw_camera *cam)
        leaves a margin. The direction is normalised (0.3, 0.4, 1). */
     static const double dir[3] = {0.27196414661021, 0.36261886214694, 0.90654715536736};
     int w = cam->width > 0 ? cam->width : 512, h = cam->height > 0 ? cam->height : 512;
+    /* 'from' stays within a float's range, as the scene files' numbers must, so that the
+       camera written as NFF reads back. For a scene at the edge of that range the view
+       steps back on each axis toward the origin instead, and no farther than fits. */
+    double t = 1.5 * d, side[3] = {1.0, 1.0, 1.0};
+    int fits = 1;
+    for (int k = 0; k < 3; k++)
+        fits &= fabs(c[k] + t * dir[k]) <= FLT_MAX;
+    if (!fits)
+        for (int k = 0; k < 3; k++) {
+            side[k] = c[k] > 0 ? -1.0 : 1.0;
+            double room = 0.999 * (FLT_MAX + fabs(c[k])) / dir[k];
+            if (t > room)
+                t = room;
+        }
     memset(cam, 0, sizeof *cam);
     for (int k = 0; k < 3; k++) {
         cam->at[k] = c[k];
-        cam->from[k] = c[k] + 1.5 * d * dir[k];
+        cam->from[k] = c[k] + side[k] * t * dir[k];
     }
     cam->up[1] = 1.0;
     cam->angle = 45.0;
-    cam->hither = 1e-3 * d;
+    cam->hither = 1e-3 * (t < d ? t : d);
     cam->width = w;
     cam->height = h;
     cam->valid = 0;

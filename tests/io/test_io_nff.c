@@ -232,7 +232,8 @@ int main(int argc, char **argv)
     expect_error(VIEW "\n\np 3 0 0 0\n1 0 0\n", "t.nff:4: file ends in the middle of 'p'");
     expect_error(VIEW "p -1\n", "t.nff:2: polygon needs at least 3 vertices");
     expect_error(VIEW "p 99999999999\n", "t.nff:2: vertex count 99999999999 out of range in 'p' (3..2147483647)");
-    expect_error(VIEW "b 1 2 3e39\n", "t.nff:2: number 3e+39 out of range in 'b'");
+    expect_error(VIEW "b 1 2 3e39\n",
+                 "t.nff:2: number '3e39' out of range in 'b' (at most 3.40282e+38 in size)");
     expect_error("", "t.nff:1: missing 'v' block (NFF needs a camera)");
     expect_error(VIEW "s 0 0 0 1\n7\n", "t.nff:3: wrong number of values for 's'");
     expect_error(VIEW "s 0 0 0 1\x01\n", "t.nff:2: bad number '1?' in 's'");

@@ -95,9 +95,12 @@ int main(int argc, char **argv)
     /* Meshes far from the origin, huge or degenerate, still get a usable default
        camera when written as NFF (the reader rejects 'from' equal to 'at'). */
     const char *far[] = {"v 1e20 1e20 1e20\nv 1e20 1e20 1e20\nv 1e20 1e20 1e20\nf 1 2 3\n",
-                         "v -1e300 0 0\nv 1e300 0 0\nv 0 1e300 1e300\nf 1 2 3\n",
-                         "v 0 0 0\nv 0 0 0\nv 0 0 0\nf 1 2 3\n"};
-    for (int i = 0; i < 3; i++) {
+                         "v -3.4e38 0 0\nv 3.4e38 0 0\nv 0 3.4e38 3.4e38\nf 1 2 3\n",
+                         "v 0 0 0\nv 0 0 0\nv 0 0 0\nf 1 2 3\n",
+                         /* at a corner of the float range: no room on the usual side */
+                         "v 3.4e38 -3.4e38 3.4e38\nv 3.4e38 -3.3e38 3.4e38\nv 3.3e38 -3.4e38 3.4e38\n"
+                         "f 1 2 3\n"};
+    for (int i = 0; i < 4; i++) {
         CHECK_EQ_INT(vw_scene_read_obj("far.obj", far[i], strlen(far[i]), NULL, &n, err,
                                        sizeof err), VW_OK);
         char *fw = nff_string(n, NULL);

@@ -5,6 +5,7 @@
 #include "vwalls/engine.h"
 
 #include <errno.h>
+#include <float.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -60,6 +61,30 @@ int vw_cli_double(const char *cmd, const char *opt, const char *s, double lo, do
     }
     *out = v;
     return 0;
+}
+
+int vw_cli_numbers(const char *cmd, const char *opt, const char *s, const char *shape,
+                   double *out, int min, int max, int *n)
+{
+    int k = 0;
+    const char *p = s ? s : "";
+    for (;;) {
+        char *end;
+        errno = 0;
+        double v = strtod(p, &end);
+        if (end == p || errno || !(fabs(v) <= FLT_MAX) || k == max) break;
+        out[k++] = v;
+        if (!*end) {
+            if (k < min) break;
+            if (n) *n = k;
+            return 0;
+        }
+        if (*end != ',') break;
+        p = end + 1;
+    }
+    vw_cli_error(cmd, "%s: bad value '%s' (expected %s: finite numbers of at most %g in size)",
+                 opt, s ? s : "", shape, (double)FLT_MAX);
+    return -1;
 }
 
 int vw_cli_size(const char *cmd, const char *opt, const char *s, int *w, int *h)

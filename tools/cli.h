@@ -20,6 +20,11 @@ int vw_cli_int(const char *cmd, const char *opt, const char *s, long lo, long hi
 int vw_cli_double(const char *cmd, const char *opt, const char *s, double lo, double hi,
                   double *out);
 int vw_cli_size(const char *cmd, const char *opt, const char *s, int *w, int *h);  /* WxH */
+/* Between min and max comma-separated numbers (shape names them in the message, like
+   "X,Y,Z"), each finite and at most FLT_MAX in size, the scene files' range; *n (when
+   not NULL) gets their count. */
+int vw_cli_numbers(const char *cmd, const char *opt, const char *s, const char *shape,
+                   double *out, int min, int max, int *n);
 int vw_cli_layout(const char *cmd, const char *opt, const char *s, int dims[3]);
 
 /* The value after option argv[*i] (advancing *i), or an error and NULL. */

@@ -3,6 +3,8 @@
  * stats JSON and a picture of the walls tinted by each cell's measured load.
  */
 #define _POSIX_C_SOURCE 200809L
+#include <float.h>
+#include <math.h>
 #include <pthread.h>
 #include <stdatomic.h>
 #include <stdio.h>
@@ -69,16 +71,6 @@ static int ends_with(const char *s, const char *suf)
 {
     size_t n = strlen(s), m = strlen(suf);
     return n >= m && !strcasecmp(s + n - m, suf);
-}
-
-static int parse_vec(const char *opt, const char *s, double v[3])
-{
-    char tail;
-    if (!s || sscanf(s, "%lf,%lf,%lf%c", &v[0], &v[1], &v[2], &tail) != 3) {
-        vw_cli_error(CMD, "%s: bad value '%s' (expected X,Y,Z)", opt, s ? s : "");
-        return -1;
-    }
-    return 0;
 }
 
 /* The progress bar: a small thread polls the output handler's atomic counter, so the
@@ -262,13 +254,19 @@ int vw_cmd_render(int argc, char **argv)
             }
             by_worker = !strcmp(v, "worker");
         } else if (!strcmp(a, "--from")) {
-            if (parse_vec(a, vw_cli_value(CMD, argc, argv, &i), from)) return VW_EXIT_USAGE;
+            if (vw_cli_numbers(CMD, a, vw_cli_value(CMD, argc, argv, &i), "X,Y,Z", from, 3, 3,
+                               NULL))
+                return VW_EXIT_USAGE;
             has_from = 1;
         } else if (!strcmp(a, "--at")) {
-            if (parse_vec(a, vw_cli_value(CMD, argc, argv, &i), at)) return VW_EXIT_USAGE;
+            if (vw_cli_numbers(CMD, a, vw_cli_value(CMD, argc, argv, &i), "X,Y,Z", at, 3, 3,
+                               NULL))
+                return VW_EXIT_USAGE;
             has_at = 1;
         } else if (!strcmp(a, "--up")) {
-            if (parse_vec(a, vw_cli_value(CMD, argc, argv, &i), up)) return VW_EXIT_USAGE;
+            if (vw_cli_numbers(CMD, a, vw_cli_value(CMD, argc, argv, &i), "X,Y,Z", up, 3, 3,
+                               NULL))
+                return VW_EXIT_USAGE;
             has_up = 1;
         } else if (!strcmp(a, "--angle")) {
             if (!(v = vw_cli_value(CMD, argc, argv, &i)) ||
@@ -357,6 +355,13 @@ int vw_cmd_render(int argc, char **argv)
     if (has_at) memcpy(cam.at, at, sizeof at);
     if (has_up) memcpy(cam.up, up, sizeof up);
     if (has_angle) cam.angle = angle;
+    const char *camera_problem = vw_camera_problem(&cam);
+    if (camera_problem) { /* a file's own camera was checked by its parser */
+        vw_cli_error(CMD, "--from/--at/--up: %s", camera_problem);
+        vw_scene_free(scene);
+        free(speeds), free(slowdown);
+        return VW_EXIT_USAGE;
+    }
 
     rt_params p;
     memset(&p, 0, sizeof p);

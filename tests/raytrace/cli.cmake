@@ -75,6 +75,29 @@ endif()
 if(EXISTS ${WORK}/bad.png)
   message(FATAL_ERROR "bad scene: an output file was left behind")
 endif()
+# Camera overrides that give no view: exit 2, a message, no output file (a NaN or an
+# infinite 'from' used to reach Embree and abort the process).
+foreach(case "--from;1,2,nan;--from: bad value '1,2,nan'"
+             "--from;inf,0,0;--from: bad value 'inf,0,0'"
+             "--at;1e300,0,0;--at: bad value '1e300,0,0'"
+             "--up;0,0,0;'up' is zero or parallel"
+             "--from;0,0,0;'from' and 'at' are the same point")
+  list(GET case 0 opt)
+  list(GET case 1 val)
+  list(GET case 2 want)
+  set(extra)
+  if(val STREQUAL "0,0,0" AND opt STREQUAL "--from")
+    set(extra --at 0,0,0)
+  endif()
+  file(REMOVE ${WORK}/cam.png)
+  execute_process(COMMAND ${VWALLS} render ${SCENE} -o ${WORK}/cam.png --size 8x8 --quiet
+                          ${opt} ${val} ${extra}
+                  RESULT_VARIABLE rc ERROR_VARIABLE err)
+  string(FIND "${err}" "${want}" at)
+  if(NOT rc EQUAL 2 OR at LESS 0 OR EXISTS ${WORK}/cam.png)
+    message(FATAL_ERROR "${opt} ${val}: exit ${rc}, expected 2, '${want}' and no file (${err})")
+  endif()
+endforeach()
 # Bad usage.
 execute_process(COMMAND ${VWALLS} render ${SCENE} -o ${WORK}/x.jpg RESULT_VARIABLE rc
                 OUTPUT_QUIET ERROR_QUIET)

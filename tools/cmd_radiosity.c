@@ -39,7 +39,8 @@ static void help(void)
            "  --max-shots N        stop after about N shots (not converged)\n"
            "  --csv FILE           per polygon: id, area, reflectance, emission, radiosity\n"
            "  --image FILE.png     picture from the scene's camera (or --view)\n"
-           "  --view F,A[,FOV]     camera: from x,y,z, at x,y,z, vertical angle (degrees)\n"
+           "  --view F,A[,FOV]     camera: from x,y,z, at x,y,z, vertical angle (degrees,\n"
+           "                       0.001-179, default 45); +y up (+z for a vertical view)\n"
            "  --size WxH           picture size (default: the camera's, or 512x512)\n"
            "  --snapshot-every N   rewrite the outputs every N shots while solving\n"
            "  --stats FILE.json    stats JSON (radiosity: shots, unshot_ratio, energy_error)\n"
@@ -113,16 +114,28 @@ static void on_round(void *user, rad_solver *s, int round)
     if (vw_world_is_output(rad_solver_world(s)) && write_outputs(r, s)) r->failed = 1;
 }
 
+/* --view fx,fy,fz,ax,ay,az[,fov]: the camera, +y up (+z when the view is vertical);
+   -1 after the message when it gives no view. */
 static int parse_view(const char *v, vw_camera *cam)
 {
     double x[7];
-    int n = sscanf(v, "%lf,%lf,%lf,%lf,%lf,%lf,%lf", &x[0], &x[1], &x[2], &x[3], &x[4], &x[5], &x[6]);
-    if (n < 6) return -1;
+    int n;
+    if (vw_cli_numbers(CMD, "--view", v, "fx,fy,fz,ax,ay,az[,fov]", x, 6, 7, &n)) return -1;
     for (int k = 0; k < 3; k++) cam->from[k] = x[k], cam->at[k] = x[3 + k];
-    cam->up[0] = 0, cam->up[1] = 1, cam->up[2] = 0;
-    if (n == 7) cam->angle = x[6];
-    if (!(cam->angle > 0 && cam->angle < 180)) cam->angle = 45;
+    cam->angle = n == 7 ? x[6] : 45;
+    if (!(cam->angle >= 0.001 && cam->angle <= 179)) { /* the range of render --angle */
+        vw_cli_error(CMD, "--view: field of view %g out of range (0.001 to 179 degrees)",
+                     cam->angle);
+        return -1;
+    }
+    int vertical = cam->from[0] == cam->at[0] && cam->from[2] == cam->at[2];
+    cam->up[0] = 0, cam->up[1] = vertical ? 0 : 1, cam->up[2] = vertical ? 1 : 0;
     cam->hither = 1e-3;
+    const char *problem = vw_camera_problem(cam);
+    if (problem) {
+        vw_cli_error(CMD, "--view: %s", problem);
+        return -1;
+    }
     return 0;
 }
 
@@ -246,10 +259,7 @@ int vw_cmd_radiosity(int argc, char **argv)
     }
     vw_camera cam_view;
     memset(&cam_view, 0, sizeof cam_view);
-    if (view && parse_view(view, &cam_view)) {
-        vw_cli_error(CMD, "--view: bad value '%s' (expected fx,fy,fz,ax,ay,az[,fov])", view);
-        return VW_EXIT_USAGE;
-    }
+    if (view && parse_view(view, &cam_view)) return VW_EXIT_USAGE;
 
     /* A radiosity cell cannot be shared by workers (a shot's bitmaps depend on the order
        of the cells, so its messages are not independent): a worker without a cell has
@@ -296,7 +306,7 @@ int vw_cmd_radiosity(int argc, char **argv)
         if (vw_cli_is_output()) fprintf(stderr, "%s\n", err);
         vw_decomp_free(d);
         vw_scene_free(sc);
-        return st == VW_E_INPUT ? VW_EXIT_USAGE : VW_EXIT_FAIL;
+        return st == VW_E_INPUT || st == VW_E_LIMIT ? VW_EXIT_USAGE : VW_EXIT_FAIL;
     }
     r.scene = sc;
     r.mesh = &mesh;
@@ -399,6 +409,12 @@ int vw_cmd_radiosity(int argc, char **argv)
                    (long long)rad_solver_shots(s), rad_solver_unshot_ratio(s), o.sf, L.error, t4 - t3);
             printf("shot messages %lld (%lld bytes), full notices %lld\n", (long long)sm, (long long)sb,
                    (long long)fm);
+            /* sf bounds the largest patch's share of the emitted power: emitters meshed
+               into more than 1/sf patches start below it, and nothing is lit. */
+            if (converged && rad_solver_shots(s) == 0)
+                fprintf(stderr, "vwalls radiosity: warning: converged before the first shot: no "
+                                "patch holds sf = %g of the emitted power (the emitters are meshed "
+                                "finer); give a smaller --sf or a larger --patch-size\n", o.sf);
         }
         if (L.error > 1e-6) {
             vw_cli_error(CMD, "energy ledger off by %.3g (relative)", L.error);

@@ -218,7 +218,8 @@ static int push_piece(rad_mesh *m, size_t *cap, const rad_piece *pc, int owner)
 static vw_status mesh_polygon(rad_mesh *m, size_t *cap, const vw_decomp *d, const rad_poly *poly,
                               const double normal[3], const double origin[3], const double ua[3],
                               const double va[3], double S, double elem, int id,
-                              const vw_material *mat, int *cells, int ncap, double tiny)
+                              const vw_material *mat, int *cells, int ncap, double tiny,
+                              double *squares)
 {
     double umin = INFINITY, umax = -INFINITY, vmin = INFINITY, vmax = -INFINITY;
     for (int i = 0; i < poly->n; i++) {
@@ -227,6 +228,11 @@ static vw_status mesh_polygon(rad_mesh *m, size_t *cap, const vw_decomp *d, cons
         double u = rad_dot(q, ua), v = rad_dot(q, va);
         umin = fmin(umin, u), umax = fmax(umax, u), vmin = fmin(vmin, v), vmax = fmax(vmax, v);
     }
+    /* The squares of side S over the polygon's extent, counted before they are visited
+       (and before their indices are made ints): a patch size far below the scene's
+       would take forever or overflow. */
+    *squares += (floor(umax / S) - floor(umin / S) + 1) * (floor(vmax / S) - floor(vmin / S) + 1);
+    if (!(*squares <= RAD_MAX_SQUARES)) return VW_E_LIMIT;
     const double *frame = vw_decomp_frame(d);
     for (int i = (int)floor(umin / S); i <= (int)floor(umax / S); i++)
         for (int j = (int)floor(vmin / S); j <= (int)floor(vmax / S); j++) {
@@ -289,6 +295,7 @@ vw_status rad_mesh_build(const vw_scene *s, const char *path, const vw_decomp *d
     if (!cells) return VW_E_NOMEM;
     vw_status st = VW_OK;
     int max_id = -1;
+    double squares = 0; /* of the patch grid over every polygon so far */
     for (size_t k = 0; k < s->npolygons && st == VW_OK; k++) {
         const vw_polygon *pg = &s->polygons[k];
         if (pg->id > max_id) max_id = pg->id;
@@ -375,13 +382,18 @@ vw_status rad_mesh_build(const vw_scene *s, const char *path, const vw_decomp *d
             }
             if (all.n < 3 || rad_poly_area(&all, NULL, NULL) <= tiny) continue;
             st = mesh_polygon(m, &cap, d, &all, normal, origin, ua, va, S, elem, pg->id, mat, cells,
-                              ncells, tiny);
+                              ncells, tiny, &squares);
             if (all.n < chunk) break;
         }
     }
     free(cells);
     m->npolys = (size_t)(max_id + 1);
     if (st == VW_E_NOMEM) snprintf(err, errlen, "%s: out of memory while meshing", path ? path : "scene");
+    if (st == VW_E_LIMIT)
+        snprintf(err, errlen,
+                 "%s: patch size %g is too small for this scene: more than %d patch squares "
+                 "(the default is %g)", path ? path : "scene", S, RAD_MAX_SQUARES,
+                 rad_default_patch_size(s));
     if (st == VW_OK && m->npieces == 0) {
         snprintf(err, errlen, "%s: no polygon to mesh (radiosity needs polygons)", path ? path : "scene");
         st = VW_E_INPUT;

@@ -25,6 +25,9 @@
 /* Hemicube resolution limit: a shot message (header + 3 res^2 bits) must fit into
    VW_MAX_MSG_BYTES. */
 #define RAD_MAX_RES 100
+/* The most squares of side --patch-size that meshing lays over the polygons (each
+   becomes a patch where it meets one): about a gigabyte of patches. */
+#define RAD_MAX_SQUARES (1 << 21)
 
 /* The object handed to the runtime: one patch clipped to one cell (plain data). */
 typedef struct rad_piece {

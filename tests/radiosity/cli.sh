@@ -25,6 +25,33 @@ grep -q "nonplanar.obj:7: polygon (id 0) is not planar" "$T/err" || fail "non-pl
 
 # Kill after a checkpoint, resume, compare with the uninterrupted run.
 "$TR" gen cornell "$T/cornell.nff" || fail "gen"
+
+# --view that gives no view: exit 2, the reason, no picture (a NaN, a field of view
+# out of range or 'from' equal to 'at' used to be taken as they came, or made 45).
+for bad in "1,2,nan,0,0,0:finite numbers" "0,0,0,0,0,0:the same point" \
+           "1,1,1,0,0,0,200:field of view 200 out of range" "1,1,1,0,0,0,30,5:finite numbers"; do
+  val=${bad%%:*} want=${bad#*:}
+  "$V" radiosity "$T/cornell.nff" --image "$T/v.png" --view "$val" --max-shots 4 --quiet \
+    2>"$T/err"; rc=$?
+  [ $rc -eq 2 ] || fail "--view $val: exit $rc"
+  grep -q "$want" "$T/err" || fail "--view $val: message: $(cat "$T/err")"
+  [ ! -e "$T/v.png" ] || fail "--view $val: picture written"
+done
+# A patch size far below the scene's: refused before meshing (it used to overflow the
+# patch indices and report "no polygon to mesh").
+"$V" radiosity "$T/cornell.nff" -o "$T/p.ply" --patch-size 1e-9 --quiet 2>"$T/err"; rc=$?
+[ $rc -eq 2 ] || fail "--patch-size 1e-9: exit $rc"
+grep -q "patch size 1e-09 is too small" "$T/err" || fail "--patch-size 1e-9: message: $(cat "$T/err")"
+[ ! -e "$T/p.ply" ] || fail "--patch-size 1e-9: output written"
+# sf above every patch's share of the emitted power: converged at once, and said so.
+"$V" radiosity "$T/cornell.nff" -o "$T/p.ply" --sf 0.5 >/dev/null 2>"$T/err" || fail "--sf 0.5"
+grep -q "warning: converged before the first shot" "$T/err" || fail "--sf 0.5: no warning"
+"$V" radiosity "$T/cornell.nff" -o "$T/p.ply" --max-shots 4 >/dev/null 2>"$T/err" || fail "a run"
+! grep -q "before the first shot" "$T/err" || fail "a run that shot: a warning: $(cat "$T/err")"
+# Looking straight down (+y up would be parallel to the view): +z is up instead.
+"$V" radiosity "$T/cornell.nff" --image "$T/v.png" --view 278,540,280,278,0,280,100 \
+  --size 16x16 --max-shots 4 --quiet 2>"$T/err" || fail "vertical --view: $(cat "$T/err")"
+[ -s "$T/v.png" ] || fail "vertical --view: no picture"
 opts="--cells 2x2x2 --workers 2 --sf 2e-4 --quiet"
 "$V" radiosity "$T/cornell.nff" $opts --csv "$T/full.csv" 2>/dev/null || fail "uninterrupted run"
 "$V" radiosity "$T/cornell.nff" $opts --csv "$T/never.csv" --checkpoint "$T/ck" --checkpoint-every 0 2>/dev/null &

@@ -24,10 +24,11 @@ static void gen_usage(FILE *f)
             "  cornell  the Cornell box as polygons, with an emitting light (for radiosity)\n"
             "  room     a furnished room (table, chairs, shelf) with one ceiling light\n"
             "\noptions:\n"
-            "  --size N          size factor or depth (default per scene)\n"
+            "  --size N          size factor or depth of balls, rings, tree (default per scene)\n"
             "  --count N         number of spheres for 'spheres' (default 1000)\n"
             "  --seed S          random seed (default 1); the same seed gives the same scene\n"
             "  --cluster F       fraction of spheres in the cluster region, 0..1 (default 0)\n"
+            "                    (an option the scene has no use for is an error)\n"
             "  --resolution WxH  camera resolution (default 512x512)\n"
             "  -o FILE           write to FILE (atomically) instead of stdout\n"
             "  --help            this text\n"
@@ -46,7 +47,7 @@ int vw_cmd_gen(int argc, char **argv)
             gen_usage(stdout);
             return VW_EXIT_OK;
         } else if (!strcmp(a, "--size")) {
-            if (!(v = vw_cli_value(cmd, argc, argv, &i)) || vw_cli_int(cmd, a, v, 0, 1000, &n))
+            if (!(v = vw_cli_value(cmd, argc, argv, &i)) || vw_cli_int(cmd, a, v, 1, 1000, &n))
                 return VW_EXIT_USAGE;
             p.size = (int)n;
         } else if (!strcmp(a, "--count")) {
@@ -89,6 +90,16 @@ int vw_cmd_gen(int argc, char **argv)
     if (!name) {
         vw_cli_error(cmd, "which scene? balls, rings, tree, spheres, cornell or room "
                           "(try vwalls gen --help)");
+        return VW_EXIT_USAGE;
+    }
+    /* An option the scene has no use for is a mistake, not a no-op. */
+    int sized = !strcmp(name, "balls") || !strcmp(name, "rings") || !strcmp(name, "tree");
+    int random = !strcmp(name, "spheres");
+    const char *unused = p.size && !sized ? "--size" : p.count && !random ? "--count"
+                       : p.cluster != 0 && !random ? "--cluster" : NULL;
+    if (unused) {
+        vw_cli_error(cmd, "%s: '%s' takes no such option (--size: balls, rings, tree; "
+                          "--count, --cluster: spheres)", unused, name);
         return VW_EXIT_USAGE;
     }
     char err[512] = "";

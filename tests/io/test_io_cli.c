@@ -92,6 +92,15 @@ int main(int argc, char **argv)
     CHECK_EQ_INT(run(vw_cmd_gen, (const char *[]){"gen", "teapot", NULL}), 2);
     CHECK_EQ_INT(run(vw_cmd_gen, (const char *[]){"gen", NULL}), 2);
     CHECK_EQ_INT(run(vw_cmd_gen, (const char *[]){"gen", "spheres", "--cluster", "2", NULL}), 2);
+    /* An option the scene has no use for, or size 0, is an error, not a silent default. */
+    CHECK_EQ_INT(run(vw_cmd_gen, (const char *[]){"gen", "rings", "--size", "0", NULL}), 2);
+    CHECK_EQ_INT(run(vw_cmd_gen, (const char *[]){"gen", "cornell", "--size", "3", NULL}), 2);
+    t = text_of(err_path);
+    CHECK(strstr(t, "'cornell' takes no such option") && lines(t) == 1);
+    free(t);
+    CHECK_EQ_INT(run(vw_cmd_gen, (const char *[]){"gen", "balls", "--count", "5", NULL}), 2);
+    CHECK_EQ_INT(run(vw_cmd_gen, (const char *[]){"gen", "tree", "--cluster", "0.5", NULL}), 2);
+    CHECK_EQ_INT(run(vw_cmd_gen, (const char *[]){"gen", "spheres", "--size", "2", NULL}), 2);
 
     /* NFF to stdout equals NFF to -o. */
     CHECK_EQ_INT(run(vw_cmd_gen, (const char *[]){"gen", "balls", "--size", "2", "--resolution",

@@ -102,7 +102,8 @@ int vw_cli_size(const char *cmd, const char *opt, const char *s, int *w, int *h)
             return 0;
         }
     }
-    vw_cli_error(cmd, "%s: bad value '%s' (expected WIDTHxHEIGHT, like 512x512)", opt, s ? s : "");
+    vw_cli_error(cmd, "%s: bad value '%s' (expected WIDTHxHEIGHT, like 512x512: sides of 1 to "
+                      "65536, at most 2^28 pixels)", opt, s ? s : "");
     return -1;
 }
 

@@ -162,7 +162,7 @@ vw_status rt_job_create(const vw_scene *s, const rt_params *p, rt_job **out, cha
     int w = p->width > 0 ? p->width : cam.width > 0 ? cam.width : 512;
     int h = p->height > 0 ? p->height : cam.height > 0 ? cam.height : 512;
     if (w > 16384 || h > 16384) {
-        snprintf(err, errlen, "image size %dx%d too large", w, h);
+        snprintf(err, errlen, "image size %dx%d too large (at most 16384 on a side)", w, h);
         rt_job_free(j);
         return VW_E_INVAL;
     }

@@ -13,16 +13,20 @@ add_test(NAME raytrace_analytic COMMAND vw_test_raytrace analytic)
 # checks that every ray created is ended and that every layout creates the same rays.
 add_test(NAME raytrace_identical_balls COMMAND vw_test_raytrace identical gen:balls:2 96x96)
 add_test(NAME raytrace_identical_mixed COMMAND vw_test_raytrace identical ${VW_RT_MIXED} 96x96)
+# Hits on a wall: the overlap of a cell's search past its far wall (walk_ray).
+add_test(NAME raytrace_identical_wall_hit COMMAND vw_test_raytrace identical
+         ${PROJECT_SOURCE_DIR}/tests/raytrace/wall_hit.nff 8x6)
 # The same under the stress switch (random delays and reordering of deliveries).
 add_test(NAME raytrace_stress_balls COMMAND vw_test_raytrace identical gen:balls:2 64x64)
 add_test(NAME raytrace_stress_mixed COMMAND vw_test_raytrace identical ${VW_RT_MIXED} 64x64)
 set(VW_RT_TSAN "TSAN_OPTIONS=suppressions=${PROJECT_SOURCE_DIR}/tests/raytrace/tsan.supp")
 set_tests_properties(raytrace_cone raytrace_analytic raytrace_identical_balls
-  raytrace_identical_mixed PROPERTIES ENVIRONMENT "${VW_RT_TSAN}")
+  raytrace_identical_mixed raytrace_identical_wall_hit PROPERTIES ENVIRONMENT "${VW_RT_TSAN}")
 # Threads-engine tests: ./run test-sanitizers runs them under TSan (rays handed from
 # cell to cell inline and by message, under the stress switch too).
 set_tests_properties(raytrace_cone raytrace_analytic raytrace_identical_balls
-  raytrace_identical_mixed raytrace_stress_balls raytrace_stress_mixed PROPERTIES LABELS "threads")
+  raytrace_identical_mixed raytrace_identical_wall_hit raytrace_stress_balls raytrace_stress_mixed
+  PROPERTIES LABELS "threads")
 set_tests_properties(raytrace_stress_balls PROPERTIES ENVIRONMENT "VW_STRESS=7;${VW_RT_TSAN}")
 set_tests_properties(raytrace_stress_mixed PROPERTIES
   ENVIRONMENT "VW_STRESS=1994;VW_STRESS_SPLIT=1;${VW_RT_TSAN}")

@@ -171,7 +171,6 @@ vw_status rt_job_create(const vw_scene *s, const rt_params *p, rt_job **out, cha
     /* Secondary rays start this far from their surface: far above Embree's float error
        (~1e-7 of the scene size), far below any feature a scene file means. */
     sh->eps = 1e-4 * diag;
-    sh->bpad = 1e-6 * diag;
     for (int k = 0; k < 3; k++) sh->background[k] = s->background[k];
 
     size_t nl = s->nlights ? s->nlights : 1;
@@ -214,6 +213,21 @@ vw_status rt_job_create(const vw_scene *s, const rt_params *p, rt_job **out, cha
         world.hi[a] = hi[a] + pad;
     }
     if (p->world) world = *p->world;
+    /* A cell's search runs past its far wall by `overlap` (walk_ray), so that a hit on
+       the wall, which Embree's float arithmetic can place a little on either side of it,
+       is not missed by both cells. Ten times that error (about 1e-7 of the magnitudes:
+       every ray starts at the eye or inside the world, see cell_reach). Objects are
+       placed with their bounds widened by twice that, so a cell holds every object a
+       ray can hit within the overlap past its walls: what it finds there is the ray's
+       first hit, as one cell would find it. */
+    double m = fabs(cam.from[0]) + fabs(cam.from[1]) + fabs(cam.from[2]);
+    for (int i = 0; i < 8; i++) {
+        double n = fabs((i & 1) ? world.hi[0] : world.lo[0]) +
+                   fabs((i & 2) ? world.hi[1] : world.lo[1]) + fabs((i & 4) ? world.hi[2] : world.lo[2]);
+        if (n > m) m = n;
+    }
+    sh->overlap = 1e-6 * 3 * m;
+    sh->bpad = fmax(1e-6 * diag, 2 * sh->overlap);
     int dims[3];
     for (int a = 0; a < 3; a++) dims[a] = p->dims[a] > 0 ? p->dims[a] : 1;
     st = vw_decomp_create_grid(&world, dims, &j->decomp);

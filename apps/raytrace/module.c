@@ -323,9 +323,10 @@ static void shade(vw_ctx *ctx, rt_cell *c, const rt_ray *r, const rt_hit *h)
 }
 
 /* Whether the box around the ray's segment [tn, t1] (its two ends' bounds) meets the
-   reach of the cell's objects: if not, no point of the segment does. Six multiply-adds
-   and comparisons, so it costs far less than the Embree call it can spare. A NaN
-   anywhere counts as a meeting, so Embree decides. */
+   reach of the cell's objects: if not, no point of the segment does, nor of its overlap
+   past t1 (the reach's margin is ten times the overlap). Six multiply-adds and
+   comparisons, so it costs far less than the Embree call it can spare. A NaN anywhere
+   counts as a meeting, so Embree decides. */
 static inline int meets_reach(const rt_cell *c, const rt_ray *r, double tn)
 {
     for (int a = 0; a < 3; a++) {
@@ -352,17 +353,21 @@ static int walk_ray(vw_ctx *ctx, rt_cell *c, rt_ray *r, vw_walk *w)
         /* max(eps, t0), as fmax gives it (eps for a NaN t0), without fmax's libm call:
            gcc keeps the call, whose NaN rules maxsd does not follow. */
         double tn = r->t0 > c->sh->eps ? r->t0 : c->sh->eps;
+        /* Past the far wall by the overlap (not past the ray's end): a hit on the wall
+           is found here even when Embree's floats put it just beyond. */
+        double tf = r->t1 + c->sh->overlap;
+        if (tf > r->tmax) tf = r->tmax;
         rt_hit h;
         /* (A segment from the ray's origin is not tested: a secondary ray starts on an
            object of the cell that spawned it, so its first segment meets the reach.) */
         if (c->bounded && r->t0 > 0 && !meets_reach(c, r, tn)) {
             /* nothing of this cell on the segment: on to the next cell */
         } else if (r->kind == RT_SHADOW) {
-            if (rt_cell_geo_occluded(c->geo, r->org, r->dir, tn, r->t1)) {
+            if (rt_cell_geo_occluded(c->geo, r->org, r->dir, tn, tf)) {
                 c->tally[RT_C_ENDED]++;
                 return entered;
             }
-        } else if (rt_cell_geo_intersect(c->geo, r->org, r->dir, tn, r->t1, &h)) {
+        } else if (rt_cell_geo_intersect(c->geo, r->org, r->dir, tn, tf, &h)) {
             c->tally[RT_C_ENDED]++;
             shade(ctx, c, r, &h);
             return entered;

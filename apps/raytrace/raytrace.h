@@ -93,6 +93,7 @@ typedef struct rt_shared {
     int max_depth;   /* an eye ray has depth 1; rays of depth max_depth spawn no others */
     double eps;      /* minimum t of a secondary ray: avoids self-intersection */
     double bpad;     /* objects' bounds are widened by this before placement */
+    double overlap;  /* a cell searches this far past its far wall (< bpad / 2) */
     void *device;    /* RTCDevice, one per process, shared by every cell */
     struct rt_geo_cache *geo_cache; /* the built cells of this process, shared by the
                                        copies of a cell (geometry.h) */

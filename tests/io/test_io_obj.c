@@ -98,8 +98,8 @@ int main(int argc, char **argv)
                          "v -3.4e38 0 0\nv 3.4e38 0 0\nv 0 3.4e38 3.4e38\nf 1 2 3\n",
                          "v 0 0 0\nv 0 0 0\nv 0 0 0\nf 1 2 3\n",
                          /* at a corner of the float range: no room on the usual side */
-                         "v 3.4e38 -3.4e38 3.4e38\nv 3.4e38 -3.3e38 3.4e38\nv 3.3e38 -3.4e38 3.4e38\n"
-                         "f 1 2 3\n"};
+                         ("v 3.4e38 -3.4e38 3.4e38\nv 3.4e38 -3.3e38 3.4e38\nv 3.3e38 -3.4e38 3.4e38\n"
+                          "f 1 2 3\n")};
     for (int i = 0; i < 4; i++) {
         CHECK_EQ_INT(vw_scene_read_obj("far.obj", far[i], strlen(far[i]), NULL, &n, err,
                                        sizeof err), VW_OK);

@@ -38,8 +38,11 @@ int vw_example_opts_parse(const char *cmd, int argc, char **argv, vw_example_opt
                 return VW_EXIT_USAGE;
         } else if (!strcmp(a, "--stats")) {
             if (!(o->stats = vw_cli_value(cmd, argc, argv, &i))) return VW_EXIT_USAGE;
-        } else {
+        } else if (a[0] == '-' && a[1]) {
             vw_cli_error(cmd, "unknown option '%s' (try --help)", a);
+            return VW_EXIT_USAGE;
+        } else { /* the spheres are generated: there is no scene to give */
+            vw_cli_error(cmd, "unexpected argument '%s': takes options only (try --help)", a);
             return VW_EXIT_USAGE;
         }
     }

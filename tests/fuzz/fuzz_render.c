@@ -3,7 +3,8 @@
  * and on 2x2x2 cells. Besides "never crash" (a NaN or infinite ray reaching Embree
  * aborts in its assertions), it checks what the design promises for every scene:
  * every ray created ends exactly once, and the walls change neither the pixel sums nor
- * the ray counts.
+ * the ray counts (unless the order of the objects alone changes them: coincident
+ * surfaces, whose tie nothing decides).
  */
 #ifndef _GNU_SOURCE
 #define _GNU_SOURCE
@@ -20,10 +21,11 @@ enum { W = 8, H = 6 };
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 
-/* Renders s on the layout dims; the pixel sums into sums, the counters into c.
-   0 when the job refused the scene (a clear error is fine), 1 when it rendered. */
-static int render(const vw_scene *s, const int dims[3], int64_t *sums,
-                  int64_t c[RT_NCOUNTERS])
+/* Renders s on the layout dims (from the records objs[0..n) when objs is not NULL);
+   the pixel sums into sums, the counters into c. 0 when the job refused the scene (a
+   clear error is fine), 1 when it rendered. */
+static int render(const vw_scene *s, const rt_object *objs, size_t n, const int dims[3],
+                  int64_t *sums, int64_t c[RT_NCOUNTERS])
 {
     char err[256];
     rt_params p;
@@ -33,6 +35,8 @@ static int render(const vw_scene *s, const int dims[3], int64_t *sums,
     p.depth = 3;
     memcpy(p.dims, dims, sizeof p.dims);
     p.workers = 1;
+    p.objects = objs;
+    p.nobjects = n;
     rt_job *j = NULL;
     if (rt_job_create(s, &p, &j, err, sizeof err) != VW_OK) return 0;
     if (rt_job_farm(j, RT_FARM_NONE, NULL, err, sizeof err) != VW_OK ||
@@ -53,16 +57,32 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     if (vw_scene_read_nff("fuzz.nff", (const char *)data, size, &s, err, sizeof err) != VW_OK)
         return 0;
     static const int one[3] = {1, 1, 1}, eight[3] = {2, 2, 2};
-    static int64_t sums1[W * H * 3], sums8[W * H * 3];
-    int64_t c1[RT_NCOUNTERS], c8[RT_NCOUNTERS];
-    int ok1 = render(s, one, sums1, c1);
-    int ok8 = render(s, eight, sums8, c8);
+    static int64_t sums1[W * H * 3], sums8[W * H * 3], sumsr[W * H * 3];
+    int64_t c1[RT_NCOUNTERS], c8[RT_NCOUNTERS], cr[RT_NCOUNTERS];
+    int ok1 = render(s, NULL, 0, one, sums1, c1);
+    int ok8 = render(s, NULL, 0, eight, sums8, c8);
+    /* The same cell with its objects in reverse order: Embree's tree then visits them in
+       another order. Where that alone changes the image, the scene has coincident
+       surfaces whose tie no order decides (z-fighting, docs/known-issues.md), and the
+       walls may change it too: nothing to compare. */
+    rt_object *objs = NULL;
+    size_t n = 0;
+    int okr = 0;
+    if (ok1 && rt_objects_from_scene(s, &objs, &n) == VW_OK) {
+        for (size_t i = 0; i < n / 2; i++) {
+            rt_object t = objs[i];
+            objs[i] = objs[n - 1 - i];
+            objs[n - 1 - i] = t;
+        }
+        okr = render(s, objs, n, one, sumsr, cr);
+    }
+    free(objs);
     vw_scene_free(s);
     if (ok1 != ok8) {
         fprintf(stderr, "one layout rendered the scene, the other refused it\n");
         abort();
     }
-    if (!ok1) return 0;
+    if (!ok1 || !okr || memcmp(sums1, sumsr, sizeof sums1)) return 0;
     for (int k = RT_C_EYE; k <= RT_C_PIXELS; k++)
         if (c1[k] != c8[k]) {
             fprintf(stderr, "counter %d: %lld on 1 cell, %lld on 2x2x2\n", k, (long long)c1[k],

@@ -5,8 +5,11 @@
  *  - a ray is owned by exactly one cell at a time; crossing a wall transfers ownership,
  *    and the ray keeps its ORIGINAL origin and direction for its whole life (it is never
  *    re-originated at a wall), so every cell computes the same hit for it;
- *  - the t-interval a cell searches is the ray-walk segment, and the segments of one
- *    ray are contiguous (decomp.h), so "first hit over all cells" is the global first hit;
+ *  - the t-interval a cell searches is the ray-walk segment, run past its far wall by
+ *    rt_shared.overlap (Embree's float tests do not split a hit on a wall exactly),
+ *    and the segments of one ray are contiguous (decomp.h); objects are placed with
+ *    bounds widened by bpad >= 2 overlap, so "first hit over all cells" is the global
+ *    first hit (docs/raytrace.md, "The overlap");
  *  - nothing in the shading depends on the cell: it reads only the ray, the hit object's
  *    record (material copied in) and the lights;
  *  - every contribution goes to the output process in 64-bit fixed point, where integer
@@ -93,7 +96,7 @@ typedef struct rt_shared {
     int max_depth;   /* an eye ray has depth 1; rays of depth max_depth spawn no others */
     double eps;      /* minimum t of a secondary ray: avoids self-intersection */
     double bpad;     /* objects' bounds are widened by this before placement */
-    double overlap;  /* a cell searches this far past its far wall (< bpad / 2) */
+    double overlap;  /* a cell searches this far past its far wall (<= bpad / 2) */
     void *device;    /* RTCDevice, one per process, shared by every cell */
     struct rt_geo_cache *geo_cache; /* the built cells of this process, shared by the
                                        copies of a cell (geometry.h) */

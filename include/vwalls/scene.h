@@ -22,7 +22,7 @@ typedef struct vw_material {
     float shine;        /* Phong exponent (NFF Shine, MTL Ns) */
     float transmit;     /* NFF T; MTL 1-d or Tr */
     float ior;          /* index of refraction (NFF ior, MTL Ni); 1 when absent */
-    float emission[3];  /* MTL Ke; zero for NFF */
+    float emission[3];  /* MTL Ke, NFF '#vw Ke' after an 'f'; zero otherwise */
 } vw_material;
 
 typedef struct vw_light {

@@ -64,11 +64,14 @@ static void sorted_vertices(const rt_object *o, double v[3][3])
             }
 }
 
-/* Two records of the same shape (triangles: the same vertices in any order) that look
-   different: every ray that hits one hits the other at the same t. */
+/* Two records of the same shape (triangles: the same vertices in any order) that may
+   look different (anything but their ids differs: material, flags, vertex normals):
+   every ray that hits one hits the other at the same t. */
 static int coincident(const rt_object *a, const rt_object *b)
 {
-    if (a->kind != b->kind || !memcmp(&a->mat, &b->mat, sizeof a->mat)) return 0;
+    rt_object x = *a, y = *b;
+    x.id = y.id = 0;
+    if (a->kind != b->kind || !memcmp(&x, &y, sizeof x)) return 0;
     if (a->kind != RT_TRIANGLE) return !memcmp(&a->g, &b->g, sizeof a->g);
     double va[3][3], vb[3][3];
     sorted_vertices(a, va);

@@ -52,7 +52,8 @@ static int render(const vw_scene *s, const rt_object *objs, size_t n, const int 
 }
 
 /* Do triangles a and b lie in one plane (to 1e-6 of their coordinates' size) and
-   overlap in their bounding boxes? Rays then meet both at t a float ulp apart or equal. */
+   overlap there with some area (not only along an edge)? A ray then meets both at t
+   equal or an ulp apart. */
 static int coplanar_overlap(const rt_object *a, const rt_object *b)
 {
     const double(*p)[3] = a->g.tri.v, (*q)[3] = b->g.tri.v;
@@ -75,28 +76,40 @@ static int coplanar_overlap(const rt_object *a, const rt_object *b)
         for (int k = 0; k < 3; k++) d += n[k] * (q[i][k] - p[0][k]);
         if (!(fabs(d) <= 1e-6 * size * len)) return 0;
     }
-    for (int k = 0; k < 3; k++) {
-        double alo = fmin(p[0][k], fmin(p[1][k], p[2][k])), ahi = fmax(p[0][k], fmax(p[1][k], p[2][k]));
-        double blo = fmin(q[0][k], fmin(q[1][k], q[2][k])), bhi = fmax(q[0][k], fmax(q[1][k], q[2][k]));
-        if (bhi < alo - 1e-6 * size || blo > ahi + 1e-6 * size) return 0;
-    }
+    /* In the plane (the two axes other than the normal's largest): separating axes. */
+    int drop = fabs(n[0]) > fabs(n[1]) ? (fabs(n[0]) > fabs(n[2]) ? 0 : 2) : (fabs(n[1]) > fabs(n[2]) ? 1 : 2);
+    int ax = drop == 0 ? 1 : 0, ay = drop == 2 ? 1 : 2;
+    const double(*t[2])[3] = {p, q};
+    for (int s = 0; s < 2; s++)
+        for (int e = 0; e < 3; e++) {
+            const double *u = t[s][e], *v = t[s][(e + 1) % 3];
+            double nx = -(v[ay] - u[ay]), ny = v[ax] - u[ax];
+            double lo[2] = {INFINITY, INFINITY}, hi[2] = {-INFINITY, -INFINITY};
+            for (int w = 0; w < 2; w++)
+                for (int i = 0; i < 3; i++) {
+                    double x = nx * t[w][i][ax] + ny * t[w][i][ay];
+                    lo[w] = fmin(lo[w], x);
+                    hi[w] = fmax(hi[w], x);
+                }
+            double tol = 1e-9 * (fabs(nx) + fabs(ny)) * size;
+            if (hi[0] <= lo[1] + tol || hi[1] <= lo[0] + tol) return 0;
+        }
     return 1;
 }
 
-/* Two records that may show the same ray each other's surface at the same t (equal
-   spheres or cones, coplanar overlapping triangles) and look different there
-   (material, flags, smooth normals): a tie nothing decides. */
+/* Two records that may show a ray each other's surface at the same t (equal spheres or
+   cones, coplanar triangles overlapping with some area) and are not exact copies (all
+   but the id equal, so whichever is hit shades alike, bit for bit): a tie nothing
+   decides. Even one material is not enough: two coplanar triangles' normals, computed
+   from different edges, differ in their last bits, which can tip a refraction into
+   total internal reflection. */
 static int coincident(const rt_object *a, const rt_object *b)
 {
-    if (a->kind != b->kind) return 0;
-    if (a->kind != RT_TRIANGLE) {
-        rt_object x = *a, y = *b;
-        x.id = y.id = 0;
-        return memcmp(&x, &y, sizeof x) && !memcmp(&a->g, &b->g, sizeof a->g);
-    }
-    int same_look = a->flags == b->flags && !(a->flags & RT_SMOOTH) &&
-                    !memcmp(&a->mat, &b->mat, sizeof a->mat);
-    return !same_look && coplanar_overlap(a, b);
+    rt_object x = *a, y = *b;
+    x.id = y.id = 0;
+    if (a->kind != b->kind || !memcmp(&x, &y, sizeof x)) return 0;
+    if (a->kind != RT_TRIANGLE) return !memcmp(&a->g, &b->g, sizeof a->g);
+    return coplanar_overlap(a, b);
 }
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)

@@ -215,8 +215,9 @@ vw_status rt_job_create(const vw_scene *s, const rt_params *p, rt_job **out, cha
     if (p->world) world = *p->world;
     /* A cell's search runs past its far wall by `overlap` (walk_ray), so that a hit on
        the wall, which Embree's float arithmetic can place a little on either side of it,
-       is not missed by both cells. Ten times that error (about 1e-7 of the magnitudes:
-       every ray starts at the eye or inside the world, see cell_reach). Objects are
+       is not missed by both cells. The overlap is ten times that error, which is about
+       1e-7 of the magnitudes involved, at most 3m (every ray starts at the eye or inside
+       the world, whose coordinate sums m bounds; see cell_reach). Objects are
        placed with their bounds widened by twice that, so a cell holds every object a
        ray can hit within the overlap past its walls: what it finds there is the ray's
        first hit, as one cell would find it. */

@@ -1,10 +1,10 @@
-/* fuzz_render.c - libFuzzer target for the ray tracer behind the NFF reader: any scene
- * the reader accepts is rendered small (8x6 pixels, depth 3, one worker) on one cell
- * and on 2x2x2 cells. Besides "never crash" (a NaN or infinite ray reaching Embree
- * aborts in its assertions), it checks what the design promises for every scene:
- * every ray created ends exactly once, and the walls change neither the image (its 8-bit
- * values, what the PNG holds) nor the ray counts (unless the order of the objects alone changes them on one cell:
- * coincident surfaces, whose tie nothing decides).
+/* fuzz_render.c - libFuzzer target for the ray tracer behind the scene readers: any
+ * scene the NFF reader, or else the OBJ reader, accepts is rendered small (8x6 pixels,
+ * depth 3, one worker) on one cell and on 2x2x2 cells. Besides "never crash" (a NaN or
+ * infinite ray reaching Embree aborts in its assertions), it checks what the design
+ * promises for every scene: every ray created ends exactly once, and the walls change
+ * neither the image (its 8-bit values, what the PNG holds) nor the ray counts, unless
+ * the scene has coincident surfaces whose tie nothing decides (z-fighting, below).
  */
 #ifndef _GNU_SOURCE
 #define _GNU_SOURCE
@@ -116,7 +116,10 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
     char err[256];
     vw_scene *s = NULL;
-    if (vw_scene_read_nff("fuzz.nff", (const char *)data, size, &s, err, sizeof err) != VW_OK)
+    /* NFF, or else OBJ (no material libraries: the fuzzer must not open files), which
+       gets the default camera and light, and smooth triangles from 'vn'. */
+    if (vw_scene_read_nff("fuzz.nff", (const char *)data, size, &s, err, sizeof err) != VW_OK &&
+        vw_scene_read_obj("fuzz.obj", (const char *)data, size, NULL, &s, err, sizeof err) != VW_OK)
         return 0;
     static const int one[3] = {1, 1, 1}, eight[3] = {2, 2, 2};
     /* 8-bit values, not the fixed-point sums: two surfaces a float ulp apart along a ray

@@ -3,8 +3,6 @@
  * stats JSON and a picture of the walls tinted by each cell's measured load.
  */
 #define _POSIX_C_SOURCE 200809L
-#include <float.h>
-#include <math.h>
 #include <pthread.h>
 #include <stdatomic.h>
 #include <stdio.h>

@@ -26,7 +26,8 @@ static void gen_usage(FILE *f)
             "\noptions:\n"
             "  --size N          size factor or depth of balls, rings, tree (default per scene)\n"
             "  --count N         number of spheres for 'spheres' (default 1000)\n"
-            "  --seed S          random seed (default 1); the same seed gives the same scene\n"
+            "  --seed S          random seed of spheres and tree (default 1); the same seed\n"
+            "                    gives the same scene\n"
             "  --cluster F       fraction of spheres in the cluster region, 0..1 (default 0)\n"
             "                    (an option the scene has no use for is an error)\n"
             "  --resolution WxH  camera resolution (default 512x512)\n"
@@ -38,6 +39,7 @@ static void gen_usage(FILE *f)
 int vw_cmd_gen(int argc, char **argv)
 {
     const char *cmd = "gen", *name = NULL, *out = NULL, *v;
+    int seed_given = 0;
     vw_gen_params p;
     vw_gen_params_init(&p);
     for (int i = 1; i < argc; i++) {
@@ -66,6 +68,7 @@ int vw_cmd_gen(int argc, char **argv)
                 return VW_EXIT_USAGE;
             }
             p.seed = (uint64_t)s;
+            seed_given = 1;
         } else if (!strcmp(a, "--cluster")) {
             if (!(v = vw_cli_value(cmd, argc, argv, &i)) ||
                 vw_cli_double(cmd, a, v, 0.0, 1.0, &p.cluster))
@@ -95,11 +98,13 @@ int vw_cmd_gen(int argc, char **argv)
     /* An option the scene has no use for is a mistake, not a no-op. */
     int sized = !strcmp(name, "balls") || !strcmp(name, "rings") || !strcmp(name, "tree");
     int random = !strcmp(name, "spheres");
+    int seeded = random || !strcmp(name, "tree");
     const char *unused = p.size && !sized ? "--size" : p.count && !random ? "--count"
-                       : p.cluster != 0 && !random ? "--cluster" : NULL;
+                       : p.cluster != 0 && !random ? "--cluster"
+                       : seed_given && !seeded ? "--seed" : NULL;
     if (unused) {
         vw_cli_error(cmd, "%s: '%s' takes no such option (--size: balls, rings, tree; "
-                          "--count, --cluster: spheres)", unused, name);
+                          "--count, --cluster: spheres; --seed: spheres, tree)", unused, name);
         return VW_EXIT_USAGE;
     }
     char err[512] = "";

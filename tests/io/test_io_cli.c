@@ -101,6 +101,8 @@ int main(int argc, char **argv)
     CHECK_EQ_INT(run(vw_cmd_gen, (const char *[]){"gen", "balls", "--count", "5", NULL}), 2);
     CHECK_EQ_INT(run(vw_cmd_gen, (const char *[]){"gen", "tree", "--cluster", "0.5", NULL}), 2);
     CHECK_EQ_INT(run(vw_cmd_gen, (const char *[]){"gen", "spheres", "--size", "2", NULL}), 2);
+    CHECK_EQ_INT(run(vw_cmd_gen, (const char *[]){"gen", "balls", "--seed", "3", NULL}), 2);
+    CHECK_EQ_INT(run(vw_cmd_gen, (const char *[]){"gen", "tree", "--size", "2", "--seed", "3", NULL}), 0);
 
     /* NFF to stdout equals NFF to -o. */
     CHECK_EQ_INT(run(vw_cmd_gen, (const char *[]){"gen", "balls", "--size", "2", "--resolution",

@@ -23,7 +23,6 @@ grep -q "nonplanar.obj:7: polygon (id 0) is not planar" "$T/err" || fail "non-pl
 "$V" radiosity "$T/nonplanar.obj" -o "$T/c.ply" --hemicube 7 2>"$T/err"; rc=$?
 [ $rc -eq 2 ] || fail "odd hemicube: exit $rc"
 
-# Kill after a checkpoint, resume, compare with the uninterrupted run.
 "$TR" gen cornell "$T/cornell.nff" || fail "gen"
 
 # --view that gives no view: exit 2, the reason, no picture (a NaN, a field of view
@@ -52,6 +51,8 @@ grep -q "warning: converged before the first shot" "$T/err" || fail "--sf 0.5: n
 "$V" radiosity "$T/cornell.nff" --image "$T/v.png" --view 278,540,280,278,0,280,100 \
   --size 16x16 --max-shots 4 --quiet 2>"$T/err" || fail "vertical --view: $(cat "$T/err")"
 [ -s "$T/v.png" ] || fail "vertical --view: no picture"
+
+# Kill after a checkpoint, resume, compare with the uninterrupted run.
 opts="--cells 2x2x2 --workers 2 --sf 2e-4 --quiet"
 "$V" radiosity "$T/cornell.nff" $opts --csv "$T/full.csv" 2>/dev/null || fail "uninterrupted run"
 "$V" radiosity "$T/cornell.nff" $opts --csv "$T/never.csv" --checkpoint "$T/ck" --checkpoint-every 0 2>/dev/null &

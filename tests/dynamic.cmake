@@ -19,10 +19,11 @@ add_test(NAME dynamic_decisions_stress COMMAND test_dynamic decisions 2 --worker
 set_tests_properties(dynamic_decisions_stress PROPERTIES ENVIRONMENT "VW_STRESS=42;VW_STRESS_SPLIT=1")
 
 # The command line: summary, frames, stats; bad lines give file:line and status 2 (or
-# are skipped with --keep-going); vwalls edit answers from stdin.
+# are skipped with --keep-going), the bad scripts of tests/data/edits too; vwalls edit
+# answers from stdin.
 add_test(NAME dynamic_cli
   COMMAND sh ${PROJECT_SOURCE_DIR}/tests/dynamic/cli.sh $<TARGET_FILE:vwalls_tool>
-          ${CMAKE_CURRENT_BINARY_DIR}/dynamic_cli)
+          ${CMAKE_CURRENT_BINARY_DIR}/dynamic_cli ${PROJECT_SOURCE_DIR}/tests/data/edits)
 
 # Under mpirun -np 2 (launcher flags: cmake/mpi_launcher.cmake).
 if(VW_HAVE_MPI AND MPIEXEC_EXECUTABLE)

@@ -1,10 +1,12 @@
 #!/bin/sh
 # cli.sh - vwalls animate / edit on the command line: frames and summary, stats JSON,
-# bad lines (file:line on stderr, status 2, or skipped with --keep-going), edit on stdin.
-# Usage: cli.sh VWALLS WORKDIR
+# bad lines (file:line on stderr, status 2, or skipped with --keep-going), the bad
+# scripts of EDITS_DIR, edit on stdin.
+# Usage: cli.sh VWALLS WORKDIR EDITS_DIR
 set -u
 V=$1
 W=$2
+E=$3
 rm -rf "$W" && mkdir -p "$W" && cd "$W" || exit 1
 fail() { echo "FAIL: $*" >&2; exit 1; }
 
@@ -82,6 +84,24 @@ grep -q '^bad.txt:3: unknown command' kerr.txt || fail "unknown command message"
 grep -q '^bad.txt:4: bad number' kerr.txt || fail "NaN message"
 grep -q '^bad.txt:5: object 2 would leave the world' kerr.txt || fail "outside-world message: $(cat kerr.txt)"
 [ -s k01.png ] || fail "--keep-going: second frame missing"
+
+# Every bad script of the corpus (its last line is the bad one): status 2, "file:line:
+# why" naming that line, and no frame (a 'frame' is added after it). The good one runs.
+n=0
+for f in "$E"/bad_*.edits; do
+  b=$(basename "$f")
+  l=$(wc -l < "$f")
+  { cat "$f"; echo frame; } > "$b"
+  "$V" animate scene.nff "$b" -o 'c%02d.png' --workers 2 --quiet > /dev/null 2> cerr.txt; rc=$?
+  [ $rc -eq 2 ] || fail "$b: status $rc, expected 2"
+  grep -Eq "^$b:$l: [a-z]" cerr.txt || fail "$b: no '$b:$l: why' message: $(cat cerr.txt)"
+  [ -e c00.png ] && fail "$b: a frame was rendered"
+  n=$((n + 1))
+done
+[ $n -ge 10 ] || fail "only $n bad scripts in $E"
+"$V" animate scene.nff "$E/good_moves.edits" -o 'ok%02d.png' --cells 2x2x1 --workers 2 --quiet \
+  || fail "good_moves.edits: status $?"
+[ -s ok00.png ] && [ -s ok01.png ] || fail "good_moves.edits: frames missing"
 
 printf 'move 0 0.05 0 0\nbogus\nremove 1\nremove 1\nframe\n' | "$V" edit scene.nff -o 'e%02d.png' --workers 1 > eout.txt 2> eerr.txt
 rc=$?

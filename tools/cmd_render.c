@@ -3,6 +3,7 @@
  * stats JSON and a picture of the walls tinted by each cell's measured load.
  */
 #define _POSIX_C_SOURCE 200809L
+#include <math.h>
 #include <pthread.h>
 #include <stdatomic.h>
 #include <stdio.h>
@@ -15,6 +16,8 @@
 #include "commands.h"
 #include "raytrace/raytrace.h"
 #include "vwalls/image.h"
+
+enum { MAX_LIGHTS = 64 }; /* --light */
 
 static const char *const CMD = "render";
 
@@ -32,6 +35,9 @@ static void help(void)
            "  --depth D        maximum ray depth, eye rays being depth 1 (default 5)\n"
            "  --from X,Y,Z --at X,Y,Z --up X,Y,Z --angle DEG\n"
            "                   override the camera (angle: full vertical field of view)\n"
+           "  --light X,Y,Z[,R,G,B]  replace the scene's lights: each --light adds one point\n"
+           "                   light (up to 64); without a colour, 1/sqrt(lights) each,\n"
+           "                   as NFF gives a light without one\n"
            "  --stats FILE     write the stats JSON\n"
            "  --overlay FILE   write a PNG of the image with the walls drawn and each cell's\n"
            "                   pixels tinted by its measured load (green light .. red heavy)\n"
@@ -169,6 +175,8 @@ int vw_cmd_render(int argc, char **argv)
     long workers = 0, depth = 5;
     double from[3], at[3], up[3], angle = 0;
     int has_from = 0, has_at = 0, has_up = 0, has_angle = 0;
+    vw_light lights[MAX_LIGHTS];
+    int nlights = 0;
     const char *speeds_s = NULL, *slow_s = NULL;
     vw_balance_strategy strategy = VW_BALANCE_NONE;
     int farm = -1, farm_copies = 0; /* -1: auto, resolved once the options are read */
@@ -266,6 +274,26 @@ int vw_cmd_render(int argc, char **argv)
                                NULL))
                 return VW_EXIT_USAGE;
             has_up = 1;
+        } else if (!strcmp(a, "--light")) {
+            double l[6];
+            int n = 0;
+            if (nlights == MAX_LIGHTS) {
+                vw_cli_error(CMD, "--light: at most %d lights", MAX_LIGHTS);
+                return VW_EXIT_USAGE;
+            }
+            if (vw_cli_numbers(CMD, a, v = vw_cli_value(CMD, argc, argv, &i), "X,Y,Z or X,Y,Z,R,G,B",
+                               l, 3, 6, &n))
+                return VW_EXIT_USAGE;
+            if ((n != 3 && n != 6) || (n == 6 && !(l[3] >= 0 && l[4] >= 0 && l[5] >= 0))) {
+                vw_cli_error(CMD, "--light: bad value '%s' (expected X,Y,Z or X,Y,Z,R,G,B with "
+                                  "a colour of at least 0)", v);
+                return VW_EXIT_USAGE;
+            }
+            vw_light *L = &lights[nlights++];
+            for (int k = 0; k < 3; k++) {
+                L->pos[k] = l[k];
+                L->color[k] = n == 6 ? (float)l[3 + k] : -1.0f; /* -1: not given */
+            }
         } else if (!strcmp(a, "--angle")) {
             if (!(v = vw_cli_value(CMD, argc, argv, &i)) ||
                 vw_cli_double(CMD, a, v, 1e-3, 179, &angle))
@@ -343,6 +371,22 @@ int vw_cmd_render(int argc, char **argv)
         /* The parser's "file:line: message", as it is. */
         if (vw_cli_is_output()) fprintf(stderr, "%s\n", err);
         return VW_EXIT_USAGE;
+    }
+    if (nlights) { /* --light: these lights instead of the scene's */
+        vw_light *L = malloc(sizeof *L * (size_t)nlights);
+        if (!L) {
+            vw_scene_free(scene);
+            return VW_EXIT_FAIL;
+        }
+        /* The NFF reader's rule (nff.c) for lights without a colour. */
+        float dflt = (float)(1.0 / sqrt((double)nlights));
+        for (int k = 0; k < nlights; k++) {
+            L[k] = lights[k];
+            if (L[k].color[0] < 0) L[k].color[0] = L[k].color[1] = L[k].color[2] = dflt;
+        }
+        free(scene->lights);
+        scene->lights = L;
+        scene->nlights = (size_t)nlights;
     }
     vw_camera cam = scene->camera;
     if (!cam.valid) {

@@ -62,6 +62,21 @@ foreach(key "\"rays\"" "\"eye\": " "\"shadow\"" "\"cells\"" "\"pixels\"" "\"comp
   endif()
 endforeach()
 
+# --light replaces the scene's lights: its own two given on the command line (the first
+# without a colour: 1/sqrt(2), as the file's) render the same bytes; the first alone not.
+render(${WORK}/lights.png 2x2x2 2 --light 5,-5,8 --light -6,-3,6,0.6,0.6,0.5)
+execute_process(COMMAND ${CMAKE_COMMAND} -E compare_files ${WORK}/ref.png ${WORK}/lights.png
+                RESULT_VARIABLE same)
+if(NOT same EQUAL 0)
+  message(FATAL_ERROR "--light with the scene's own lights: PNG differs from the scene's")
+endif()
+render(${WORK}/light1.png 1 1 --light 5,-5,8)
+execute_process(COMMAND ${CMAKE_COMMAND} -E compare_files ${WORK}/ref.png ${WORK}/light1.png
+                RESULT_VARIABLE same)
+if(same EQUAL 0)
+  message(FATAL_ERROR "--light with one of the scene's two lights: PNG did not change")
+endif()
+
 # Bad input: exit 2, file:line on stderr, no output file.
 file(WRITE ${WORK}/bad.nff "v\nfrom 0 0 5\nat 0 0 0\nup 0 1 0\nangle 30\nhither 1\nresolution 8 8\ns 0 0 zero 1\n")
 execute_process(COMMAND ${VWALLS} render ${WORK}/bad.nff -o ${WORK}/bad.png --quiet
@@ -75,13 +90,17 @@ endif()
 if(EXISTS ${WORK}/bad.png)
   message(FATAL_ERROR "bad scene: an output file was left behind")
 endif()
-# Camera overrides that give no view: exit 2, a message, no output file (a NaN or an
-# infinite 'from' used to reach Embree and abort the process).
+# Camera overrides that give no view, and bad lights: exit 2, a message, no output file
+# (a NaN or an infinite 'from' used to reach Embree and abort the process).
 foreach(case "--from;1,2,nan;--from: bad value '1,2,nan'"
              "--from;inf,0,0;--from: bad value 'inf,0,0'"
              "--at;1e300,0,0;--at: bad value '1e300,0,0'"
              "--up;0,0,0;'up' is zero or parallel"
-             "--from;0,0,0;'from' and 'at' are the same point")
+             "--from;0,0,0;'from' and 'at' are the same point"
+             "--light;1,2;--light: bad value '1,2'"
+             "--light;1,2,3,4;--light: bad value '1,2,3,4'"
+             "--light;1,2,3,1,-1,1;--light: bad value '1,2,3,1,-1,1'"
+             "--light;1,nan,3;--light: bad value '1,nan,3'")
   list(GET case 0 opt)
   list(GET case 1 val)
   list(GET case 2 want)

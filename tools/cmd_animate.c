@@ -200,17 +200,12 @@ static int session_line(vw_anim_session *s, const char *line, int lineno)
         }
         return 0;
     }
-    switch (e.op) {
-    case VW_EDIT_NONE:
-        break;
-    case VW_EDIT_MOVE:
-    case VW_EDIT_MOVETO:
-    case VW_EDIT_ROTATE:
-    case VW_EDIT_ADD:
-    case VW_EDIT_REMOVE:
+    if (vw_edit_is_object(e.op)) {
         s->batch[s->nbatch++] = e;
         if (s->nbatch == MAX_BATCH || s->interactive) flush(s);
-        break;
+        return s->failed;
+    }
+    switch (e.op) {
     case VW_EDIT_CHECK:
         flush(s);
         s->check = e.on;
@@ -235,6 +230,8 @@ static int session_line(vw_anim_session *s, const char *line, int lineno)
         }
         break;
     }
+    default: /* VW_EDIT_NONE: a blank line or a comment */
+        break;
     }
     return s->failed;
 }

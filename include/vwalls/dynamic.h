@@ -123,6 +123,13 @@ typedef enum vw_edit_op {
     VW_EDIT_BALANCE    /* balance */
 } vw_edit_op;
 
+/* Whether op is an object edit, one vw_dynscene_apply decides (MOVE .. REMOVE, kept
+   together in the enum); the others are switches and commands of the session. */
+static inline int vw_edit_is_object(vw_edit_op op)
+{
+    return op >= VW_EDIT_MOVE && op <= VW_EDIT_REMOVE;
+}
+
 typedef struct vw_edit {
     vw_edit_op op;
     int id;            /* MOVE, MOVETO, ROTATE, REMOVE */

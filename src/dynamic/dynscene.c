@@ -719,7 +719,7 @@ vw_status vw_dynscene_apply(vw_dynscene *ds, const vw_edit *edits, size_t n, int
     *changed = NULL;
     *nchanged = 0;
     for (size_t i = 0; i < n; i++)
-        if (edits[i].op < VW_EDIT_MOVE || edits[i].op > VW_EDIT_REMOVE) return VW_E_INVAL;
+        if (!vw_edit_is_object(edits[i].op)) return VW_E_INVAL;
     /* Every id the batch can name or create. */
     size_t maxid = (size_t)ds->nids + n + 1;
     for (size_t i = 0; i < n; i++)

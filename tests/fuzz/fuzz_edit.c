@@ -163,23 +163,15 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         check_parsed(st, &e, err, lineno);
         line = next;
         if (st != VW_OK) continue; /* as --keep-going does */
-        switch (e.op) {
-        case VW_EDIT_NONE:
-            break;
-        case VW_EDIT_MOVE:
-        case VW_EDIT_MOVETO:
-        case VW_EDIT_ROTATE:
-        case VW_EDIT_ADD:
-        case VW_EDIT_REMOVE:
+        if (e.op == VW_EDIT_NONE) continue;
+        if (vw_edit_is_object(e.op)) {
             batch[nbatch++] = e;
-            if (nbatch < MAX_BATCH) break;
-            /* fall through */
-        default:
-            decide(dist, ref, batch, nbatch, check, sweep);
-            nbatch = 0;
-            if (e.op == VW_EDIT_CHECK) check = e.on;
-            if (e.op == VW_EDIT_SWEEP) sweep = e.on;
+            if (nbatch < MAX_BATCH) continue;
         }
+        decide(dist, ref, batch, nbatch, check, sweep);
+        nbatch = 0;
+        if (e.op == VW_EDIT_CHECK) check = e.on;
+        if (e.op == VW_EDIT_SWEEP) sweep = e.on;
     }
     decide(dist, ref, batch, nbatch, check, sweep);
     vw_dynscene_free(dist);

@@ -191,8 +191,13 @@ static void geom_apply(geom *g, const xform *x)
 /* Rodrigues: rotation by deg degrees about unit axis u, right-handed. */
 static void rotation(const double axis[3], double deg, double R[3][3])
 {
-    double l = sqrt(axis[0] * axis[0] + axis[1] * axis[1] + axis[2] * axis[2]);
-    double u[3] = {axis[0] / l, axis[1] / l, axis[2] / l};
+    /* Scaled by its largest component first: squares of components beyond 1e154
+       overflow (the unit axis came out 0, and the "rotation" scaled by cos), and below
+       1e-154 underflow. */
+    double m = fmax(fabs(axis[0]), fmax(fabs(axis[1]), fabs(axis[2])));
+    double a[3] = {axis[0] / m, axis[1] / m, axis[2] / m};
+    double l = sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
+    double u[3] = {a[0] / l, a[1] / l, a[2] / l};
     double th = deg * (3.14159265358979323846 / 180.0), c = cos(th), s = sin(th), C = 1 - c;
     R[0][0] = c + u[0] * u[0] * C, R[0][1] = u[0] * u[1] * C - u[2] * s, R[0][2] = u[0] * u[2] * C + u[1] * s;
     R[1][0] = u[1] * u[0] * C + u[2] * s, R[1][1] = c + u[1] * u[1] * C, R[1][2] = u[1] * u[2] * C - u[0] * s;

@@ -108,7 +108,7 @@ vw_status vw_edit_parse(const char *line, const char *name, int lineno, vw_edit 
                 return fail(err, errlen, name, lineno, "bad number '%s' (expected '%s')", w[k],
                             c->usage);
         if (c->op == VW_EDIT_ROTATE &&
-            !(out->v[0] * out->v[0] + out->v[1] * out->v[1] + out->v[2] * out->v[2] > 0))
+            !(out->v[0] != 0 || out->v[1] != 0 || out->v[2] != 0))
             return fail(err, errlen, name, lineno, "rotation axis is zero");
         break;
     }

@@ -69,7 +69,7 @@ static void check_parsed(vw_status st, const vw_edit *e, const char *err, int li
     if (e->line != lineno) die("edit has the wrong line", lineno, NULL);
     switch (e->op) {
     case VW_EDIT_ROTATE:
-        if (!(e->v[0] * e->v[0] + e->v[1] * e->v[1] + e->v[2] * e->v[2] > 0))
+        if (!(e->v[0] != 0 || e->v[1] != 0 || e->v[2] != 0))
             die("rotation with a zero axis accepted", lineno, NULL);
         /* fall through */
     case VW_EDIT_MOVE:

@@ -107,6 +107,37 @@ int vw_cli_size(const char *cmd, const char *opt, const char *s, int *w, int *h)
     return -1;
 }
 
+int vw_cli_frame_pattern(const char *cmd, const char *opt, const char *s)
+{
+    int conversions = 0, ok = 1;
+    size_t n = strlen(s);
+    for (const char *p = s; *p; p++) {
+        if (*p != '%') continue;
+        if (p[1] == '%') {
+            p++;
+            continue;
+        }
+        p++;
+        while (*p && strchr("0-+ #", *p)) p++;
+        int digits = 0;
+        while (*p >= '0' && *p <= '9') p++, digits++;
+        if (*p == '.') {
+            int prec = 0;
+            for (p++; *p >= '0' && *p <= '9'; p++) prec++;
+            if (prec > 2) digits = 3;
+        }
+        if (digits > 2 || (*p != 'd' && *p != 'i')) {
+            ok = 0;
+            break;
+        }
+        conversions++;
+    }
+    if (ok && conversions == 1 && n > 4 && !strcmp(s + n - 4, ".png")) return 0;
+    vw_cli_error(cmd, "%s: bad pattern '%s' (expected a .png name with one %%d for the frame "
+                      "number, like 'frames/%%04d.png'; %%%% for a percent sign)", opt, s);
+    return -1;
+}
+
 int vw_cli_layout(const char *cmd, const char *opt, const char *s, int dims[3])
 {
     char err[256];

@@ -26,6 +26,12 @@ int vw_cli_size(const char *cmd, const char *opt, const char *s, int *w, int *h)
 int vw_cli_numbers(const char *cmd, const char *opt, const char *s, const char *shape,
                    double *out, int min, int max, int *n);
 int vw_cli_layout(const char *cmd, const char *opt, const char *s, int dims[3]);
+/* A frame file pattern (-o of animate and edit): a .png name with exactly one integer
+   conversion for the frame number (%d or %i, with flags 0-+ #, a width and a precision
+   of at most two digits each) and %% for a percent sign; anything else (no
+   conversion, two, %s, %n, ...) is an error, since the pattern becomes a printf
+   format. */
+int vw_cli_frame_pattern(const char *cmd, const char *opt, const char *s);
 
 /* The value after option argv[*i] (advancing *i), or an error and NULL. */
 const char *vw_cli_value(const char *cmd, int argc, char **argv, int *i);

@@ -4,10 +4,13 @@
  * (the same language from stdin) share.
  */
 #define _POSIX_C_SOURCE 200809L
+#include <errno.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
+#include <sys/types.h>
 
 #include "cli.h"
 #include "commands.h"
@@ -40,6 +43,7 @@ struct vw_anim_session {
     rt_anim_stats acc;           /* since the last frame */
     size_t total_acc, total_coll, total_sweep, total_invalid;
     int frame, failed;           /* failed: 2 bad input, 1 other */
+    int bad_lines;               /* lines refused (parsed or applied): exit status 2 */
     frame_rec *frames;
     size_t nframes, capframes;
 };
@@ -48,6 +52,18 @@ static void say(const vw_anim_session *s, const char *fmt, ...) __attribute__((f
 static void say(const vw_anim_session *s, const char *fmt, ...)
 {
     if (!vw_cli_is_output() || s->quiet) return;
+    va_list ap;
+    va_start(ap, fmt);
+    vfprintf(stdout, fmt, ap);
+    va_end(ap);
+}
+
+/* An edit's answer: always for vwalls edit (its answers are its output), unless --quiet
+   for animate. */
+static void tell(const vw_anim_session *s, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+static void tell(const vw_anim_session *s, const char *fmt, ...)
+{
+    if (!vw_cli_is_output() || (s->quiet && !s->interactive)) return;
     va_list ap;
     va_start(ap, fmt);
     vfprintf(stdout, fmt, ap);
@@ -88,15 +104,15 @@ static int flush(vw_anim_session *s)
         int out = vw_cli_is_output();
         switch (r->outcome) {
         case VW_OUT_ACCEPTED:
-            if (s->interactive) say(s, "%s %d: accepted\n", op, r->id);
+            if (s->interactive) tell(s, "%s %d: accepted\n", op, r->id);
             if (s->log && out) fprintf(s->log, "%s:%d: %s %d: accepted\n", s->name, r->edit.line, op, r->id);
             break;
         case VW_OUT_COLLISION:
         case VW_OUT_SWEEP: {
             const char *why = r->outcome == VW_OUT_COLLISION ? "collides at its destination with"
                                                              : "would pass through";
-            say(s, "%s:%d: %s %d rejected: %s object %d\n", s->name, r->edit.line, op, r->id, why,
-                r->obstacle);
+            tell(s, "%s:%d: %s %d rejected: %s object %d\n", s->name, r->edit.line, op, r->id, why,
+                 r->obstacle);
             if (s->log && out)
                 fprintf(s->log, "%s:%d: %s %d: rejected: %s object %d\n", s->name, r->edit.line, op,
                         r->id, why, r->obstacle);
@@ -105,6 +121,7 @@ static int flush(vw_anim_session *s)
         default:
             if (out) fprintf(stderr, "%s:%d: %s\n", s->name, r->edit.line, r->msg);
             if (s->log && out) fprintf(s->log, "%s:%d: %s: invalid: %s\n", s->name, r->edit.line, op, r->msg);
+            s->bad_lines++;
             if (!s->interactive && !s->keep_going && !s->failed) s->failed = 2;
             break;
         }
@@ -116,7 +133,7 @@ static int flush(vw_anim_session *s)
 
 static int do_frame(vw_anim_session *s)
 {
-    char err[512] = "";
+    char err[5120] = ""; /* room for a long path and the reason after it */
     rt_anim_stats st;
     memset(&st, 0, sizeof st);
     vw_status rc = rt_anim_render(s->anim, &st, err, sizeof err);
@@ -130,7 +147,12 @@ static int do_frame(vw_anim_session *s)
     /* Without -o (vwalls edit) a frame still renders; its times are reported. */
     if (vw_cli_is_output() && s->pattern) {
         char path[4096];
-        snprintf(path, sizeof path, s->pattern, s->frame);
+        /* The pattern has exactly one integer conversion (vw_cli_frame_pattern). */
+        if (snprintf(path, sizeof path, s->pattern, s->frame) >= (int)sizeof path) {
+            vw_cli_error(s->cmd, "frame %d: the file name is longer than %zu bytes", s->frame,
+                         sizeof path - 1);
+            return s->failed = 1;
+        }
         uint8_t *rgb = malloc((size_t)w * h * 3);
         if (!rgb) return s->failed = 1;
         rt_job_rgb8(job, rgb);
@@ -187,13 +209,32 @@ static int do_frame(vw_anim_session *s)
     return 0;
 }
 
-/* One line of the language. Returns nonzero when the session must stop. */
-static int session_line(vw_anim_session *s, const char *line, int lineno)
+/* One line of the language (len bytes, its newline included). Returns nonzero when the
+   session must stop. */
+static int session_line(vw_anim_session *s, const char *line, size_t len, int lineno)
 {
     vw_edit e;
     char err[512];
-    if (vw_edit_parse(line, s->name, lineno, &e, err, sizeof err) != VW_OK) {
-        if (vw_cli_is_output()) fprintf(stderr, "%s\n", err);
+    vw_status pst;
+    if (memchr(line, '\0', len)) { /* the parser would stop at it and not see the rest */
+        snprintf(err, sizeof err, "%s:%d: a NUL byte in the line", s->name, lineno);
+        pst = VW_E_INPUT;
+    } else {
+        pst = vw_edit_parse(line, s->name, lineno, &e, err, sizeof err);
+    }
+    if (pst != VW_OK) {
+        int out = vw_cli_is_output();
+        if (out) fprintf(stderr, "%s\n", err);
+        if (s->log && out) {
+            /* The message after its "name:line: ", in the log's own format. */
+            char prefix[64];
+            int k = snprintf(prefix, sizeof prefix, ":%d: ", lineno);
+            const char *why = strstr(err, prefix);
+            fprintf(s->log, "%s:%d: invalid: %s\n", s->name, lineno, why ? why + k : err);
+        }
+        s->acc.invalid++;
+        s->total_invalid++;
+        s->bad_lines++;
         if (!s->interactive && !s->keep_going) {
             flush(s);
             return s->failed = 2;
@@ -247,26 +288,32 @@ static void help(const char *cmd)
                "\nRuns the edit script EDITS (docs/edit-language.md) on SCENE: moves are checked\n"
                "for collisions at their destination (and along their path with 'sweep on') by\n"
                "cells of the decomposition; every 'frame' renders a PNG.\n");
-    printf("  -o PATTERN       frame file names, printf-style with the frame number (from 0)\n"
+    printf("  -o PATTERN       frame file names: a .png name with one %%d (like %%04d) for the\n"
+           "                   frame number (from 0), %%%% for a percent sign\n"
            "  --cells L        layout of cells, like 4, 2x4, 2x2x2 (default 1)\n"
            "  --workers W      worker threads per process (default: number of cores)\n"
            "  --size WxH       image size (default: the scene's, else 512x512)\n"
            "  --depth D        maximum ray depth (default 5)\n"
            "  --balance S      none|tensor|rotate|staggered|divide: rebalance between frames\n"
            "                   when lambda exceeds 1 + --threshold (default 0.1)\n"
+           "  --threshold X    rebalance when lambda exceeds 1 + X (default 0.1)\n"
            "  --trigger T      busy (default) | work: that lambda is of the workers' busy time,\n"
-           "                   or of their counted work (ray segments: the same on every run)\n"
+           "                   or of their counted work (ray segments: the same on every run\n"
+           "                   when no cell has copies, as with --farm idle or none)\n"
            "  --farm F         auto (default) | all | idle | none, as for render: auto is all\n"
            "                   (every worker holds every cell), or idle with --balance\n"
            "  --margin F       the world box is the scene bounds grown by F x diagonal on\n"
            "                   every side (default 0.25); objects cannot leave it\n"
            "  --keep-going     (animate) report bad lines and go on instead of stopping\n"
+           "                   (the exit status is still 2)\n"
            "  --log FILE       every edit's outcome, one line each\n"
            "  --stats FILE     the stats JSON, with an \"animation\" member (per frame)\n"
            "  --full-rebuild   rebuild every cell at every frame (the benchmark's baseline)\n"
            "  --brute-force    decide with the O(n^2) reference instead of the cells\n"
-           "  --quiet          no summary\n"
-           "Exit status: 0 success, 2 bad input (a bad line stops animate unless --keep-going), 1 other.\n");
+           "  --quiet          no banner, frame lines or summary (animate: no rejections\n"
+           "                   either; edit always answers every edit)\n"
+           "Exit status: 0 success, 2 bad input (any bad line; it stops animate unless\n"
+           "--keep-going), 1 other.\n");
 }
 
 static char *frames_json(const vw_anim_session *s)
@@ -371,6 +418,7 @@ int vw_anim_main(const char *cmd, int argc, char **argv)
                                           : "usage: vwalls animate SCENE EDITS -o PATTERN (try --help)");
         goto done;
     }
+    if (s->pattern && vw_cli_frame_pattern(cmd, "-o", s->pattern)) goto done;
     if (s->strategy && strcmp(s->strategy, "none") && strcmp(s->strategy, "tensor") &&
         strcmp(s->strategy, "rotate") && strcmp(s->strategy, "staggered") && strcmp(s->strategy, "divide")) {
         vw_cli_error(cmd, "--balance: bad value '%s' (expected none, tensor, rotate, staggered or divide)",
@@ -381,12 +429,15 @@ int vw_anim_main(const char *cmd, int argc, char **argv)
     p.depth = (int)depth;
     p.farm = (rt_farm)vw_cli_farm_resolve(farm, s->strategy != NULL); /* as render's */
     s->farm = p.farm;
+    double t_start = vw_cli_now();
     FILE *in = stdin;
     s->name = "stdin";
     if (edits_path) {
         in = fopen(edits_path, "r");
-        if (!in) {
-            vw_cli_error(cmd, "cannot open '%s'", edits_path);
+        struct stat sb;
+        if (!in || (fstat(fileno(in), &sb) == 0 && S_ISDIR(sb.st_mode))) {
+            vw_cli_error(cmd, "cannot open '%s': %s", edits_path, in ? strerror(EISDIR) : strerror(errno));
+            if (in) fclose(in);
             goto done;
         }
         s->name = edits_path;
@@ -411,17 +462,30 @@ int vw_anim_main(const char *cmd, int argc, char **argv)
         rc = VW_EXIT_FAIL;
         goto done;
     }
-    char line[1024];
+    /* Whole lines, however long (the parser refuses a long command; a long comment is
+       fine), so no tail of a line is ever read as a line of its own. */
+    char *line = NULL;
+    size_t cap = 0;
+    ssize_t len;
     int lineno = 0;
-    if (s->interactive) say(s, "vwalls edit: %d objects; commands: move moveto rotate add remove check sweep frame balance\n",
-                            vw_dynscene_ids(rt_anim_dynscene(s->anim)));
-    while (fgets(line, sizeof line, in)) {
+    if (s->interactive) {
+        say(s, "vwalls edit: %d objects; commands: move moveto rotate add remove check sweep frame balance\n",
+            vw_dynscene_ids(rt_anim_dynscene(s->anim)));
+        fflush(stdout); /* a program driving edit waits for it */
+    }
+    while ((len = getline(&line, &cap, in)) > 0) {
         lineno++;
-        if (session_line(s, line, lineno)) break;
+        if (session_line(s, line, (size_t)len, lineno)) break;
         if (s->interactive) fflush(stdout);
     }
+    int read_error = len < 0 && ferror(in) ? errno : 0;
+    free(line);
     if (!s->failed) flush(s);
     if (in != stdin) fclose(in);
+    if (read_error && !s->failed) {
+        vw_cli_error(cmd, "cannot read '%s': %s", edits_path ? edits_path : "stdin", strerror(read_error));
+        s->failed = 1;
+    }
     say(s, "%s: %zu accepted, %zu rejected at the destination, %zu rejected along the path, "
            "%zu invalid; %zu frames (farm %s)\n",
         cmd, s->total_acc, s->total_coll, s->total_sweep, s->total_invalid, s->nframes,
@@ -429,6 +493,7 @@ int vw_anim_main(const char *cmd, int argc, char **argv)
     if (stats && s->failed != 1) {
         char *extra = frames_json(s);
         vw_world *w = rt_job_world(rt_anim_job(s->anim));
+        vw_world_add_time(w, "total", vw_cli_now() - t_start);
         if (!extra) {
             vw_cli_error(cmd, "out of memory for the stats");
             if (!s->failed) s->failed = 1;
@@ -438,7 +503,8 @@ int vw_anim_main(const char *cmd, int argc, char **argv)
         }
         free(extra);
     }
-    rc = s->failed ? s->failed : VW_EXIT_OK;
+    /* A bad line is bad input even when the session went on past it (--keep-going, edit). */
+    rc = s->failed ? s->failed : s->bad_lines ? VW_EXIT_USAGE : VW_EXIT_OK;
 done:
     if (s->log) fclose(s->log);
     rt_anim_free(s->anim);

@@ -77,13 +77,59 @@ rc=$?
 grep -q '^bad.txt:2: no object 999999' berr.txt || fail "unknown id message: $(cat berr.txt)"
 [ -e b01.png ] && fail "a frame after the bad line was rendered"
 
-"$V" animate scene.nff bad.txt -o 'k%02d.png' --workers 2 --keep-going > kout.txt 2> kerr.txt
+# --keep-going renders every frame, and the bad lines still make the status 2; all four
+# count as invalid and are in the log, the unparsable ones too.
+"$V" animate scene.nff bad.txt -o 'k%02d.png' --workers 2 --keep-going --log klog.txt > kout.txt 2> kerr.txt
 rc=$?
-[ $rc -eq 0 ] || fail "--keep-going: status $rc"
+[ $rc -eq 2 ] || fail "--keep-going: status $rc, expected 2"
 grep -q '^bad.txt:3: unknown command' kerr.txt || fail "unknown command message"
 grep -q '^bad.txt:4: bad number' kerr.txt || fail "NaN message"
 grep -q '^bad.txt:5: object 2 would leave the world' kerr.txt || fail "outside-world message: $(cat kerr.txt)"
 [ -s k01.png ] || fail "--keep-going: second frame missing"
+grep -q '4 invalid' kout.txt || fail "--keep-going: summary should count 4 invalid: $(tail -1 kout.txt)"
+[ "$(grep -c invalid klog.txt)" -eq 4 ] || fail "--keep-going: the log should list 4 invalid lines: $(cat klog.txt)"
+grep -q '^bad.txt:3: invalid: unknown command' klog.txt || fail "log of an unparsable line: $(cat klog.txt)"
+
+# -o is a printf format: one integer conversion and a .png name, or status 2 and no file
+# ('%s' and '%n' used to crash, '%x' to print the stack, no conversion to overwrite).
+for pat in 'p%s.png' 'p%n.png' 'p%x.png' 'p%d%d.png' 'p.png' '' 'p%d' 'p%5000d.png' 'p%'; do
+  rm -f p*
+  "$V" animate scene.nff ok.txt -o "$pat" --size 8x8 --quiet 2> perr.txt; rc=$?
+  [ $rc -eq 2 ] || fail "-o '$pat': status $rc, expected 2"
+  grep -q -- "-o: bad pattern" perr.txt || fail "-o '$pat': message: $(cat perr.txt)"
+  ls p* 2> /dev/null | grep -v perr.txt | grep -q . && fail "-o '$pat': a file was written"
+done
+"$V" animate scene.nff ok.txt -o 'q%%%03i.png' --size 8x8 --quiet || fail "-o 'q%%%03i.png': status $?"
+[ -s 'q%000.png' ] && [ -s 'q%001.png' ] || fail "-o 'q%%%03i.png': frames missing"
+
+# Lines of any length: a long comment is a comment (its tail used to run as a line of its
+# own), a long command is one bad line; a NUL byte makes a bad line; a directory is not
+# a script.
+long=$(printf 'x%.0s' $(seq 1100))
+printf 'frame\n# %s move 0 0 0 1\nframe\n' "$long" > long.txt
+"$V" animate scene.nff long.txt -o 'l%02d.png' --size 8x8 --log llog.txt --quiet || fail "long comment: status $?"
+grep -q move llog.txt && fail "the tail of a long comment was run: $(cat llog.txt)"
+cmp -s l00.png l01.png || fail "long comment: the frames differ"
+printf 'move 0 0 0 0.1 %s\nframe\n' "$long" > longc.txt
+"$V" animate scene.nff longc.txt -o 'm%02d.png' --size 8x8 --quiet 2> lerr.txt; rc=$?
+[ $rc -eq 2 ] && [ "$(wc -l < lerr.txt)" -eq 1 ] && grep -q '^longc.txt:1: line too long' lerr.txt \
+  || fail "long command: status $rc, messages: $(cat lerr.txt)"
+printf 'move 0 0 0 0.1\0garbage\nframe\n' > nul.txt
+"$V" animate scene.nff nul.txt -o 'n%02d.png' --size 8x8 --quiet 2> nerr.txt; rc=$?
+[ $rc -eq 2 ] && grep -q '^nul.txt:1: a NUL byte' nerr.txt || fail "NUL byte: status $rc: $(cat nerr.txt)"
+mkdir -p adir
+"$V" animate scene.nff adir -o 'd%02d.png' --size 8x8 --quiet 2> derr.txt; rc=$?
+[ $rc -eq 2 ] && grep -q "cannot open 'adir': Is a directory" derr.txt || fail "directory script: status $rc: $(cat derr.txt)"
+
+# A rotation about an axis too long to square (1e200) is the rotation about the unit
+# axis (it used to scale the triangle, object 1, by cos 30 degrees).
+printf 'v\nfrom 0 -6 2\nat 0 0 0\nup 0 0 1\nangle 40\nhither 0.01\nresolution 32 32\nl 3 -5 5\n%s\n' \
+  'f 0.8 0.5 0.3 0.7 0.3 10 0 1 s 0 0 -1 0.5 p 3 -1 0 0 1 0 0 0 0 1.5' > tri.nff
+for ax in '1e200 0 0' '1 0 0'; do
+  printf 'rotate 1 %s 30\nframe\n' "$ax" > rot.txt
+  "$V" animate tri.nff rot.txt -o "r${ax%% *}-%d.png" --quiet || fail "rotate $ax: status $?"
+done
+cmp -s r1e200-0.png r1-0.png || fail "rotate about 1e200,0,0 differs from rotate about 1,0,0"
 
 # Every bad script of the corpus (its last line is the bad one): status 2, "file:line:
 # why" naming that line, and no frame (a 'frame' is added after it). The good one runs.
@@ -105,7 +151,10 @@ done
 
 printf 'move 0 0.05 0 0\nbogus\nremove 1\nremove 1\nframe\n' | "$V" edit scene.nff -o 'e%02d.png' --workers 1 > eout.txt 2> eerr.txt
 rc=$?
-[ $rc -eq 0 ] || fail "edit: status $rc"
+[ $rc -eq 2 ] || fail "edit: status $rc, expected 2 (it went on past two bad lines)"
+printf 'move 0 0.05 0 0\n' | "$V" edit scene.nff --workers 1 --quiet > qout.txt || fail "edit --quiet: status $?"
+grep -q 'move 0: accepted' qout.txt || fail "edit --quiet: the answer is missing"
+grep -q 'objects; commands' qout.txt && fail "edit --quiet: the banner was printed"
 grep -q 'remove 1: accepted' eout.txt || fail "edit: no answer"
 grep -q '^stdin:2: unknown command' eerr.txt || fail "edit: bad line message"
 grep -q '^stdin:4: no object 1' eerr.txt || fail "edit: removed id message"

@@ -7,11 +7,14 @@
  *    them: check, sweep, frame, balance) are decided by cells of a 2x2x1 world on two
  *    workers, and one edit at a time by the O(n^2) brute-force reference; every outcome,
  *    obstacle, id and message must agree, and the two scenes must be the same NFF after
- *    every batch.
+ *    every batch;
+ *  - moves and rotations are rigid: an object they were accepted for keeps its sizes
+ *    (radii, a cone's length, a polygon's sides) to 1e-9 of the world.
  */
 #ifndef _GNU_SOURCE
 #define _GNU_SOURCE
 #endif
+#include <math.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -92,6 +95,36 @@ static void check_parsed(vw_status st, const vw_edit *e, const char *err, int li
     }
 }
 
+/* The sizes a rigid motion keeps: a sphere's radius; a cone's radii and length; a
+   polygon's sides (at most 6 numbers). Returns how many, 0 for no such object. */
+static int sizes(const vw_scene *s, int id, double out[6])
+{
+    vw_prim_kind kind;
+    size_t i;
+    if (vw_scene_find_object(s, id, &kind, &i) != VW_OK) return 0;
+    if (kind == VW_PRIM_SPHERE) {
+        out[0] = s->spheres[i].radius;
+        return 1;
+    }
+    if (kind == VW_PRIM_CONE) {
+        const vw_cone *c = &s->cones[i];
+        double l = 0;
+        for (int k = 0; k < 3; k++) l += (c->apex[k] - c->base[k]) * (c->apex[k] - c->base[k]);
+        out[0] = c->base_radius, out[1] = c->apex_radius, out[2] = sqrt(l);
+        return 3;
+    }
+    const vw_polygon *p = &s->polygons[i];
+    int n = p->count < 6 ? p->count : 6;
+    for (int j = 0; j < n; j++) {
+        const double *a = s->vertices[s->indices[p->first + j]];
+        const double *b = s->vertices[s->indices[p->first + (j + 1) % p->count]];
+        double l = 0;
+        for (int k = 0; k < 3; k++) l += (b[k] - a[k]) * (b[k] - a[k]);
+        out[j] = sqrt(l);
+    }
+    return n;
+}
+
 /* Decides a batch both ways and compares. */
 static void decide(vw_dynscene *dist, vw_dynscene *ref, const vw_edit *e, size_t n, int check,
                    int sweep)
@@ -100,6 +133,14 @@ static void decide(vw_dynscene *dist, vw_dynscene *ref, const vw_edit *e, size_t
     vw_result r1[MAX_BATCH], r2[MAX_BATCH];
     int *ch;
     size_t nch;
+    /* The sizes before the batch of every object it moves or turns (an object edited
+       twice in the batch is checked against the first). */
+    double before[MAX_BATCH][6];
+    int nbefore[MAX_BATCH];
+    for (size_t i = 0; i < n; i++) {
+        int rigid = e[i].op == VW_EDIT_MOVE || e[i].op == VW_EDIT_MOVETO || e[i].op == VW_EDIT_ROTATE;
+        nbefore[i] = rigid ? sizes(vw_dynscene_scene(dist), e[i].id, before[i]) : 0;
+    }
     if (vw_dynscene_apply(dist, e, n, check, sweep, r1, &ch, &nch) != VW_OK)
         die("the collider's batch failed", e[0].line, NULL);
     free(ch);
@@ -117,6 +158,18 @@ static void decide(vw_dynscene *dist, vw_dynscene *ref, const vw_edit *e, size_t
                     r2[i].obstacle, r2[i].id, r2[i].msg);
             die("the collider and the reference disagree", e[i].line, NULL);
         }
+    }
+    for (size_t i = 0; i < n; i++) {
+        double after[6];
+        if (!nbefore[i] || r1[i].outcome != VW_OUT_ACCEPTED) continue;
+        int na = sizes(vw_dynscene_scene(dist), e[i].id, after);
+        if (!na) continue; /* removed later in the batch */
+        if (na != nbefore[i]) die("an object changed kind", e[i].line, NULL);
+        for (int k = 0; k < nbefore[i]; k++)
+            if (!(fabs(after[k] - before[i][k]) <= 1e-8)) { /* 1e-9 of the 11-unit world */
+                fprintf(stderr, "size %d: %.17g before, %.17g after\n", k, before[i][k], after[k]);
+                die("a move or rotation changed the object's size", e[i].line, NULL);
+            }
     }
     char *a = nff_text(dist), *b = nff_text(ref);
     if (strcmp(a, b)) die("the scenes differ after the batch", e[n - 1].line, NULL);

@@ -160,9 +160,14 @@ double rad_default_patch_size(const vw_scene *s)
 
 /* The line of the k-th polygon statement of a scene file (OBJ "f", NFF "p"/"pp"), so
    that geometry errors found after parsing can still be reported as file:line. 0 when
-   it cannot be told. */
+   it cannot be told. The format follows the name, as vw_scene_read_file decides it: in
+   NFF an "f" line is a material, not a polygon, and counting it named the wrong line
+   (the Cornell box's red wall, line 57, was reported at line 44). */
 static int polygon_line(const char *path, size_t k)
 {
+    size_t plen = path ? strlen(path) : 0;
+    int nff = plen >= 4 && path[plen - 4] == '.' && (path[plen - 3] | 32) == 'n' &&
+              (path[plen - 2] | 32) == 'f' && (path[plen - 1] | 32) == 'f';
     FILE *f = path ? fopen(path, "r") : NULL;
     if (!f) return 0;
     char buf[4096];
@@ -172,9 +177,13 @@ static int polygon_line(const char *path, size_t k)
         line++;
         const char *p = buf;
         while (*p == ' ' || *p == '\t') p++;
-        int is_poly = (p[0] == 'f' && (p[1] == ' ' || p[1] == '\t')) ||
-                      (p[0] == 'p' && (p[1] == ' ' || p[1] == '\t' || p[1] == '\n' || p[1] == '\r')) ||
-                      (p[0] == 'p' && p[1] == 'p' && (p[2] == ' ' || p[2] == '\t' || p[2] == '\n'));
+        int is_poly;
+        if (nff) {
+            const char *q = p[0] == 'p' ? p + 1 + (p[1] == 'p') : NULL; /* after "p", "pp" */
+            is_poly = q && (!*q || *q == ' ' || *q == '\t' || *q == '\n' || *q == '\r');
+        } else {
+            is_poly = p[0] == 'f' && (p[1] == ' ' || p[1] == '\t');
+        }
         size_t n = strlen(buf);
         while (n == sizeof buf - 1 && buf[n - 1] != '\n' && fgets(buf, sizeof buf, f)) n = strlen(buf);
         if (is_poly && count++ == k) {

@@ -28,6 +28,18 @@ void rad_options_init(rad_options *o)
     o->checkpoint_every = 60;
 }
 
+int rad_material(const vw_material *mt, double rho[3], double emit[3])
+{
+    int clamped = 0;
+    for (int k = 0; k < 3; k++) {
+        double d = mt ? mt->diffuse[k] : 0.5;
+        clamped |= !(d >= 0 && d <= 1);
+        rho[k] = d >= 0 ? fmin(d, 1) : 0;
+        emit[k] = mt && mt->emission[k] > 0 ? mt->emission[k] : 0;
+    }
+    return clamped;
+}
+
 /* ---- polygon clipping ---- */
 
 /* Keeps the part of p where dot(a, x) >= b (one Sutherland-Hodgman pass). */
@@ -275,11 +287,8 @@ static vw_status mesh_polygon(rad_mesh *m, size_t *cap, const vw_decomp *d, cons
                 memcpy(pc.uax, ua, sizeof pc.uax);
                 memcpy(pc.vax, va, sizeof pc.vax);
                 pc.elem = elem;
-                for (int k = 0; k < 3; k++) {
-                    pc.rho[k] = mat ? fmin(fmax(mat->diffuse[k], 0), 1) : 0.5;
-                    pc.emit[k] = mat ? fmax(mat->emission[k], 0) : 0;
-                    m->emitted[k] += pc.emit[k] * area;
-                }
+                rad_material(mat, pc.rho, pc.emit);
+                for (int k = 0; k < 3; k++) m->emitted[k] += pc.emit[k] * area;
                 m->area += area;
                 if (push_piece(m, cap, &pc, owner)) return VW_E_NOMEM;
             }
@@ -305,6 +314,7 @@ vw_status rad_mesh_build(const vw_scene *s, const char *path, const vw_decomp *d
     vw_status st = VW_OK;
     int max_id = -1;
     double squares = 0; /* of the patch grid over every polygon so far */
+    size_t nclamped = 0, first_clamped = 0; /* polygons whose reflectance is clamped */
     for (size_t k = 0; k < s->npolygons && st == VW_OK; k++) {
         const vw_polygon *pg = &s->polygons[k];
         if (pg->id > max_id) max_id = pg->id;
@@ -376,6 +386,8 @@ vw_status rad_mesh_build(const vw_scene *s, const char *path, const vw_decomp *d
         rad_cross(normal, ua, va);
         const vw_material *mat =
             pg->material >= 0 && (size_t)pg->material < s->nmaterials ? &s->materials[pg->material] : NULL;
+        double rho_used[3], emit_used[3];
+        if (rad_material(mat, rho_used, emit_used) && nclamped++ == 0) first_clamped = k;
         /* Large polygons are fanned into chunks that fit RAD_MAXV after clipping. */
         const int chunk = RAD_MAXV - 10;
         for (int first = 1; first + 1 < nv && st == VW_OK; first += chunk - 2) {
@@ -397,6 +409,18 @@ vw_status rad_mesh_build(const vw_scene *s, const char *path, const vw_decomp *d
     }
     free(cells);
     m->npolys = (size_t)(max_id + 1);
+    /* Once, not per polygon: a scene usually shares a few materials among many. */
+    if (st == VW_OK && nclamped && !o->quiet) {
+        const vw_polygon *pg = &s->polygons[first_clamped];
+        const vw_material *mat = &s->materials[pg->material];
+        char at[512];
+        where(at, sizeof at, path, first_clamped);
+        fprintf(stderr,
+                "%s: warning: reflectance %g %g %g of polygon (id %d) is outside [0, 1], clamped "
+                "(%zu polygon%s in all); the solver and the CSV use the clamped values\n",
+                at, mat->diffuse[0], mat->diffuse[1], mat->diffuse[2], pg->id, nclamped,
+                nclamped == 1 ? "" : "s");
+    }
     if (st == VW_E_NOMEM) snprintf(err, errlen, "%s: out of memory while meshing", path ? path : "scene");
     if (st == VW_E_LIMIT)
         snprintf(err, errlen,

@@ -343,10 +343,11 @@ vw_status rad_write_csv(const char *path, const rad_mesh *m, const vw_scene *sc,
         if (pg->id < 0 || (size_t)pg->id >= np || area[pg->id] <= 0) continue;
         const vw_material *mt =
             pg->material >= 0 && (size_t)pg->material < sc->nmaterials ? &sc->materials[pg->material] : NULL;
+        double rho[3], emit[3];
+        rad_material(mt, rho, emit); /* what the solver used, not what the file said */
         sb_printf(&b, "%d,%.9g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.9g,%.9g,%.9g\n", pg->id, area[pg->id],
-                  mt ? mt->diffuse[0] : 0.5, mt ? mt->diffuse[1] : 0.5, mt ? mt->diffuse[2] : 0.5,
-                  mt ? mt->emission[0] : 0, mt ? mt->emission[1] : 0, mt ? mt->emission[2] : 0,
-                  B[pg->id][0], B[pg->id][1], B[pg->id][2]);
+                  rho[0], rho[1], rho[2], emit[0], emit[1], emit[2], B[pg->id][0], B[pg->id][1],
+                  B[pg->id][2]);
         area[pg->id] = 0; /* once per polygon */
     }
     free(area), free(B), free(inc);

@@ -84,6 +84,11 @@ void rad_mesh_free(rad_mesh *m);
 vw_box rad_world_box(const vw_scene *s);
 /* The default patch size for a scene (a tenth of the largest extent). */
 double rad_default_patch_size(const vw_scene *s);
+/* What the solver uses of a material (NULL: grey 0.5, no emission): the reflectance
+   clamped to [0, 1], so that no surface gives back more than it receives, and the
+   emission clamped to >= 0. The one definition for the mesher and the CSV. Returns 1
+   when the reflectance had to be clamped (NaN counts, and becomes 0). */
+int rad_material(const vw_material *mt, double rho[3], double emit[3]);
 
 /* Geometry helpers shared with the module and the outputs. */
 typedef struct rad_poly {

@@ -52,6 +52,16 @@ grep -q "warning: converged before the first shot" "$T/err" || fail "--sf 0.5: n
 [ "$(grep -c "warning: polygon" "$T/err")" = 1 ] &&
   grep -q "cornell.nff:57: warning: polygon (id 8) is not planar (0.8 off)" "$T/err" \
   || fail "Cornell non-planar warning: $(cat "$T/err")"
+# Kd 5 on the white of the floor and the ceiling (line 11; polygons 0-4): the solver
+# clamps it to 1, the CSV says 1, and one warning names the first polygon's line.
+sed '11s/.*/f 1 1 1 5 0 0 0 1/' "$T/cornell.nff" >"$T/kd5.nff"
+"$V" radiosity "$T/kd5.nff" --csv "$T/kd5.csv" --sf 0.01 --patch-size 200 --max-shots 4 \
+  >/dev/null 2>"$T/err" || fail "Kd 5: $(cat "$T/err")"
+awk -F, '$1 == 0 && $3 == 1 && $4 == 1 && $5 == 1 { ok = 1 } END { exit !ok }' "$T/kd5.csv" \
+  || fail "Kd 5: CSV reflectance: $(sed -n 2p "$T/kd5.csv")"
+[ "$(grep -c "reflectance" "$T/err")" = 1 ] &&
+  grep -q "kd5.nff:12: warning: reflectance 5 5 5 of polygon (id 0) is outside \[0, 1\], clamped (5 polygons in all)" \
+    "$T/err" || fail "Kd 5: warning: $(cat "$T/err")"
 # Looking straight down (+y up would be parallel to the view): +z is up instead.
 "$V" radiosity "$T/cornell.nff" --image "$T/v.png" --view 278,540,280,278,0,280,100 \
   --size 16x16 --max-shots 4 --quiet 2>"$T/err" || fail "vertical --view: $(cat "$T/err")"

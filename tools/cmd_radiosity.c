@@ -49,7 +49,9 @@ static void help(void)
            "  --checkpoint FILE    write checkpoints here (atomically)\n"
            "  --checkpoint-every S seconds between checkpoints (default 60; 0: every round;\n"
            "                       under MPI the output process's clock decides for all)\n"
-           "  --resume FILE        continue from a checkpoint (same scene and meshing options)\n"
+           "  --resume FILE        continue from a checkpoint: the same scene, --cells,\n"
+           "                       --patch-size, --elements, --hemicube, --subdivide, --max-level\n"
+           "                       and --neighbourhood as the run that wrote it (--sf may change)\n"
            "  --max-rounds N       stop after N rounds without writing outputs (tests: a kill)\n"
            "  --quiet              no progress bar and no summary\n",
            RAD_MAX_RES);

@@ -409,6 +409,7 @@ vw_status rad_mesh_build(const vw_scene *s, const char *path, const vw_decomp *d
     }
     free(cells);
     m->npolys = (size_t)(max_id + 1);
+    m->patch_size = S;
     /* Once, not per polygon: a scene usually shares a few materials among many. */
     if (st == VW_OK && nclamped && !o->quiet) {
         const vw_polygon *pg = &s->polygons[first_clamped];

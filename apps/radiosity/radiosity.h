@@ -72,6 +72,7 @@ typedef struct rad_mesh {
     size_t npolys;          /* scene polygons (ids are scene ids, may be sparse) */
     double emitted[3];      /* total emitted power */
     double area;            /* total area */
+    double patch_size;      /* the patch side used (--patch-size or the scene's default) */
 } rad_mesh;
 
 /* Splits every polygon into patches and clips them at the cells of d. Bad geometry is

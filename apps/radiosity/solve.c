@@ -114,6 +114,271 @@ static void update_ledger(rad_solver *s)
     s->ratio = s->rep.max_unshot / s->emitted_sum;
 }
 
+/* ---- checkpoints ---- */
+
+/* Checkpoint file, native byte order (resume on the same kind of machine):
+     "VWRADCK2"                  8 bytes
+     pieces, fingerprint         u64, u64: the mesh (ck_fingerprint)
+     round, shots                i32, i64
+     absorbed[3], escaped[3]     f64: the ledger of the shots so far (absorbed[0] at
+                                 byte 36, where format 1 had it too)
+     patch size, elements, hemicube, cells[3], max level, subdivide, neighbourhood
+                                 f64, i32, i32, 3 i32, i32, f64, f64: what the state
+                                 depends on besides the mesh (ck_compatible)
+     patches                     u64, then one rad_patch_result per piece, by piece
+     elements                    u64, then rad_elem_result by piece, level, gi, gj
+   Written atomically: a kill while writing leaves the previous one. */
+#define CK_MAGIC "VWRADCK2"
+#define CK_HEAD_BYTES 132
+
+typedef struct ck_head {
+    uint64_t npieces, fingerprint;
+    int32_t round;
+    int64_t shots;
+    double absorbed[3], escaped[3];
+    double patch_size;
+    int32_t elements, hemicube, cells[3], max_level;
+    double subdivide, neighbourhood;
+} ck_head;
+
+static uint64_t fnv(uint64_t h, const void *p, size_t n)
+{
+    const unsigned char *b = p;
+    for (size_t i = 0; i < n; i++) h = (h ^ b[i]) * 1099511628211ull;
+    return h;
+}
+
+/* Every field of every piece that the solution depends on: geometry, the polygon's frame
+   and element size, reflectance and emission. The same scene meshed with the same
+   --patch-size, --elements and --cells gives the same bits. */
+static uint64_t ck_fingerprint(const rad_mesh *m)
+{
+    uint64_t h = 1469598103934665603ull;
+    for (size_t i = 0; i < m->npieces; i++) {
+        const rad_piece *pc = &m->pieces[i];
+        h = fnv(h, &pc->poly, sizeof pc->poly);
+        h = fnv(h, &pc->nv, sizeof pc->nv);
+        h = fnv(h, &pc->pi, sizeof pc->pi);
+        h = fnv(h, &pc->pj, sizeof pc->pj);
+        h = fnv(h, pc->v, sizeof(double) * 3 * (size_t)pc->nv);
+        h = fnv(h, pc->normal, sizeof pc->normal);
+        h = fnv(h, pc->centroid, sizeof pc->centroid);
+        h = fnv(h, &pc->area, sizeof pc->area);
+        h = fnv(h, pc->origin, sizeof pc->origin);
+        h = fnv(h, pc->uax, sizeof pc->uax);
+        h = fnv(h, pc->vax, sizeof pc->vax);
+        h = fnv(h, &pc->elem, sizeof pc->elem);
+        h = fnv(h, pc->rho, sizeof pc->rho);
+        h = fnv(h, pc->emit, sizeof pc->emit);
+    }
+    return h;
+}
+
+/* The header this run would write (round, shots and ledger from the solver). */
+static void ck_head_of(const rad_solver *s, ck_head *h)
+{
+    memset(h, 0, sizeof *h);
+    h->npieces = s->mesh->npieces;
+    h->fingerprint = ck_fingerprint(s->mesh);
+    h->round = s->round;
+    h->shots = s->shots;
+    for (int k = 0; k < 3; k++) h->absorbed[k] = s->ledger.absorbed[k], h->escaped[k] = s->ledger.escaped[k];
+    h->patch_size = s->mesh->patch_size;
+    h->elements = s->opt.elem_split;
+    h->hemicube = s->opt.res;
+    for (int a = 0; a < 3; a++) h->cells[a] = s->opt.dims[a];
+    /* Without --subdivide the level limit plays no part. */
+    h->subdivide = s->opt.subdivide > 0 ? s->opt.subdivide : 0;
+    h->max_level = h->subdivide > 0 ? s->opt.max_level : 0;
+    h->neighbourhood = s->opt.neighbourhood > 0 ? s->opt.neighbourhood : 0;
+}
+
+#define CK_FIELDS(X)                                                                   \
+    X(npieces, 8) X(fingerprint, 8) X(round, 4) X(shots, 8) X(absorbed, 24)             \
+    X(escaped, 24) X(patch_size, 8) X(elements, 4) X(hemicube, 4) X(cells, 12)          \
+    X(max_level, 4) X(subdivide, 8) X(neighbourhood, 8)
+
+#define X(f, n) _Static_assert(sizeof(((ck_head *)0)->f) == n, "checkpoint field " #f);
+CK_FIELDS(X)
+#undef X
+#define X(f, n) +n
+_Static_assert(8 CK_FIELDS(X) == CK_HEAD_BYTES, "checkpoint header size");
+#undef X
+/* The records are written as they are: no padding, so no uninitialised bytes. */
+_Static_assert(sizeof(rad_patch_result) == 40 && sizeof(rad_elem_result) == 80, "checkpoint records");
+
+static void ck_put(unsigned char *p, const ck_head *h)
+{
+    memcpy(p, CK_MAGIC, 8), p += 8;
+#define X(f, n) memcpy(p, &h->f, n), p += n;
+    CK_FIELDS(X)
+#undef X
+}
+
+static void ck_get(const unsigned char *p, ck_head *h)
+{
+    p += 8;
+#define X(f, n) memcpy(&h->f, p, n), p += n;
+    CK_FIELDS(X)
+#undef X
+}
+
+/* Why a checkpoint with header c cannot continue this run (mine), in why; 0 when it
+   can. Everything the restored state depends on must match: the mesh (scene, patch
+   size, elements, cells: the fingerprint), and the options that decide what the state
+   means: elements (their grid), hemicube (the form factors the powers came from),
+   subdivision (leaves deeper than this run's fine cells cannot be restored), the
+   neighbourhood (which shots reached which cells). --sf, --per-round, --max-shots and
+   the workers may change. */
+/* An option's value for a message: the shortest form that reads back to it (so 0.3,
+   not 0.29999999999999999), "none" for an option not given. */
+static const char *opt_value(double x, char *buf, size_t n)
+{
+    if (!(x > 0)) {
+        snprintf(buf, n, "none");
+        return buf;
+    }
+    for (int digits = 6; digits <= 17; digits++) {
+        snprintf(buf, n, "%.*g", digits, x);
+        if (strtod(buf, NULL) == x) break;
+    }
+    return buf;
+}
+
+static int ck_incompatible(const ck_head *c, const ck_head *mine, char *why, size_t n)
+{
+    char a[32], b[32];
+    if (c->cells[0] != mine->cells[0] || c->cells[1] != mine->cells[1] || c->cells[2] != mine->cells[2])
+        snprintf(why, n, "--cells %dx%dx%d there, %dx%dx%d here", c->cells[0], c->cells[1], c->cells[2],
+                 mine->cells[0], mine->cells[1], mine->cells[2]);
+    else if (c->patch_size != mine->patch_size)
+        snprintf(why, n, "--patch-size %s there, %s here", opt_value(c->patch_size, a, sizeof a),
+                 opt_value(mine->patch_size, b, sizeof b));
+    else if (c->elements != mine->elements)
+        snprintf(why, n, "--elements %d there, %d here", c->elements, mine->elements);
+    else if (c->hemicube != mine->hemicube)
+        snprintf(why, n, "--hemicube %d there, %d here", c->hemicube, mine->hemicube);
+    else if (c->subdivide != mine->subdivide)
+        snprintf(why, n, "--subdivide %s there, %s here", opt_value(c->subdivide, a, sizeof a),
+                 opt_value(mine->subdivide, b, sizeof b));
+    else if (c->max_level != mine->max_level)
+        snprintf(why, n, "--max-level %d there, %d here", c->max_level, mine->max_level);
+    else if (c->neighbourhood != mine->neighbourhood)
+        snprintf(why, n, "--neighbourhood %s there, %s here", opt_value(c->neighbourhood, a, sizeof a),
+                 opt_value(mine->neighbourhood, b, sizeof b));
+    else if (c->npieces != mine->npieces || c->fingerprint != mine->fingerprint)
+        snprintf(why, n, "the scene or its meshing differs: %llu pieces there, %llu here",
+                 (unsigned long long)c->npieces, (unsigned long long)mine->npieces);
+    else
+        return 0;
+    return 1;
+}
+
+/* Reads the whole file at s->opt.resume into *buf and checks that it can continue this
+   run. */
+static vw_status read_checkpoint(rad_solver *s, unsigned char **buf, size_t *len, ck_head *h,
+                                 char *err, size_t errlen)
+{
+    const char *path = s->opt.resume;
+    const rad_mesh *m = s->mesh;
+    *buf = NULL;
+    *len = 0;
+    FILE *f = fopen(path, "rb");
+    if (!f) {
+        snprintf(err, errlen, "%s: cannot open checkpoint: %s", path, strerror(errno));
+        return VW_E_IO;
+    }
+    size_t cap = 1 << 16, n = 0, k;
+    unsigned char *b = malloc(cap);
+    while (b && (k = fread(b + n, 1, cap - n, f)) > 0) {
+        n += k;
+        if (n == cap) {
+            unsigned char *nb = realloc(b, 2 * cap);
+            if (!nb) free(b);
+            b = nb, cap *= 2;
+        }
+    }
+    int rerr = ferror(f);
+    fclose(f);
+    if (!b) return VW_E_NOMEM;
+    if (rerr) {
+        snprintf(err, errlen, "%s: cannot read checkpoint: %s", path, strerror(errno));
+        free(b);
+        return VW_E_IO;
+    }
+    *buf = b, *len = n;
+#define CORRUPT(...)                                                                     \
+    do {                                                                                 \
+        char what_[256];                                                                 \
+        snprintf(what_, sizeof what_, __VA_ARGS__);                                      \
+        snprintf(err, errlen, "%s: truncated or corrupt checkpoint (%s)", path, what_);  \
+        return VW_E_INPUT;                                                               \
+    } while (0)
+    if (n >= 8 && !memcmp(b, "VWRADCK1", 8)) {
+        snprintf(err, errlen, "%s: a checkpoint of an older vwalls (format 1, which does not record "
+                 "the meshing options): start the run again", path);
+        return VW_E_INPUT;
+    }
+    if (n < 8 || memcmp(b, CK_MAGIC, 8)) {
+        snprintf(err, errlen, "%s: not a radiosity checkpoint", path);
+        return VW_E_INPUT;
+    }
+    if (n < CK_HEAD_BYTES + 8) CORRUPT("%zu bytes, shorter than its header", n);
+    ck_get(b, h);
+    ck_head mine;
+    ck_head_of(s, &mine);
+    char why[256];
+    if (ck_incompatible(h, &mine, why, sizeof why)) {
+        snprintf(err, errlen,
+                 "%s: checkpoint of a different scene or meshing (%s; use the same scene, --cells, "
+                 "--patch-size, --elements, --hemicube, --subdivide, --max-level and --neighbourhood "
+                 "as the run that wrote it; without --cells the layout follows the number of "
+                 "workers)", path, why);
+        return VW_E_INPUT;
+    }
+    uint64_t np, ne;
+    memcpy(&np, b + CK_HEAD_BYTES, 8);
+    if (np != m->npieces) CORRUPT("%llu patches for %zu pieces", (unsigned long long)np, m->npieces);
+    size_t at_ne = CK_HEAD_BYTES + 8 + (size_t)np * sizeof(rad_patch_result);
+    if (n < at_ne + 8) CORRUPT("%zu bytes, shorter than its %llu patches", n, (unsigned long long)np);
+    memcpy(&ne, b + at_ne, 8);
+    if (ne > (n - at_ne - 8) / sizeof(rad_elem_result) || n != at_ne + 8 + (size_t)ne * sizeof(rad_elem_result))
+        CORRUPT("%zu bytes for %llu elements", n, (unsigned long long)ne);
+    for (uint64_t i = 0; i < np; i++) {
+        rad_patch_result r;
+        memcpy(&r, b + CK_HEAD_BYTES + 8 + i * sizeof r, sizeof r);
+        if (r.piece != (int64_t)i) CORRUPT("patch %llu: piece %lld", (unsigned long long)i, (long long)r.piece);
+    }
+    for (uint64_t i = 0; i < ne; i++) {
+        rad_elem_result r;
+        memcpy(&r, b + at_ne + 8 + i * sizeof r, sizeof r);
+        if (r.piece < 0 || (uint64_t)r.piece >= np)
+            CORRUPT("element %llu: piece %lld", (unsigned long long)i, (long long)r.piece);
+    }
+#undef CORRUPT
+    return VW_OK;
+}
+
+/* Posts the records of a checked checkpoint to their owner cells. */
+static void post_checkpoint(rad_solver *s, const unsigned char *b)
+{
+    const rad_mesh *m = s->mesh;
+    uint64_t np, ne;
+    memcpy(&np, b + CK_HEAD_BYTES, 8);
+    size_t at_ne = CK_HEAD_BYTES + 8 + (size_t)np * sizeof(rad_patch_result);
+    memcpy(&ne, b + at_ne, 8);
+    for (uint64_t i = 0; i < np; i++) {
+        rad_patch_result r;
+        memcpy(&r, b + CK_HEAD_BYTES + 8 + i * sizeof r, sizeof r);
+        vw_world_post(s->w, m->owner[r.piece], RAD_K_RESTORE_PATCH, &r);
+    }
+    for (uint64_t i = 0; i < ne; i++) {
+        rad_elem_result r;
+        memcpy(&r, b + at_ne + 8 + i * sizeof r, sizeof r);
+        vw_world_post(s->w, m->owner[r.piece], RAD_K_RESTORE_ELEM, &r);
+    }
+}
+
 vw_status rad_solver_create(const rad_mesh *m, const vw_decomp *d, const rad_options *o,
                             rad_solver **out, char *err, size_t errlen)
 {
@@ -159,69 +424,21 @@ vw_status rad_solver_create(const rad_mesh *m, const vw_decomp *d, const rad_opt
         return st;
     }
     if (o->resume) {
-        st = VW_OK;
-        FILE *f = fopen(o->resume, "rb");
-        char magic[8];
-        uint64_t npieces = 0, fp = 0, np = 0, ne = 0;
-        int32_t round = 0;
-        int64_t shots = 0;
-        double ba[3], be[3];
-        if (!f) {
-            snprintf(err, errlen, "%s: cannot open checkpoint: %s", o->resume, strerror(errno));
-            vw_world_agree(s->w, VW_E_IO, err, errlen);
-            rad_solver_free(s);
-            return VW_E_IO;
-        }
-        uint64_t want = 1469598103934665603ull;
-        for (size_t i = 0; i < m->npieces; i++) {
-            uint64_t bits;
-            memcpy(&bits, &m->pieces[i].area, sizeof bits);
-            want = (want ^ bits) * 1099511628211ull;
-            memcpy(&bits, &m->pieces[i].centroid[0], sizeof bits);
-            want = (want ^ bits) * 1099511628211ull;
-        }
-        if (fread(magic, 1, 8, f) != 8 || memcmp(magic, "VWRADCK1", 8) || fread(&npieces, 8, 1, f) != 1 ||
-            fread(&fp, 8, 1, f) != 1 || fread(&round, 4, 1, f) != 1 || fread(&shots, 8, 1, f) != 1 ||
-            fread(ba, 8, 3, f) != 3 || fread(be, 8, 3, f) != 3 || fread(&np, 8, 1, f) != 1) {
-            snprintf(err, errlen, "%s: not a radiosity checkpoint (or truncated)", o->resume);
-            st = VW_E_INPUT;
-        } else if (npieces != m->npieces || fp != want) {
-            snprintf(err, errlen,
-                     "%s: checkpoint of a different scene or meshing (use the same scene, --cells, "
-                     "--patch-size and --elements as the run that wrote it; without --cells the "
-                     "layout follows the number of workers)", o->resume);
-            st = VW_E_INPUT;
-        }
-        for (uint64_t i = 0; st == VW_OK && i < np; i++) {
-            rad_patch_result r;
-            if (fread(&r, sizeof r, 1, f) != 1 || r.piece < 0 || (size_t)r.piece >= m->npieces) {
-                snprintf(err, errlen, "%s: truncated or corrupt checkpoint", o->resume);
-                st = VW_E_INPUT;
-                break;
-            }
-            vw_world_post(s->w, m->owner[r.piece], RAD_K_RESTORE_PATCH, &r);
-        }
-        if (st == VW_OK && fread(&ne, 8, 1, f) != 1) st = VW_E_INPUT;
-        for (uint64_t i = 0; st == VW_OK && i < ne; i++) {
-            rad_elem_result r;
-            if (fread(&r, sizeof r, 1, f) != 1 || r.piece < 0 || (size_t)r.piece >= m->npieces) {
-                st = VW_E_INPUT;
-                break;
-            }
-            vw_world_post(s->w, m->owner[r.piece], RAD_K_RESTORE_ELEM, &r);
-        }
-        if (st == VW_E_INPUT && !err[0]) snprintf(err, errlen, "%s: truncated or corrupt checkpoint", o->resume);
-        fclose(f);
         /* Every process reads the file; one that cannot must not leave the others
            waiting in the run below. */
-        st = vw_world_agree(s->w, st, err, errlen);
+        unsigned char *buf = NULL;
+        size_t len = 0;
+        ck_head h;
+        st = vw_world_agree(s->w, read_checkpoint(s, &buf, &len, &h, err, errlen), err, errlen);
         if (st == VW_OK) {
-            s->round = round;
-            s->base_shots = shots;
-            memcpy(s->base_absorbed, ba, sizeof ba);
-            memcpy(s->base_escaped, be, sizeof be);
+            post_checkpoint(s, buf);
+            s->round = h.round;
+            s->base_shots = h.shots;
+            memcpy(s->base_absorbed, h.absorbed, sizeof h.absorbed);
+            memcpy(s->base_escaped, h.escaped, sizeof h.escaped);
             st = run_world(s, err, errlen);
         }
+        free(buf);
         if (st != VW_OK) {
             rad_solver_free(s);
             return st;
@@ -371,45 +588,26 @@ vw_status rad_solver_checkpoint(rad_solver *s, const char *path, char *err, size
     return vw_world_agree(s->w, st, err, errlen);
 }
 
-/* Checkpoint: "VWRADCK1", pieces, mesh fingerprint, round, shots, absorbed[3],
-   escaped[3], patches, elements (native byte order: resume on the same kind of
-   machine). Written atomically: a kill while writing leaves the previous one. */
+/* Writes the format described at ck_head (output process). */
 vw_status rad_solver_write_checkpoint(const rad_solver *s, const char *path, char *err, size_t errlen)
 {
-    vw_status st;
     if (!vw_world_is_output(s->w)) return VW_OK;
-    const rad_mesh *m = s->mesh;
-    uint64_t fp = 1469598103934665603ull;
-    for (size_t i = 0; i < m->npieces; i++) {
-        uint64_t bits;
-        memcpy(&bits, &m->pieces[i].area, sizeof bits);
-        fp = (fp ^ bits) * 1099511628211ull;
-        memcpy(&bits, &m->pieces[i].centroid[0], sizeof bits);
-        fp = (fp ^ bits) * 1099511628211ull;
-    }
-    size_t len = 8 + 8 + 8 + 4 + 8 + 48 + 8 + s->npatches * sizeof(rad_patch_result) + 8 +
+    size_t len = CK_HEAD_BYTES + 8 + s->npatches * sizeof(rad_patch_result) + 8 +
                  s->nelems * sizeof(rad_elem_result);
     unsigned char *buf = malloc(len), *p = buf;
     if (!buf) return VW_E_NOMEM;
-    uint64_t npieces = m->npieces, np = s->npatches, ne = s->nelems;
-    int32_t round = s->round;
-    int64_t shots = s->shots;
-    double ab[3], es[3];
-    for (int k = 0; k < 3; k++) ab[k] = s->ledger.absorbed[k], es[k] = s->ledger.escaped[k];
+    ck_head h;
+    ck_head_of(s, &h);
+    uint64_t np = s->npatches, ne = s->nelems;
+    ck_put(p, &h);
+    p += CK_HEAD_BYTES;
 #define PUT(x, n) (memcpy(p, (x), (n)), p += (n))
-    PUT("VWRADCK1", 8);
-    PUT(&npieces, 8);
-    PUT(&fp, 8);
-    PUT(&round, 4);
-    PUT(&shots, 8);
-    PUT(ab, 24);
-    PUT(es, 24);
     PUT(&np, 8);
     PUT(s->patches, s->npatches * sizeof(rad_patch_result));
     PUT(&ne, 8);
     PUT(s->elems, s->nelems * sizeof(rad_elem_result));
 #undef PUT
-    st = rad_write_atomic(path, buf, len, err, errlen);
+    vw_status st = rad_write_atomic(path, buf, len, err, errlen);
     free(buf);
     return st;
 }

@@ -82,6 +82,24 @@ ls "$T" | grep -q "tmp\." && fail "temporary file left behind"
 "$V" radiosity "$T/cornell.nff" $opts --csv "$T/resumed.csv" --resume "$T/ck" 2>/dev/null || fail "resume"
 "$TR" csvcmp "$T/full.csv" "$T/resumed.csv" 0.01 || fail "resumed differs"
 
+# A checkpoint continues only a run with the options its state depends on: each of
+# these is refused (status 2, no output); --sf and --per-round may change.
+small="--sf 0.01 --patch-size 200 --per-round 1 --cells 2x2x2 --quiet"
+"$V" radiosity "$T/cornell.nff" $small --checkpoint "$T/k2" --checkpoint-every 0 --max-rounds 2 \
+  || fail "small checkpoint"
+for bad in "--elements 3:--elements 2 there, 3 here" "--hemicube 32:--hemicube 64 there, 32 here" \
+           "--subdivide 0.3:--subdivide none there, 0.3 here" "--patch-size 150:--patch-size 200 there, 150 here" \
+           "--neighbourhood 300:--neighbourhood none there, 300 here" "--cells 2x2x1:--cells 2x2x2 there, 2x2x1 here"; do
+  opt=${bad%%:*} want=${bad#*:}
+  "$V" radiosity "$T/cornell.nff" $small $opt --resume "$T/k2" --csv "$T/k2.csv" 2>"$T/err"; rc=$?
+  [ $rc -eq 2 ] || fail "resume with $opt: exit $rc"
+  grep -q "k2: checkpoint of a different scene or meshing ($want;" "$T/err" \
+    || fail "resume with $opt: message: $(cat "$T/err")"
+  [ ! -e "$T/k2.csv" ] || fail "resume with $opt: output written"
+done
+"$V" radiosity "$T/cornell.nff" $small --sf 0.005 --per-round 3 --resume "$T/k2" --csv "$T/k2.csv" \
+  || fail "resume with another --sf and --per-round"
+
 # Without --cells: one cell for one worker, at least 4 a worker for more; fewer cells
 # than workers given: a warning (radiosity cells cannot be shared).
 layout() { sed -n 's/.*"layout": "\([0-9x]*\)".*/\1/p' "$1" | head -n 1; }

@@ -117,6 +117,15 @@ static void on_round(void *user, rad_solver *s, int round)
     if (vw_world_is_output(rad_solver_world(s)) && write_outputs(r, s)) r->failed = 1;
 }
 
+/* x as a JSON number, or null: JSON has no NaN nor infinity, and "nan" makes the whole
+   stats file unreadable. */
+static const char *json_number(double x, char buf[32])
+{
+    if (isfinite(x)) snprintf(buf, 32, "%.17g", x);
+    else snprintf(buf, 32, "null");
+    return buf;
+}
+
 /* --view fx,fy,fz,ax,ay,az[,fov]: the camera, +y up (+z when the view is vertical);
    -1 after the message when it gives no view. */
 static int parse_view(const char *v, vw_camera *cam)
@@ -382,16 +391,18 @@ int vw_cmd_radiosity(int argc, char **argv)
             goto done;
         }
         if (r.stats) {
-            char extra[768];
+            char extra[768], n[7][32];
             snprintf(extra, sizeof extra,
-                     "\"radiosity\": {\"shots\": %lld, \"unshot_ratio\": %.17g, \"energy_error\": %.17g, "
-                     "\"converged\": %s, \"sf\": %.17g, \"hemicube\": %d, \"pieces\": %zu, \"elements\": %zu, "
-                     "\"emitted\": %.17g, \"absorbed\": %.17g, \"unshot\": %.17g, \"escaped\": %.17g, "
+                     "\"radiosity\": {\"shots\": %lld, \"unshot_ratio\": %s, \"energy_error\": %s, "
+                     "\"converged\": %s, \"sf\": %s, \"hemicube\": %d, \"pieces\": %zu, \"elements\": %zu, "
+                     "\"emitted\": %s, \"absorbed\": %s, \"unshot\": %s, \"escaped\": %s, "
                      "\"shot_messages\": %lld, \"shot_bytes\": %lld, \"full_messages\": %lld}",
-                     (long long)rad_solver_shots(s), rad_solver_unshot_ratio(s), L.error,
-                     converged ? "true" : "false", o.sf, o.res, mesh.npieces, ne,
-                     L.emitted[0] + L.emitted[1] + L.emitted[2], L.absorbed[0] + L.absorbed[1] + L.absorbed[2],
-                     L.unshot[0] + L.unshot[1] + L.unshot[2], L.escaped[0] + L.escaped[1] + L.escaped[2],
+                     (long long)rad_solver_shots(s), json_number(rad_solver_unshot_ratio(s), n[0]),
+                     json_number(L.error, n[1]), converged ? "true" : "false", json_number(o.sf, n[2]),
+                     o.res, mesh.npieces, ne, json_number(L.emitted[0] + L.emitted[1] + L.emitted[2], n[3]),
+                     json_number(L.absorbed[0] + L.absorbed[1] + L.absorbed[2], n[4]),
+                     json_number(L.unshot[0] + L.unshot[1] + L.unshot[2], n[5]),
+                     json_number(L.escaped[0] + L.escaped[1] + L.escaped[2], n[6]),
                      (long long)sm, (long long)sb, (long long)fm);
             vw_world_add_time(w, "load", t1 - t0);
             vw_world_add_time(w, "build", (t2 - t1) + (t3 - t2));
@@ -419,7 +430,7 @@ int vw_cmd_radiosity(int argc, char **argv)
                                 "patch holds sf = %g of the emitted power (the emitters are meshed "
                                 "finer); give a smaller --sf or a larger --patch-size\n", o.sf);
         }
-        if (L.error > 1e-6) {
+        if (!(L.error <= 1e-6)) { /* NaN too */
             vw_cli_error(CMD, "energy ledger off by %.3g (relative)", L.error);
             rc = VW_EXIT_FAIL;
         }

@@ -169,7 +169,8 @@ typedef struct rad_patch_result {
 
 typedef struct rad_ledger {
     double emitted[3], absorbed[3], unshot[3], escaped[3];
-    double error;           /* max over channels of |emitted - rest| / emitted */
+    double error;           /* max over channels of |emitted - rest| / emitted (infinity
+                               when a term is not a number) */
 } rad_ledger;
 
 typedef struct rad_solver rad_solver;

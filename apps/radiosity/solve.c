@@ -109,12 +109,15 @@ static void update_ledger(rad_solver *s)
         L->escaped[k] = s->base_escaped[k] + s->rep.shot[k] - s->rep.won[k];
         double scale = fmax(L->emitted[k], 1e-300 + 1e-12 * s->emitted_sum);
         double e = fabs(L->emitted[k] - (L->absorbed[k] + L->unshot[k] + L->escaped[k])) / scale;
-        if (e > L->error) L->error = e;
+        /* A NaN anywhere is an unbalanced ledger, not a balanced one (NaN > x is false). */
+        if (!(e <= L->error)) L->error = isnan(e) ? INFINITY : e;
     }
     s->ratio = s->rep.max_unshot / s->emitted_sum;
 }
 
 /* ---- checkpoints ---- */
+
+static int cmp_elem(const void *a, const void *b);
 
 /* Checkpoint file, native byte order (resume on the same kind of machine):
      "VWRADCK2"                  8 bytes
@@ -127,7 +130,10 @@ static void update_ledger(rad_solver *s)
                                  depends on besides the mesh (ck_compatible)
      patches                     u64, then one rad_patch_result per piece, by piece
      elements                    u64, then rad_elem_result by piece, level, gi, gj
-   Written atomically: a kill while writing leaves the previous one. */
+     checksum                    u64: FNV-1a of every byte before it
+   Written atomically: a kill while writing leaves the previous one. The checksum finds
+   a damaged file whose numbers still look plausible; the reader checks the numbers
+   first, so that what is wrong can be named. */
 #define CK_MAGIC "VWRADCK2"
 #define CK_HEAD_BYTES 132
 
@@ -141,6 +147,7 @@ typedef struct ck_head {
     double subdivide, neighbourhood;
 } ck_head;
 
+#define FNV_BASIS 1469598103934665603ull
 static uint64_t fnv(uint64_t h, const void *p, size_t n)
 {
     const unsigned char *b = p;
@@ -153,7 +160,7 @@ static uint64_t fnv(uint64_t h, const void *p, size_t n)
    --patch-size, --elements and --cells gives the same bits. */
 static uint64_t ck_fingerprint(const rad_mesh *m)
 {
-    uint64_t h = 1469598103934665603ull;
+    uint64_t h = FNV_BASIS;
     for (size_t i = 0; i < m->npieces; i++) {
         const rad_piece *pc = &m->pieces[i];
         h = fnv(h, &pc->poly, sizeof pc->poly);
@@ -336,25 +343,82 @@ static vw_status read_checkpoint(rad_solver *s, unsigned char **buf, size_t *len
                  "workers)", path, why);
         return VW_E_INPUT;
     }
+    /* Every number is checked before any is used: a NaN or a negative power would go
+       through the solve unnoticed (NaN compares false with every bound) into the
+       outputs, an index out of range would be used as one. */
+    if (h->round < 0 || h->shots < 0) CORRUPT("round %d, %lld shots", (int)h->round, (long long)h->shots);
+    const char *const ch = "rgb";
+    for (int k = 0; k < 3; k++) {
+        /* escaped = shot - won: a closed scene's is a rounding error either way of 0 */
+        double tol = 1e-6 * fmax(m->emitted[k], 1e-12 * rad_sum3(m->emitted));
+        if (!isfinite(h->absorbed[k]) || h->absorbed[k] < 0)
+            CORRUPT("absorbed power %c %g", ch[k], h->absorbed[k]);
+        if (!isfinite(h->escaped[k]) || h->escaped[k] < -tol)
+            CORRUPT("escaped power %c %g", ch[k], h->escaped[k]);
+    }
     uint64_t np, ne;
     memcpy(&np, b + CK_HEAD_BYTES, 8);
     if (np != m->npieces) CORRUPT("%llu patches for %zu pieces", (unsigned long long)np, m->npieces);
     size_t at_ne = CK_HEAD_BYTES + 8 + (size_t)np * sizeof(rad_patch_result);
     if (n < at_ne + 8) CORRUPT("%zu bytes, shorter than its %llu patches", n, (unsigned long long)np);
     memcpy(&ne, b + at_ne, 8);
-    if (ne > (n - at_ne - 8) / sizeof(rad_elem_result) || n != at_ne + 8 + (size_t)ne * sizeof(rad_elem_result))
+    if (ne > (n - at_ne - 16) / sizeof(rad_elem_result) ||
+        n != at_ne + 8 + (size_t)ne * sizeof(rad_elem_result) + 8)
         CORRUPT("%zu bytes for %llu elements", n, (unsigned long long)ne);
+    /* Patches: one per piece, in piece order (as collected). */
+    double unshot[3] = {0, 0, 0};
+    int64_t nshots = 0;
     for (uint64_t i = 0; i < np; i++) {
         rad_patch_result r;
         memcpy(&r, b + CK_HEAD_BYTES + 8 + i * sizeof r, sizeof r);
         if (r.piece != (int64_t)i) CORRUPT("patch %llu: piece %lld", (unsigned long long)i, (long long)r.piece);
+        if (r.nshots < 0 || r.nshots > h->shots - nshots)
+            CORRUPT("patch %llu: %lld shots", (unsigned long long)i, (long long)r.nshots);
+        nshots += r.nshots;
+        for (int k = 0; k < 3; k++) {
+            if (!isfinite(r.unshot[k]) || r.unshot[k] < 0)
+                CORRUPT("patch %llu: unshot power %c %g", (unsigned long long)i, ch[k], r.unshot[k]);
+            unshot[k] += r.unshot[k];
+        }
     }
+    if (nshots != h->shots)
+        CORRUPT("the patches' shots sum to %lld, not %lld", (long long)nshots, (long long)h->shots);
+    /* The ledger as the run left it: emitted = absorbed + unshot + escaped. */
+    for (int k = 0; k < 3; k++) {
+        double scale = fmax(m->emitted[k], 1e-300 + 1e-12 * rad_sum3(m->emitted));
+        double off = fabs(m->emitted[k] - (h->absorbed[k] + unshot[k] + h->escaped[k])) / scale;
+        if (!(off <= 1e-6)) CORRUPT("energy ledger off by %.3g in %c", off, ch[k]);
+    }
+    /* Elements: leaves of this run's grid, sorted by piece, level, gi, gj, each once. */
+    int max_level = h->subdivide > 0 ? h->max_level : 0;
+    rad_elem_result prev;
+    memset(&prev, 0, sizeof prev);
     for (uint64_t i = 0; i < ne; i++) {
         rad_elem_result r;
         memcpy(&r, b + at_ne + 8 + i * sizeof r, sizeof r);
         if (r.piece < 0 || (uint64_t)r.piece >= np)
             CORRUPT("element %llu: piece %lld", (unsigned long long)i, (long long)r.piece);
+        const rad_piece *pc = &m->pieces[r.piece];
+        int lo[2], hi[2];
+        rad_piece_grid(pc, lo, hi);
+        if (r.poly != pc->poly || r.level < 0 || r.level > max_level)
+            CORRUPT("element %llu: polygon %d, level %d", (unsigned long long)i, (int)r.poly, (int)r.level);
+        int64_t sc = (int64_t)1 << r.level;
+        if (r.gi < lo[0] * sc || r.gi >= (hi[0] + 1) * sc || r.gj < lo[1] * sc || r.gj >= (hi[1] + 1) * sc)
+            CORRUPT("element %llu: grid square %d %d off its piece", (unsigned long long)i, (int)r.gi, (int)r.gj);
+        if (i > 0 && cmp_elem(&prev, &r) >= 0)
+            CORRUPT("element %llu out of order", (unsigned long long)i);
+        if (!isfinite(r.area) || r.area <= 0 || r.area > pc->area * (1 + 1e-9))
+            CORRUPT("element %llu: area %g", (unsigned long long)i, r.area);
+        for (int k = 0; k < 3; k++)
+            if (!isfinite(r.B[k]) || r.B[k] < 0 || !isfinite(r.incident[k]) || r.incident[k] < 0)
+                CORRUPT("element %llu: radiosity %c %g, incident power %g", (unsigned long long)i, ch[k],
+                        r.B[k], r.incident[k]);
+        prev = r;
     }
+    uint64_t sum;
+    memcpy(&sum, b + n - 8, 8);
+    if (sum != fnv(FNV_BASIS, b, n - 8)) CORRUPT("checksum mismatch");
 #undef CORRUPT
     return VW_OK;
 }
@@ -593,7 +657,7 @@ vw_status rad_solver_write_checkpoint(const rad_solver *s, const char *path, cha
 {
     if (!vw_world_is_output(s->w)) return VW_OK;
     size_t len = CK_HEAD_BYTES + 8 + s->npatches * sizeof(rad_patch_result) + 8 +
-                 s->nelems * sizeof(rad_elem_result);
+                 s->nelems * sizeof(rad_elem_result) + 8;
     unsigned char *buf = malloc(len), *p = buf;
     if (!buf) return VW_E_NOMEM;
     ck_head h;
@@ -606,6 +670,8 @@ vw_status rad_solver_write_checkpoint(const rad_solver *s, const char *path, cha
     PUT(s->patches, s->npatches * sizeof(rad_patch_result));
     PUT(&ne, 8);
     PUT(s->elems, s->nelems * sizeof(rad_elem_result));
+    uint64_t sum = fnv(FNV_BASIS, buf, len - 8);
+    PUT(&sum, 8);
 #undef PUT
     vw_status st = rad_write_atomic(path, buf, len, err, errlen);
     free(buf);

@@ -12,6 +12,8 @@
 #include <sys/resource.h>
 #include <unistd.h>
 
+/* Every double goes through num(): JSON has no NaN nor infinity, and one "nan" makes
+   the whole file unreadable (the 0 stands for "not measured"). */
 static double num(double x) { return isfinite(x) ? x : 0.0; }
 
 static void json_string(FILE *f, const char *s)
@@ -74,13 +76,13 @@ static void write_body(vw_world *w, FILE *f, const char *command, const char *ex
     fprintf(f, "  \"time_s\": {");
     double total = 0;
     for (int i = 0; i < w->nphases; i++) {
-        fprintf(f, "\"%s\": %.6f, ", w->phase_name[i], w->time_phase[i]);
-        if (strcmp(w->phase_name[i], "total") != 0) total += w->time_phase[i];
+        fprintf(f, "\"%s\": %.6f, ", w->phase_name[i], num(w->time_phase[i]));
+        if (strcmp(w->phase_name[i], "total") != 0) total += num(w->time_phase[i]);
     }
     int has_total = 0;
     for (int i = 0; i < w->nphases; i++) has_total |= strcmp(w->phase_name[i], "total") == 0;
     if (!has_total)
-        fprintf(f, "\"total\": %.6f", total);
+        fprintf(f, "\"total\": %.6f", num(total));
     else
         fprintf(f, "\"phases\": %d", w->nphases);
     fprintf(f, "},\n");
@@ -112,8 +114,8 @@ static void write_body(vw_world *w, FILE *f, const char *command, const char *ex
         vw_cell_stats cs;
         vw_world_cell_stats(w, c, &cs);
         fprintf(f, "    {\"id\": %d, \"box\": [[%.9g,%.9g,%.9g],[%.9g,%.9g,%.9g]], \"worker\": %d, \"objects\": %zu, \"messages_in\": %llu, \"busy_s\": %.6f, \"load\": %.6g",
-                c, b.lo[0], b.lo[1], b.lo[2], b.hi[0], b.hi[1], b.hi[2], cs.worker, cs.objects,
-                (unsigned long long)cs.messages_in, cs.busy_s, num(cs.load));
+                c, num(b.lo[0]), num(b.lo[1]), num(b.lo[2]), num(b.hi[0]), num(b.hi[1]), num(b.hi[2]),
+                cs.worker, cs.objects, (unsigned long long)cs.messages_in, num(cs.busy_s), num(cs.load));
         for (int k = 0; k < w->m->ncounters; k++) {
             fprintf(f, ", ");
             json_string(f, w->m->counters[k]);
@@ -126,9 +128,9 @@ static void write_body(vw_world *w, FILE *f, const char *command, const char *ex
             fprintf(f, ", \"replicas\": [");
             for (int r = 0; r < cl->nreps; r++)
                 fprintf(f, "%s{\"worker\": %d, \"busy_s\": %.6f, \"messages_in\": %llu}", r ? ", " : "",
-                        cl->reps[r].worker, cl->reps[r].busy_s,
+                        cl->reps[r].worker, num(cl->reps[r].busy_s),
                         (unsigned long long)cl->reps[r].messages_in);
-            fprintf(f, "], \"master_busy_s\": %.6f", cl->busy_s);
+            fprintf(f, "], \"master_busy_s\": %.6f", num(cl->busy_s));
         }
         fprintf(f, "}%s\n", c + 1 < w->ncells ? "," : "");
     }
@@ -138,7 +140,7 @@ static void write_body(vw_world *w, FILE *f, const char *command, const char *ex
         const vw__worker_stats *ws = &w->wstats[g];
         uint64_t rss = vw__worker_process(w, g) == w->rank || !ws->peak_rss ? rss_here : ws->peak_rss;
         fprintf(f, "    {\"id\": %d, \"process\": %d, \"busy_s\": %.6f, \"peak_rss_bytes\": %llu, \"messages\": %llu, \"bytes\": %llu, \"remote_count\": %llu, \"remote_bytes\": %llu",
-                g, vw__worker_process(w, g), vw_world_worker_busy(w, g), (unsigned long long)rss,
+                g, vw__worker_process(w, g), num(vw_world_worker_busy(w, g)), (unsigned long long)rss,
                 (unsigned long long)ws->msgs_sent, (unsigned long long)ws->bytes_sent,
                 (unsigned long long)ws->msgs_remote, (unsigned long long)ws->bytes_remote);
         /* The module's counters of the units (cells, copies) on this worker: what each
@@ -168,7 +170,7 @@ static void write_body(vw_world *w, FILE *f, const char *command, const char *ex
             if (p != w->rank && w->wstats[g].peak_rss > rss) rss = w->wstats[g].peak_rss;
         }
         fprintf(f, "    {\"id\": %d, \"workers\": %d, \"busy_s\": %.6f, \"messages\": %llu, \"bytes\": %llu, \"remote_count\": %llu, \"remote_bytes\": %llu, \"peak_rss_bytes\": %llu}%s\n",
-                p, w->nworkers, busy, (unsigned long long)pm, (unsigned long long)pb,
+                p, w->nworkers, num(busy), (unsigned long long)pm, (unsigned long long)pb,
                 (unsigned long long)prm, (unsigned long long)prb, (unsigned long long)rss,
                 p + 1 < w->nprocs ? "," : "");
     }

@@ -100,6 +100,28 @@ done
 "$V" radiosity "$T/cornell.nff" $small --sf 0.005 --per-round 3 --resume "$T/k2" --csv "$T/k2.csv" \
   || fail "resume with another --sf and --per-round"
 
+# A damaged checkpoint is refused (status 2, no output), naming what is wrong: it used
+# to be resumed, and a NaN went through the solve into the CSV and the stats JSON.
+# Offsets (solve.c, format 2): absorbed[0] at 36, the patches from 140 (40 bytes each,
+# unshot[0] at +16), the last element's B[0] 80 - 32 + 8 bytes before the end.
+poke() { printf "$3" | dd of="$1" bs=1 seek="$2" conv=notrunc 2>/dev/null; }
+nan='\000\000\000\000\000\000\370\177' one='\000\000\000\000\000\000\360\077'
+size=$(wc -c <"$T/k2")
+for bad in "36:$nan:absorbed power r nan" "356:$nan:patch 5: unshot power r nan" \
+           "$((size * 9 / 10)):\377\377\377\377\377\377\377\377:" \
+           "$((size - 56)):$one:checksum mismatch" "truncate::bytes for"; do
+  off=${bad%%:*} rest=${bad#*:}; bytes=${rest%%:*} want=${rest#*:}
+  if [ "$off" = truncate ]; then head -c $((size - 1)) "$T/k2" >"$T/kbad"
+  else cp "$T/k2" "$T/kbad" && poke "$T/kbad" "$off" "$bytes"; fi
+  rm -f "$T/kbad.csv" "$T/kbad.json"
+  "$V" radiosity "$T/cornell.nff" $small --resume "$T/kbad" --csv "$T/kbad.csv" --stats "$T/kbad.json" \
+    2>"$T/err"; rc=$?
+  [ $rc -eq 2 ] || fail "checkpoint damaged at $off: exit $rc"
+  grep -q "kbad: truncated or corrupt checkpoint (.*$want" "$T/err" \
+    || fail "checkpoint damaged at $off: message: $(cat "$T/err")"
+  [ ! -e "$T/kbad.csv" ] && [ ! -e "$T/kbad.json" ] || fail "checkpoint damaged at $off: output written"
+done
+
 # Without --cells: one cell for one worker, at least 4 a worker for more; fewer cells
 # than workers given: a warning (radiosity cells cannot be shared).
 layout() { sed -n 's/.*"layout": "\([0-9x]*\)".*/\1/p' "$1" | head -n 1; }

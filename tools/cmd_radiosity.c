@@ -39,7 +39,8 @@ static void help(void)
            "  --max-shots N        stop after about N shots (not converged)\n"
            "  --csv FILE           per polygon: id, area, reflectance, emission, radiosity (the\n"
            "                       values used: reflectance clamped to [0, 1], with a warning)\n"
-           "  --image FILE.png     picture from the scene's camera (or --view)\n"
+           "  --image FILE         picture from the scene's camera (or --view): .png (tone\n"
+           "                       mapped) or .pfm (float: radiosity, not tone mapped)\n"
            "  --view F,A[,FOV]     camera: from x,y,z, at x,y,z, vertical angle (degrees,\n"
            "                       0.001-179, default 45); +y up (+z for a vertical view)\n"
            "  --size WxH           picture size (default: the camera's, or 512x512)\n"
@@ -267,6 +268,11 @@ int vw_cmd_radiosity(int argc, char **argv)
     }
     if (!r.out && !r.csv && !r.image && !r.stats && !o.checkpoint) {
         vw_cli_error(CMD, "no output: give -o OUT.ply (or --csv, --image, --stats)");
+        return VW_EXIT_USAGE;
+    }
+    /* Before the solve: a picture that cannot be written would be found only after it. */
+    if (r.image && rad_image_format(r.image) < 0) {
+        vw_cli_error(CMD, "--image %s: the picture must end in .png or .pfm", r.image);
         return VW_EXIT_USAGE;
     }
     vw_camera cam_view;

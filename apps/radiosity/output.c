@@ -1,6 +1,7 @@
 /* output.c - what the radiosity solver writes: a vertex-coloured PLY, a per-polygon CSV
- * and a PNG from a camera (its own small z-buffer rasteriser of the elements, Gouraud
- * shaded). Every file is written atomically: a temporary file in the same directory,
+ * and a picture from a camera (its own small z-buffer rasteriser of the elements,
+ * Gouraud shaded), as PNG or as PFM (the same picture in linear radiosity, not tone
+ * mapped). Every file is written atomically: a temporary file in the same directory,
  * renamed over the target only once complete.
  *
  * Display colours: radiosity plus the ambient term of progressive refinement (the
@@ -16,6 +17,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 #include <unistd.h>
 
 #include "vwalls/image.h"
@@ -200,7 +202,9 @@ static void fix_t_junctions(const rad_mesh *m, const rad_elem_result *e, size_t 
     }
 }
 
-static int shade(const rad_mesh *m, const rad_elem_result *e, size_t n, const double amb[3], shaded *out)
+/* linear: col holds the display radiosity itself (for PFM); else tone-mapped 0..1. */
+static int shade(const rad_mesh *m, const rad_elem_result *e, size_t n, const double amb[3], int linear,
+                 shaded *out)
 {
     memset(out, 0, sizeof *out);
     out->n = n;
@@ -287,7 +291,7 @@ static int shade(const rad_mesh *m, const rad_elem_result *e, size_t n, const do
     for (size_t sl = 0; sl < ns; sl++)
         for (int k = 0; k < 3; k++) {
             double x = fmin(fmax(lin[sl][k] * expo, 0), 1);
-            out->col[sl][k] = (float)pow(x, 1 / 2.2);
+            out->col[sl][k] = linear ? (float)lin[sl][k] : (float)pow(x, 1 / 2.2);
         }
     free(lin);
     free(keys), free(owner), free(rad);
@@ -302,7 +306,7 @@ vw_status rad_write_ply(const char *path, const rad_mesh *m, const rad_elem_resu
                         const double ambient[3], char *err, size_t errlen)
 {
     shaded sh;
-    if (shade(m, e, n, ambient, &sh)) return VW_E_NOMEM;
+    if (shade(m, e, n, ambient, 0, &sh)) return VW_E_NOMEM;
     sbuf b = {0};
     size_t nv = sh.first[n];
     sb_printf(&b, "ply\nformat ascii 1.0\ncomment vwalls radiosity: %zu elements\n"
@@ -358,17 +362,32 @@ vw_status rad_write_csv(const char *path, const rad_mesh *m, const vw_scene *sc,
 
 /* ---- the image: perspective z-buffer over triangles with Gouraud colour ---- */
 
+int rad_image_format(const char *path)
+{
+    size_t n = strlen(path);
+    if (n >= 4 && !strcasecmp(path + n - 4, ".png")) return RAD_IMAGE_PNG;
+    if (n >= 4 && !strcasecmp(path + n - 4, ".pfm")) return RAD_IMAGE_PFM;
+    return -1;
+}
+
 vw_status rad_write_image(const char *path, const vw_camera *cam, const rad_mesh *m,
                           const rad_elem_result *e, size_t n, const double ambient[3], char *err,
                           size_t errlen)
 {
     int W = cam->width > 0 ? cam->width : 512, H = cam->height > 0 ? cam->height : 512;
+    int format = rad_image_format(path);
+    if (format < 0) {
+        snprintf(err, errlen, "%s: the picture must end in .png or .pfm", path);
+        return VW_E_INVAL;
+    }
+    int pfm = format == RAD_IMAGE_PFM;
     shaded sh;
-    if (shade(m, e, n, ambient, &sh)) return VW_E_NOMEM;
+    if (shade(m, e, n, ambient, pfm, &sh)) return VW_E_NOMEM;
     float *zb = malloc(sizeof(float) * (size_t)W * (size_t)H);
-    uint8_t *img = calloc((size_t)W * (size_t)H * 3, 1);
-    if (!zb || !img) {
-        free(zb), free(img), shaded_free(&sh);
+    uint8_t *img = pfm ? NULL : calloc((size_t)W * (size_t)H * 3, 1);
+    float *fimg = pfm ? calloc((size_t)W * (size_t)H * 3, sizeof(float)) : NULL;
+    if (!zb || (!img && !fimg)) {
+        free(zb), free(img), free(fimg), shaded_free(&sh);
         return VW_E_NOMEM;
     }
     for (size_t i = 0; i < (size_t)W * (size_t)H; i++) zb[i] = INFINITY;
@@ -431,12 +450,14 @@ vw_status rad_write_image(const char *path, const vw_camera *cam, const rad_mesh
                     for (int ch = 0; ch < 3; ch++) {
                         double v = (w0 * Q[a][3 + ch] * iz[a] + w1 * Q[b][3 + ch] * iz[b] +
                                     w2 * Q[c][3 + ch] * iz[c]) / izp;
-                        img[3 * pix + (size_t)ch] = (uint8_t)lround(255 * fmin(fmax(v, 0), 1));
+                        if (pfm) fimg[3 * pix + (size_t)ch] = (float)v;
+                        else img[3 * pix + (size_t)ch] = (uint8_t)lround(255 * fmin(fmax(v, 0), 1));
                     }
                 }
         }
     }
-    vw_status st = vw_image_write_png(path, W, H, img, err, errlen);
-    free(zb), free(img), shaded_free(&sh);
+    vw_status st = pfm ? vw_image_write_pfm(path, W, H, fimg, err, errlen)
+                       : vw_image_write_png(path, W, H, img, err, errlen);
+    free(zb), free(img), free(fimg), shaded_free(&sh);
     return st;
 }

@@ -62,6 +62,16 @@ awk -F, '$1 == 0 && $3 == 1 && $4 == 1 && $5 == 1 { ok = 1 } END { exit !ok }' "
 [ "$(grep -c "reflectance" "$T/err")" = 1 ] &&
   grep -q "kd5.nff:12: warning: reflectance 5 5 5 of polygon (id 0) is outside \[0, 1\], clamped (5 polygons in all)" \
     "$T/err" || fail "Kd 5: warning: $(cat "$T/err")"
+# --image: .pfm is a float map (header, then 16x16 RGB floats), any other name but .png
+# is refused before the solve (.jpg used to get PNG bytes).
+"$V" radiosity "$T/cornell.nff" --image "$T/v.pfm" --size 16x16 --max-shots 4 --quiet 2>"$T/err" \
+  || fail "--image .pfm: $(cat "$T/err")"
+[ "$(head -c 14 "$T/v.pfm" | tr '\n' ' ')" = "PF 16 16 -1.0 " ] && [ "$(wc -c <"$T/v.pfm")" -eq $((14 + 16 * 16 * 12)) ] \
+  || fail "--image .pfm: not a 16x16 PFM: $(head -c 15 "$T/v.pfm" | od -c | head -n 2)"
+"$V" radiosity "$T/cornell.nff" --image "$T/v.jpg" -o "$T/v.ply" --max-shots 4 --quiet 2>"$T/err"; rc=$?
+[ $rc -eq 2 ] || fail "--image .jpg: exit $rc"
+grep -q "image .*v.jpg: the picture must end in .png or .pfm" "$T/err" || fail "--image .jpg: message: $(cat "$T/err")"
+[ ! -e "$T/v.jpg" ] && [ ! -e "$T/v.ply" ] || fail "--image .jpg: output written"
 # Looking straight down (+y up would be parallel to the view): +z is up instead.
 "$V" radiosity "$T/cornell.nff" --image "$T/v.png" --view 278,540,280,278,0,280,100 \
   --size 16x16 --max-shots 4 --quiet 2>"$T/err" || fail "vertical --view: $(cat "$T/err")"

@@ -46,7 +46,8 @@ static void help(void)
            "  --size WxH           picture size (default: the camera's, or 512x512)\n"
            "  --snapshot-every N   rewrite the outputs every N shots while solving\n"
            "  --stats FILE.json    stats JSON (radiosity: shots, unshot_ratio, energy_error)\n"
-           "  --trace FILE         per round: seconds, shots, unshot ratio (for plots)\n"
+           "  --trace FILE         per round, the state at one moment: seconds, shots made,\n"
+           "                       unshot ratio; the last line is the final state (for plots)\n"
            "  --checkpoint FILE    write checkpoints here (atomically)\n"
            "  --checkpoint-every S seconds between checkpoints (default 60; 0: every round;\n"
            "                       under MPI the output process's clock decides for all)\n"
@@ -68,17 +69,29 @@ typedef struct run_ctx {
     double sf, t_start;
     char *trace;          /* --trace: "seconds shots unshot_ratio" per round */
     size_t ntrace, captrace;
+    double t_state;       /* when the last round ended: the moment the next report holds */
+    int64_t traced_shots; /* the shots of the last trace line (-1: none yet) */
     int failed;
 } run_ctx;
 
+/* A trace line: the state at one moment (seconds since the solve began, shots made by
+   then, unshot ratio then). Out of memory, the line is left out. */
+static void trace_line(run_ctx *r, double t, int64_t shots, double ratio)
+{
+    vw_cli_appendf(&r->trace, &r->ntrace, &r->captrace, "%.6f %lld %.9g\n", t - r->t_start,
+                   (long long)shots, ratio);
+    r->traced_shots = shots;
+}
+
+/* After each round, with the state its start reported: the one the round before left,
+   at the time that round ended. */
 static void on_progress(void *user, double ratio, int64_t shots)
 {
     run_ctx *r = user;
     char note[96];
     snprintf(note, sizeof note, "unshot %.2e / sf %.0e, %lld shots", ratio, r->sf, (long long)shots);
-    /* (Out of memory, the line is left out.) */
-    vw_cli_appendf(&r->trace, &r->ntrace, &r->captrace, "%.6f %lld %.9g\n", vw_cli_now() - r->t_start,
-                   (long long)shots, ratio);
+    trace_line(r, r->t_state, shots, ratio);
+    r->t_state = vw_cli_now();
     double frac = ratio <= r->sf ? 1 : ratio >= 1 ? 0 : log(ratio) / log(r->sf);
     vw_progress_update(&r->bar, frac, note);
 }
@@ -348,7 +361,8 @@ int vw_cmd_radiosity(int argc, char **argv)
         goto done;
     }
     double t3 = vw_cli_now();
-    r.t_start = t3;
+    r.t_start = r.t_state = t3;
+    r.traced_shots = -1;
     rad_solver_on_round(s, on_round, &r);
     vw_progress_begin(&r.bar, "radiosity", o.quiet || !vw_world_is_output(rad_solver_world(s)));
     int converged = 0;
@@ -391,6 +405,10 @@ int vw_cmd_radiosity(int argc, char **argv)
         rad_solver_traffic(s, &sm, &sb, &fm);
         size_t ne;
         rad_solver_elements(s, &ne);
+        /* The final state, collected after the last round (unless that round shot
+           nothing, and its report said so already). */
+        if (rad_solver_shots(s) != r.traced_shots)
+            trace_line(&r, r.t_state, rad_solver_shots(s), rad_solver_unshot_ratio(s));
         if (trace && rad_write_atomic(trace, r.trace ? r.trace : "", r.ntrace, err, sizeof err) != VW_OK) {
             vw_cli_error(CMD, "%s", err);
             rc = VW_EXIT_FAIL;

@@ -175,6 +175,10 @@ typedef struct rad_ledger {
 
 typedef struct rad_solver rad_solver;
 
+/* Called on the output process after every round with the state the cells reported at
+   its start, i.e. as the round before left it: the unshot ratio and the shot count of
+   that one moment (the shots of the round just run are in the next call, and in
+   rad_solver_shots()). */
 typedef void (*rad_progress_fn)(void *user, double unshot_ratio, int64_t shots);
 
 /* Creates the world over a mesh (the mesh must outlive the solver). */

@@ -568,7 +568,9 @@ vw_status rad_solver_run(rad_solver *s, rad_progress_fn progress, void *user, in
         rounds++;
         if (vw_world_is_output(s->w)) {
             update_ledger(s);
-            if (progress) progress(user, s->ratio, s->shots);
+            /* The reports describe the start of this round: pair the ratio with the
+               shots made by then, not with the count after the round. */
+            if (progress) progress(user, s->ratio, s->base_shots + s->rep.nshots);
         }
         /* On every process: the hook may collect, which is a run everybody joins. */
         if (s->on_round) s->on_round(s->on_round_user, s, s->round);

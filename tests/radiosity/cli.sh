@@ -140,6 +140,15 @@ layout() { sed -n 's/.*"layout": "\([0-9x]*\)".*/\1/p' "$1" | head -n 1; }
 # --trace: a line "seconds shots unshot_ratio" per round, the last ratio at or below sf.
 awk 'NF != 3 || $2 < 0 { bad = 1 } END { exit bad || NR < 1 || $3 > 0.01 }' "$T/d1.trace" \
   || fail "--trace: $(head -n 3 "$T/d1.trace")"
+# Each --trace line is one moment: stopped by --max-shots, the last line is the state
+# the stats report (it used to pair the shots after a round with the ratio before it:
+# "12 0.0674" against 12 shots and 0.0177), and the first is the start (0 shots).
+"$V" radiosity "$T/cornell.nff" -o "$T/ms.ply" --sf 0.001 --patch-size 200 --per-round 1 --max-shots 5 \
+  --stats "$T/ms.json" --trace "$T/ms.trace" --quiet || fail "--trace with --max-shots"
+final=$(sed -n 's/.*"radiosity": {"shots": \([0-9]*\), "unshot_ratio": \([^,]*\),.*/\1 \2/p' "$T/ms.json")
+awk -v f="$final" 'BEGIN { split(f, s, " ") } NR == 1 && $2 != 0 { bad = 1 } { n = $2; u = $3 }
+  END { exit bad || n != s[1] || (u - s[2]) ^ 2 > (1e-6 * s[2]) ^ 2 }' "$T/ms.trace" \
+  || fail "--trace: last line $(tail -n 1 "$T/ms.trace"), stats: $final"
 [ "$(layout "$T/d1.json")" = 1x1x1 ] || fail "default cells for 1 worker: $(layout "$T/d1.json")"
 "$V" radiosity "$T/cornell.nff" -o "$T/d2.ply" --workers 2 --sf 1e-2 --quiet --stats "$T/d2.json" || fail "default cells, 2 workers"
 [ "$(layout "$T/d2.json")" = 2x2x2 ] || fail "default cells for 2 workers: $(layout "$T/d2.json")"

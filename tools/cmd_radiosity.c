@@ -21,7 +21,8 @@ static void help(void)
            "patch of largest unshot power; a shot travels from cell to cell as a hemicube\n"
            "coverage bitmap, front to back from the shooter, never as geometry.\n"
            "Emission comes from MTL 'Ke' (NFF: '#vw Ke r g b' after an 'f'), reflectance\n"
-           "from 'Kd' (NFF: colour * Kd).\n"
+           "from 'Kd' (NFF: colour * Kd). At least one output: -o, --csv, --image, --stats,\n"
+           "--trace or --checkpoint.\n"
            "  -o FILE.ply          vertex-coloured mesh of the solution\n"
            "  --cells L            layout of cells, like 2x2x2 (default: 1 on one worker, else\n"
            "                       at least 4 cells a worker: 2x2x2 for 2 workers)\n"
@@ -279,8 +280,10 @@ int vw_cmd_radiosity(int argc, char **argv)
         vw_cli_error(CMD, "no scene given (try --help)");
         return VW_EXIT_USAGE;
     }
-    if (!r.out && !r.csv && !r.image && !r.stats && !o.checkpoint) {
-        vw_cli_error(CMD, "no output: give -o OUT.ply (or --csv, --image, --stats)");
+    /* Every file the user can ask for is an output, and the message names them all. */
+    if (!r.out && !r.csv && !r.image && !r.stats && !trace && !o.checkpoint) {
+        vw_cli_error(CMD, "no output: give -o OUT.ply, --csv F, --image F, --stats F, --trace F "
+                     "or --checkpoint F");
         return VW_EXIT_USAGE;
     }
     /* Before the solve: a picture that cannot be written would be found only after it. */

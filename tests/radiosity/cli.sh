@@ -140,6 +140,15 @@ layout() { sed -n 's/.*"layout": "\([0-9x]*\)".*/\1/p' "$1" | head -n 1; }
 # --trace: a line "seconds shots unshot_ratio" per round, the last ratio at or below sf.
 awk 'NF != 3 || $2 < 0 { bad = 1 } END { exit bad || NR < 1 || $3 > 0.01 }' "$T/d1.trace" \
   || fail "--trace: $(head -n 3 "$T/d1.trace")"
+# No output asked for: the message names every output option; --trace alone, like
+# --checkpoint alone, is an output (it used to be refused as "no output").
+"$V" radiosity "$T/cornell.nff" --max-shots 4 2>"$T/err"; rc=$?
+[ $rc -eq 2 ] || fail "no output: exit $rc"
+grep -q "no output: give -o OUT.ply, --csv F, --image F, --stats F, --trace F or --checkpoint F" "$T/err" \
+  || fail "no output: message: $(cat "$T/err")"
+"$V" radiosity "$T/cornell.nff" --trace "$T/only.trace" --max-shots 4 --quiet 2>"$T/err" \
+  || fail "--trace alone: $(cat "$T/err")"
+[ -s "$T/only.trace" ] || fail "--trace alone: no trace"
 # Each --trace line is one moment: stopped by --max-shots, the last line is the state
 # the stats report (it used to pair the shots after a round with the ratio before it:
 # "12 0.0674" against 12 shots and 0.0177), and the first is the start (0 shots).

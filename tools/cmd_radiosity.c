@@ -2,10 +2,14 @@
  * OBJ+MTL or NFF scene, writing a vertex-coloured PLY, a per-polygon CSV, a PNG, stats
  * and checkpoints (apps/radiosity does the work; this file is options and files).
  */
+#define _POSIX_C_SOURCE 200809L
+#include <errno.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include "cli.h"
 #include "commands.h"
@@ -130,6 +134,32 @@ static void on_round(void *user, rad_solver *s, int round)
         return;
     }
     if (vw_world_is_output(rad_solver_world(s)) && write_outputs(r, s)) r->failed = 1;
+}
+
+/* Can a file be made at path: its directory exists and may be written into, and path
+   is not a directory? 0, or -1 with the reason in err. Checked before the solve, so
+   that a result is not computed for minutes and then lost; the writes at the end still
+   report their own errors (a full disk, a directory removed meanwhile). */
+static int check_writable(const char *opt, const char *path, char *err, size_t errlen)
+{
+    struct stat st;
+    if (stat(path, &st) == 0 && S_ISDIR(st.st_mode)) {
+        snprintf(err, errlen, "%s %s: cannot write: it is a directory", opt, path);
+        return -1;
+    }
+    const char *slash = strrchr(path, '/');
+    char *dir = slash ? strndup(path, slash == path ? 1 : (size_t)(slash - path)) : strdup(".");
+    if (!dir) {
+        snprintf(err, errlen, "out of memory");
+        return -1;
+    }
+    int bad = 0;
+    if (stat(dir, &st) != 0) bad = errno;
+    else if (!S_ISDIR(st.st_mode)) bad = ENOTDIR;
+    else if (access(dir, W_OK | X_OK) != 0) bad = errno;
+    if (bad) snprintf(err, errlen, "%s %s: cannot write: %s: %s", opt, path, dir, strerror(bad));
+    free(dir);
+    return bad ? -1 : 0;
 }
 
 /* x as a JSON number, or null: JSON has no NaN nor infinity, and "nan" makes the whole
@@ -294,6 +324,19 @@ int vw_cmd_radiosity(int argc, char **argv)
     vw_camera cam_view;
     memset(&cam_view, 0, sizeof cam_view);
     if (view && parse_view(view, &cam_view)) return VW_EXIT_USAGE;
+    {
+        /* Only the output process writes; all stop if it cannot. */
+        const char *opts[] = {"-o", "--csv", "--image", "--stats", "--trace", "--checkpoint"};
+        const char *paths[] = {r.out, r.csv, r.image, r.stats, trace, o.checkpoint};
+        char werr[1024] = "";
+        vw_status wst = VW_OK;
+        for (int k = 0; k < 6 && wst == VW_OK && vw_cli_is_output(); k++)
+            if (paths[k] && check_writable(opts[k], paths[k], werr, sizeof werr)) wst = VW_E_IO;
+        if (vw_engine_agree(wst, werr, sizeof werr) != VW_OK) {
+            if (vw_cli_is_output()) vw_cli_error(CMD, "%s", werr);
+            return VW_EXIT_FAIL;
+        }
+    }
 
     /* A radiosity cell cannot be shared by workers (a shot's bitmaps depend on the order
        of the cells, so its messages are not independent): a worker without a cell has

@@ -140,6 +140,17 @@ layout() { sed -n 's/.*"layout": "\([0-9x]*\)".*/\1/p' "$1" | head -n 1; }
 # --trace: a line "seconds shots unshot_ratio" per round, the last ratio at or below sf.
 awk 'NF != 3 || $2 < 0 { bad = 1 } END { exit bad || NR < 1 || $3 > 0.01 }' "$T/d1.trace" \
   || fail "--trace: $(head -n 3 "$T/d1.trace")"
+# An output that cannot be written is found before any work (it used to be found after
+# the whole solve, with the outputs before it written): status 1, nothing written, and
+# before the scene is even read.
+"$V" radiosity "$T/cornell.nff" -o "$T/w.ply" --csv "$T/nodir/w.csv" --max-shots 4 --quiet 2>"$T/err"; rc=$?
+[ $rc -eq 1 ] || fail "--csv in a missing directory: exit $rc"
+grep -q -- "--csv .*nodir/w.csv: cannot write: .*nodir: No such file or directory" "$T/err" \
+  || fail "--csv in a missing directory: message: $(cat "$T/err")"
+[ ! -e "$T/w.ply" ] || fail "--csv in a missing directory: the PLY was written"
+"$V" radiosity "$T/missing.obj" --stats "$T" 2>"$T/err"; rc=$?
+[ $rc -eq 1 ] && grep -q -- "--stats .*: cannot write: it is a directory" "$T/err" \
+  || fail "--stats DIR: exit $rc, $(cat "$T/err")"
 # No output asked for: the message names every output option; --trace alone, like
 # --checkpoint alone, is an output (it used to be refused as "no output").
 "$V" radiosity "$T/cornell.nff" --max-shots 4 2>"$T/err"; rc=$?

@@ -346,7 +346,7 @@ static vw_status read_checkpoint(rad_solver *s, unsigned char **buf, size_t *len
     /* Every number is checked before any is used: a NaN or a negative power would go
        through the solve unnoticed (NaN compares false with every bound) into the
        outputs, an index out of range would be used as one. */
-    if (h->round < 0 || h->shots < 0) CORRUPT("round %d, %lld shots", (int)h->round, (long long)h->shots);
+    if (h->round < 0 || h->round > INT32_MAX / 2 || h->shots < 0) CORRUPT("round %d, %lld shots", (int)h->round, (long long)h->shots);
     const char *const ch = "rgb";
     for (int k = 0; k < 3; k++) {
         /* escaped = shot - won: a closed scene's is a rounding error either way of 0 */

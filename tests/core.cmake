@@ -19,6 +19,22 @@ add_test(NAME core_storm_split COMMAND test_storm 4 --stress)
 set_tests_properties(core_storm_split PROPERTIES ENVIRONMENT "VW_STRESS_SPLIT=1")
 set_tests_properties(core_storm core_storm_stress core_storm_split PROPERTIES LABELS "core;threads")
 
+# A module's mistakes get a message: a failed create says why (vw_world_errmsg(NULL)),
+# a post of a kind without handle is refused, a bad send or count stops the process
+# naming it.
+vw_core_test(test_misuse)
+add_test(NAME core_misuse_create COMMAND test_misuse create)
+add_test(NAME core_misuse_post COMMAND test_misuse post)
+set_tests_properties(core_misuse_create core_misuse_post PROPERTIES LABELS "core")
+foreach(case "send;sent message kind 1 to cell 0, but the kind has no handle"
+             "output;sent message kind 0 to the output, but the kind has no output handler"
+             "count;counted into counter 5 of 1")
+  list(GET case 0 m)
+  list(GET case 1 want)
+  add_test(NAME core_misuse_${m} COMMAND test_misuse ${m} ${want})
+  set_tests_properties(core_misuse_${m} PROPERTIES LABELS "core")
+endforeach()
+
 # The example module equals the O(n^2) count for every layout and worker count.
 foreach(layout 1 2x4 2x2x2 4x4x4)
   foreach(workers 1 2 4)

@@ -68,7 +68,8 @@ typedef struct vw_module {
     int ncounters;
 
     /* Build the local state of a cell from its objects (in the order they were added).
-       Runs once per cell at commit, on the worker that hosts the cell. */
+       Runs once per cell at commit, on the worker that hosts the cell. Optional: without
+       it every callback gets state NULL. */
     vw_status (*cell_build)(vw_ctx *ctx, const void *objects, size_t nobjects, void **state);
     void (*cell_free)(void *state, void *user);
     /* Optional: local work that needs no message (generate primary rays, shoot a patch).
@@ -109,7 +110,10 @@ VW_API int vw_ctx_replicas(const vw_ctx *ctx);
    batch numbers. */
 VW_API uint64_t vw_ctx_next_batch(vw_ctx *ctx, uint64_t nbatches);
 
-/* Sending. A message is copied when sent; the caller keeps its buffer.
+/* Sending. A message is copied when sent; the caller keeps its buffer. A send that
+   cannot be meant is a bug in the module and stops the process with a message on
+   stderr: an unknown cell or kind, a kind without handle sent to a cell, a kind without
+   output handler sent to the output; so is an unknown counter given to vw_count.
    Messages are batched per destination into packets, flushed when full or when the
    worker has nothing else to do. To a duplicated cell, a message of an independent kind
    goes to the master or one of its copies in turn (round-robin per sending worker),

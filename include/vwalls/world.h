@@ -64,15 +64,22 @@ VW_API void vw_config_init(vw_config *c);
 VW_API vw_status vw_world_create(const vw_module *m, void *user, const vw_decomp *d,
                                  const vw_config *c, vw_world **out);
 VW_API void vw_world_free(vw_world *w);
-/* The first error's message, with detail (sqlite3_errmsg style). */
+/* The first error's message, with detail (sqlite3_errmsg style). With w NULL: why this
+   thread's last vw_world_create failed (which leaves no world to ask), e.g. "processes
+   were given different worker counts (1 to 2)". */
 VW_API const char *vw_world_errmsg(const vw_world *w);
 
-/* Objects get global ids in the order added (0, 1, ...). */
+/* Objects get global ids in the order added (0, 1, ...); no callback is told the id, so
+   a module that needs it keeps it in its object record. An object whose bounds meet no
+   cell (outside the world box) is held by no cell: that is how a removed object keeps
+   its id (the dynamic scenes do so), and vw_world_cells_of_object reports 0 for it. */
 VW_API vw_status vw_world_add_objects(vw_world *w, const void *objects, size_t n);
 /* Build every cell (cell_build on the hosting worker). */
 VW_API vw_status vw_world_commit(vw_world *w);
 /* A message delivered to `cell` at the start of the next run. */
 VW_API vw_status vw_world_post(vw_world *w, int cell, int kind, const void *msg);
+/* Runs every cell to quiescence (no message in flight, every step() idle); commits
+   first when objects or the decomposition changed since the last commit. */
 VW_API vw_status vw_world_run(vw_world *w);
 
 /* Replace the decomposition (and optionally the mapping) between runs: objects are
@@ -139,7 +146,7 @@ VW_API double vw_world_time(const vw_world *w, const char *phase);
 VW_API void vw_world_set_balance_info(vw_world *w, const char *strategy, double imbalance_before,
                                       double imbalance_after, uint64_t migrated_objects);
 
-/* Stats JSON of DESIGN.md section 9, written atomically by the output process only.
+/* The stats JSON (docs/runtime.md, Statistics), written atomically by the output process only.
    extra_json: more top-level members ("\"rays\": {...}") or NULL. */
 VW_API vw_status vw_world_write_stats(vw_world *w, const char *path, const char *command,
                                       const char *extra_json);

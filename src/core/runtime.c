@@ -409,6 +409,8 @@ void vw_send_cell(vw_ctx *ctx, int cell, int kind, const void *msg)
         fprintf(stderr, "vwalls: module '%s' sent to cell %d of %d\n", w->m->name, cell, w->ncells);
         abort();
     }
+    if (kind >= 0 && kind < w->m->nkinds && !w->m->kinds[kind].handle)
+        misuse(ctx, "sent message kind %d to cell %d, but the kind has no handle", kind, cell);
     int dest = w->cell_worker[cell];
     const vw__cell *c = &w->cells[cell];
     if (c->nreps && kind >= 0 && kind < w->m->nkinds &&
@@ -455,13 +457,17 @@ int vw_send_neighbours(vw_ctx *ctx, int kind, const void *msg)
 
 void vw_send_output(vw_ctx *ctx, int kind, const void *msg)
 {
+    const vw_module *m = ctx->w->m;
+    if (kind >= 0 && kind < m->nkinds && !m->kinds[kind].output)
+        misuse(ctx, "sent message kind %d to the output, but the kind has no output handler", kind, 0);
     enqueue(ctx, ctx->w->gworkers, VW__OUTPUT, -1, kind, msg);
 }
 
 void vw_count(vw_ctx *ctx, int idx, int64_t n)
 {
-    if (idx >= 0 && idx < ctx->w->m->ncounters && ctx->cell >= 0)
-        unit_counters(ctx->w, ctx->cell, ctx->rep)[idx] += n;
+    if ((unsigned)idx >= (unsigned)ctx->w->m->ncounters)
+        misuse(ctx, "counted into counter %d of %d", idx, ctx->w->m->ncounters);
+    if (ctx->cell >= 0) unit_counters(ctx->w, ctx->cell, ctx->rep)[idx] += n;
 }
 
 /* ---- the worker loop ---------------------------------------------------------------- */

@@ -28,9 +28,23 @@ vw_status vw__world_error(vw_world *w, vw_status st, const char *fmt, ...)
     return st;
 }
 
+/* Why this thread's last vw_world_create failed: there is no world to hold it, so
+   vw_world_errmsg(NULL) returns it (sqlite3_errmsg(NULL) style). */
+static _Thread_local char create_err[512];
+
+static vw_status create_failed(vw_status st, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+static vw_status create_failed(vw_status st, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(create_err, sizeof create_err, fmt, ap);
+    va_end(ap);
+    return st;
+}
+
 const char *vw_world_errmsg(const vw_world *w)
 {
-    if (!w) return "no world";
+    if (!w) return create_err[0] ? create_err : "no world";
     return w->err == VW_OK ? "no error" : w->errmsg;
 }
 
@@ -173,15 +187,26 @@ static vw_status copy_speeds(vw_world *w)
 vw_status vw_world_create(const vw_module *m, void *user, const vw_decomp *d, const vw_config *c,
                           vw_world **out)
 {
-    if (!out) return VW_E_INVAL;
+    create_err[0] = 0;
+    if (!out) return create_failed(VW_E_INVAL, "vw_world_create: out is NULL");
     *out = NULL;
-    if (!m || !d || m->abi != VW_MODULE_ABI || m->nkinds < 0 || m->nkinds > VW_MAX_KINDS ||
-        m->ncounters < 0 || m->ncounters > VW_MAX_COUNTERS || (m->object_size && !m->object_bounds))
-        return VW_E_INVAL;
+    if (!m || !d) return create_failed(VW_E_INVAL, "vw_world_create: no %s", m ? "decomposition" : "module");
+    if (m->abi != VW_MODULE_ABI)
+        return create_failed(VW_E_INVAL, "module '%s': abi %d, the library's is %d (set .abi = "
+                             "VW_MODULE_ABI and rebuild)", m->name ? m->name : "?", m->abi, VW_MODULE_ABI);
+    if (m->nkinds < 0 || m->nkinds > VW_MAX_KINDS || m->ncounters < 0 || m->ncounters > VW_MAX_COUNTERS)
+        return create_failed(VW_E_INVAL, "module '%s': %d message kinds and %d counters (at most %d "
+                             "and %d)", m->name ? m->name : "?", m->nkinds, m->ncounters, VW_MAX_KINDS,
+                             VW_MAX_COUNTERS);
+    if (m->object_size && !m->object_bounds)
+        return create_failed(VW_E_INVAL, "module '%s': objects without object_bounds",
+                             m->name ? m->name : "?");
     for (int k = 0; k < m->nkinds; k++)
-        if (m->kinds[k].size > VW_MAX_MSG_BYTES) return VW_E_INVAL;
+        if (m->kinds[k].size > VW_MAX_MSG_BYTES)
+            return create_failed(VW_E_INVAL, "module '%s': message kind %d is %zu bytes (at most %d)",
+                                 m->name ? m->name : "?", k, m->kinds[k].size, (int)VW_MAX_MSG_BYTES);
     vw_world *w = calloc(1, sizeof *w);
-    if (!w) return VW_E_NOMEM;
+    if (!w) return create_failed(VW_E_NOMEM, "vw_world_create: out of memory");
     w->m = m;
     w->user = user;
     if (c)
@@ -193,6 +218,7 @@ vw_status vw_world_create(const vw_module *m, void *user, const vw_decomp *d, co
     w->nprocs = 1;
     w->nworkers = w->cfg.workers > 0 ? w->cfg.workers : default_workers();
     if (w->nworkers > 1024) {
+        create_failed(VW_E_LIMIT, "vw_world_create: %d workers (at most 1024)", w->nworkers);
         free(w);
         return VW_E_LIMIT;
     }
@@ -232,6 +258,7 @@ vw_status vw_world_create(const vw_module *m, void *user, const vw_decomp *d, co
     if (st == VW_OK) st = copy_speeds(w);
     if (st == VW_OK) st = map_cells(w, c ? c->cell_worker : NULL);
     if (st != VW_OK) {
+        create_failed(st, "%s", w->err != VW_OK ? w->errmsg : vw_status_message(st));
         vw_world_free(w);
         return st;
     }
@@ -392,9 +419,12 @@ static uint64_t fnv1a(uint64_t h, const void *p, size_t n)
 }
 
 /* What every process of a world must have been given alike, hashed: the walls (cell
-   boxes and frame), the mapping, the copies of duplicated cells and the number of
-   objects. A process given another scene or layout would otherwise send its rays to
-   cells the others do not expect, and show only as an abort on a malformed packet. */
+   boxes and frame), the mapping, the copies of duplicated cells, the number of objects
+   and their bounds. A process given another scene or layout would otherwise send its
+   rays to cells the others do not expect, and show only as an abort on a malformed
+   packet, or compute with other objects in its cells and give a wrong answer without a
+   word (a scene file that differs between hosts). The bounds, not the records: a
+   record's padding bytes may differ where its values do not. */
 static uint64_t world_fingerprint(const vw_world *w)
 {
     uint64_t h = 0xcbf29ce484222325ull;
@@ -414,7 +444,13 @@ static uint64_t world_fingerprint(const vw_world *w)
     const double *F = vw_decomp_frame(w->decomp);
     if (F) h = fnv1a(h, F, 9 * sizeof *F);
     uint64_t n = w->nobjects;
-    return fnv1a(h, &n, sizeof n);
+    h = fnv1a(h, &n, sizeof n);
+    for (size_t i = 0; i < w->nobjects; i++) {
+        vw_box b;
+        w->m->object_bounds(w->objects + i * w->m->object_size, &b, w->user);
+        h = fnv1a(h, &b, sizeof b);
+    }
+    return h;
 }
 
 vw_status vw_world_commit(vw_world *w)
@@ -425,8 +461,9 @@ vw_status vw_world_commit(vw_world *w)
         if (r >= 0)
             return vw__world_error(w, VW_E_STATE,
                                    "process %d was given another world than process 0 (walls, "
-                                   "mapping, copies, speeds or number of objects differ): every process "
-                                   "must run the same command on the same input", r);
+                                   "mapping, copies, speeds, number of objects or their bounds "
+                                   "differ): every process must run the same command on the same "
+                                   "input", r);
     }
     vw_status st = vw__runtime_build(w);
     char msg[512] = "";
@@ -443,6 +480,9 @@ vw_status vw_world_post(vw_world *w, int cell, int kind, const void *msg)
 {
     if (!w || !msg || cell < 0 || cell >= w->ncells || kind < 0 || kind >= w->m->nkinds)
         return VW_E_INVAL;
+    if (!w->m->kinds[kind].handle)
+        return vw__world_error(w, VW_E_INVAL, "posted message kind %d to cell %d, but the kind "
+                               "has no handle", kind, cell);
     int dest = w->cell_worker[cell];
     if (vw__worker_process(w, dest) != w->rank) return VW_OK; /* its own process posts it */
     size_t size = w->m->kinds[kind].size;

@@ -181,16 +181,28 @@ static void test_agree(int bad)
     CHECK_EQ_INT(vw_engine_agree(VW_OK, NULL, 0), VW_OK);
 }
 
+static void point_bounds(const void *o, vw_box *b, void *user)
+{
+    (void)user;
+    const double *p = o;
+    for (int a = 0; a < 3; a++) b->lo[a] = b->hi[a] = p[a];
+}
+
 /* A world given differently to one process (the last) fails to commit on every process,
    with a message naming it, instead of running on and meeting packets it cannot read:
-   other walls, another mapping, other copies, or other worker speeds (the copies'
-   shares: every process must agree on who makes which batch). The same world commits. */
+   other walls, another mapping, other copies, other worker speeds (the copies'
+   shares: every process must agree on who makes which batch), or other objects (a
+   scene file that differs between hosts: the answer would be wrong without a word).
+   The same world commits. */
 static void test_mismatch(int workers)
 {
     int rank = vw_engine_rank(), size = vw_engine_size(), bad = size - 1;
     vw_box box = {{0, 0, 0}, {1, 1, 1}};
-    static const char *const what_name[] = {"same", "walls", "mapping", "copies", "speeds"};
-    for (int what = 0; what < 5; what++) {
+    static const char *const what_name[] = {"same", "walls", "mapping", "copies", "speeds", "objects"};
+    vw_module with_objects = storm_module;
+    with_objects.object_size = 3 * sizeof(double);
+    with_objects.object_bounds = point_bounds;
+    for (int what = 0; what < 6; what++) {
         int differs = what > 0 && rank == bad && size > 1;
         int dims[3] = {2, 2, differs && what == 1 ? 1 : 2};
         vw_decomp *d;
@@ -208,8 +220,14 @@ static void test_mismatch(int workers)
         for (int g = 0; g < gw; g++) speeds[g] = differs && what == 4 && g == 0 ? 3.0 : 1.0;
         cfg.worker_speeds = speeds;
         vw_world *w;
-        CHECK_EQ_INT(vw_world_create(&storm_module, &st, d, &cfg, &w), VW_OK);
+        CHECK_EQ_INT(vw_world_create(what == 0 || what == 5 ? &with_objects : &storm_module, &st, d,
+                                     &cfg, &w), VW_OK);
         free(speeds); /* the world keeps its own copy */
+        if (what == 0 || what == 5) {
+            double pts[3][3] = {{0.1, 0.2, 0.3}, {0.6, 0.6, 0.6}, {0.9, 0.1, 0.5}};
+            if (differs) pts[2][1] = 0.15; /* one point elsewhere in the same cell */
+            CHECK_EQ_INT(vw_world_add_objects(w, pts, 3), VW_OK);
+        }
         if ((differs && what == 3) || (what == 4 && gw > 1)) {
             int other = (map[0] + 1) % gw;
             CHECK_EQ_INT(vw_world_set_replicas(w, 0, &other, 1), VW_OK);

@@ -1,0 +1,140 @@
+/* test_misuse.c - a module's mistakes get a message, never silence:
+ *   create   a world that cannot be created says why through vw_world_errmsg(NULL)
+ *   post     posting a kind without handle is VW_E_INVAL with a message
+ *   send | output | count   a module's bad send or count stops the process (abort)
+ *            with a message on stderr: run in a child, whose end and stderr are checked
+ * Usage: test_misuse MODE [EXPECTED-MESSAGE]
+ */
+#include <signal.h>
+#include <stdio.h>
+#include <string.h>
+#include <sys/wait.h>
+#include <unistd.h>
+#include "vw_test.h"
+#include "vwalls/vwalls.h"
+
+typedef struct obj {
+    double p[3];
+} obj;
+
+static void bounds(const void *o, vw_box *b, void *user)
+{
+    (void)user;
+    const obj *x = o;
+    for (int a = 0; a < 3; a++) b->lo[a] = b->hi[a] = x->p[a];
+}
+
+static void handle(vw_ctx *ctx, void *state, const void *msg)
+{
+    (void)ctx, (void)state, (void)msg;
+}
+
+static void output(void *user, const void *msg)
+{
+    (void)user, (void)msg;
+}
+
+static const char *mode;
+
+/* The mistake of the mode, once, from cell 0. */
+static int step(vw_ctx *ctx, void *state)
+{
+    int *done = state;
+    if (*done || vw_ctx_cell(ctx) != 0) return 0;
+    *done = 1;
+    int x = 0;
+    if (!strcmp(mode, "send")) vw_send_cell(ctx, 0, 1, &x);   /* kind 1: output only */
+    if (!strcmp(mode, "output")) vw_send_output(ctx, 0, &x);  /* kind 0: no output */
+    if (!strcmp(mode, "count")) vw_count(ctx, 5, 1);          /* one counter */
+    return 1;
+}
+
+static vw_status build(vw_ctx *ctx, const void *objects, size_t n, void **state)
+{
+    (void)ctx, (void)objects, (void)n;
+    static int done[64];
+    *state = &done[vw_ctx_cell(ctx)];
+    return VW_OK;
+}
+
+static const vw_msg_kind kinds[] = {
+    {.name = "to_cell", .size = sizeof(int), .handle = handle},
+    {.name = "to_output", .size = sizeof(int), .output = output},
+};
+static const char *const counters[] = {"one"};
+
+static vw_module module(void)
+{
+    vw_module m = {.abi = VW_MODULE_ABI, .name = "misuse", .object_size = sizeof(obj),
+                   .object_bounds = bounds, .kinds = kinds, .nkinds = 2, .counters = counters,
+                   .ncounters = 1, .cell_build = build, .step = step};
+    return m;
+}
+
+int main(int argc, char **argv)
+{
+    mode = argc > 1 ? argv[1] : "create";
+    vw_box world = {{0, 0, 0}, {1, 1, 1}};
+    int dims[3] = {2, 1, 1};
+    vw_decomp *d;
+    CHECK(vw_decomp_create_grid(&world, dims, &d) == VW_OK);
+    vw_module m = module();
+    vw_config cfg;
+    vw_config_init(&cfg);
+    cfg.workers = 2;
+    vw_world *w = NULL;
+    if (!strcmp(mode, "create")) {
+        vw_module bad = m;
+        bad.abi = VW_MODULE_ABI + 1;
+        CHECK(vw_world_create(&bad, NULL, d, &cfg, &w) == VW_E_INVAL && !w);
+        printf("abi: %s\n", vw_world_errmsg(NULL));
+        CHECK(strstr(vw_world_errmsg(NULL), "abi") != NULL);
+        cfg.workers = 5000;
+        CHECK(vw_world_create(&m, NULL, d, &cfg, &w) == VW_E_LIMIT && !w);
+        printf("workers: %s\n", vw_world_errmsg(NULL));
+        CHECK(strstr(vw_world_errmsg(NULL), "5000 workers") != NULL);
+        cfg.workers = 2;
+        CHECK(vw_world_create(&m, NULL, d, &cfg, &w) == VW_OK);
+        CHECK(!strcmp(vw_world_errmsg(NULL), "no world")); /* a success clears it */
+    } else {
+        CHECK(vw_world_create(&m, NULL, d, &cfg, &w) == VW_OK);
+        obj o[2] = {{{0.25, 0.5, 0.5}}, {{0.75, 0.5, 0.5}}};
+        CHECK(vw_world_add_objects(w, o, 2) == VW_OK);
+        if (!strcmp(mode, "post")) {
+            int x = 0;
+            CHECK(vw_world_post(w, 1, 1, &x) == VW_E_INVAL);
+            printf("post: %s\n", vw_world_errmsg(w));
+            CHECK(strstr(vw_world_errmsg(w), "has no handle") != NULL);
+        } else {
+            /* The child makes the mistake with its stderr into a pipe. */
+            int fd[2];
+            CHECK(pipe(fd) == 0);
+            fflush(NULL);
+            pid_t pid = fork();
+            CHECK(pid >= 0);
+            if (pid == 0) {
+                dup2(fd[1], 2);
+                close(fd[0]);
+                vw_world_run(w); /* the mistake stops the process in here */
+                fprintf(stderr, "the mistake went unnoticed\n");
+                _exit(0);
+            }
+            close(fd[1]);
+            char err[1024];
+            size_t n = 0;
+            ssize_t k;
+            while (n < sizeof err - 1 && (k = read(fd[0], err + n, sizeof err - 1 - n)) > 0) n += (size_t)k;
+            err[n] = 0;
+            close(fd[0]);
+            int status;
+            CHECK(waitpid(pid, &status, 0) == pid);
+            printf("%s: %s", mode, err);
+            CHECK(WIFSIGNALED(status) && WTERMSIG(status) == SIGABRT);
+            CHECK(argc > 2 && strstr(err, argv[2]) != NULL);
+        }
+    }
+    vw_world_free(w);
+    vw_decomp_free(d);
+    printf("misuse %s ok\n", mode);
+    return vw_test_failures ? 1 : 0;
+}

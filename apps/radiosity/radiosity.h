@@ -1,4 +1,4 @@
-/* radiosity.h - the distributed progressive radiosity solver (DESIGN.md section 7), as an
+/* radiosity.h - the distributed progressive radiosity solver (docs/radiosity.md), as an
  * application of the public vwalls API: meshing, the vwalls module, the solve loop, the
  * hemicube and the outputs. Every name here is rad_*; nothing outside apps/ and tools/
  * uses it.

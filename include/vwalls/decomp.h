@@ -81,8 +81,10 @@ VW_API void vw_decomp_to_frame(const vw_decomp *d, const double p[3], double out
 /* Bounds in frame coordinates of a world-coordinate box (conservative under rotation). */
 VW_API void vw_decomp_box_to_frame(const vw_decomp *d, const vw_box *b, vw_box *out);
 
-/* The cell holding world point p; dir decides points on walls (may be NULL).
-   -1 when p lies outside the world box. */
+/* The cell holding world point p; dir decides points on walls (may be NULL): a point
+   on a wall goes to the side dir points to, and to the upper side when dir is NULL or
+   parallel to the wall. The world box is closed: a point on its upper face belongs to
+   the last cell along that axis. -1 when p lies outside the world box. */
 VW_API int vw_decomp_locate(const vw_decomp *d, const double p[3], const double dir[3]);
 
 typedef struct vw_segment {

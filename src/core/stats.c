@@ -1,4 +1,4 @@
-/* stats.c - the stats JSON of DESIGN.md section 9 (a contract: tests, benchmarks and
+/* stats.c - the stats JSON of docs/runtime.md, Statistics (a contract: tests, benchmarks and
  * pictures read it). Written by the output process to a temporary name and renamed,
  * so a reader never sees half a file.
  */

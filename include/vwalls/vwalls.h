@@ -4,6 +4,7 @@
  * common.h (status, boxes), decomp.h (cells and walls), module.h (writing a module),
  * world.h (the runtime), engine.h (MPI set-up and agreement between processes),
  * scene.h, image.h and gen.h (reading and generating scenes, writing images),
+ * outfile.h (writing any output file complete or not at all),
  * dynamic.h (moving objects between cells, collision and swept tests, the edit language),
  * balance.h (load balancing by walls, frames, cell shape, division) and map.h (cells
  * onto workers and processes).
@@ -18,6 +19,7 @@
 #include "vwalls/engine.h"
 #include "vwalls/scene.h"
 #include "vwalls/image.h"
+#include "vwalls/outfile.h"
 #include "vwalls/gen.h"
 #include "vwalls/dynamic.h"
 #include "vwalls/balance.h"

@@ -146,8 +146,10 @@ VW_API double vw_world_time(const vw_world *w, const char *phase);
 VW_API void vw_world_set_balance_info(vw_world *w, const char *strategy, double imbalance_before,
                                       double imbalance_after, uint64_t migrated_objects);
 
-/* The stats JSON (docs/runtime.md, Statistics), written atomically by the output process only.
-   extra_json: more top-level members ("\"rays\": {...}") or NULL. */
+/* The stats JSON (docs/runtime.md, Statistics), written by the output process only,
+   through vw_outfile (vwalls/outfile.h: complete or absent). extra_json: more
+   top-level members ("\"rays\": {...}") or NULL. On failure vw_world_errmsg() says
+   "path: reason". */
 VW_API vw_status vw_world_write_stats(vw_world *w, const char *path, const char *command,
                                       const char *extra_json);
 

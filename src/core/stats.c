@@ -1,16 +1,15 @@
 /* stats.c - the stats JSON of docs/runtime.md, Statistics (a contract: tests, benchmarks and
- * pictures read it). Written by the output process to a temporary name and renamed,
- * so a reader never sees half a file.
+ * pictures read it). Written by the output process through vw_outfile (a temporary
+ * name, renamed), so a reader never sees half a file.
  */
 #include "core/world_internal.h"
+#include "vwalls/outfile.h"
 
-#include <errno.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/resource.h>
-#include <unistd.h>
 
 /* Every double goes through num(): JSON has no NaN nor infinity, and one "nan" makes
    the whole file unreadable (the 0 stands for "not measured"). */
@@ -182,25 +181,13 @@ vw_status vw_world_write_stats(vw_world *w, const char *path, const char *comman
 {
     if (!w || !path) return VW_E_INVAL;
     if (w->rank != 0) return VW_OK;
-    size_t n = strlen(path) + 32;
-    char *tmp = malloc(n);
-    if (!tmp) return VW_E_NOMEM;
-    snprintf(tmp, n, "%s.tmp.%ld", path, (long)getpid());
-    FILE *f = fopen(tmp, "w");
-    if (!f) {
-        vw__world_error(w, VW_E_IO, "%s: cannot write: %s", path, strerror(errno));
-        free(tmp);
-        return VW_E_IO;
+    char err[512];
+    vw_outfile *of;
+    vw_status st = vw_outfile_open(path, &of, err, sizeof err);
+    if (st == VW_OK) {
+        write_body(w, vw_outfile_stream(of), command, extra_json);
+        st = vw_outfile_commit(of, err, sizeof err);
     }
-    write_body(w, f, command, extra_json);
-    int bad = ferror(f);
-    bad |= fclose(f) != 0;
-    if (bad || rename(tmp, path) != 0) {
-        vw__world_error(w, VW_E_IO, "%s: cannot write: %s", path, strerror(errno));
-        remove(tmp);
-        free(tmp);
-        return VW_E_IO;
-    }
-    free(tmp);
+    if (st != VW_OK) return vw__world_error(w, st, "%s", err);
     return VW_OK;
 }

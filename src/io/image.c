@@ -1,7 +1,7 @@
 /* src/io/image.c - PNG (libpng) and PFM image writers, and a PNG reader for tests.
  *
- * Both writers go through the atomic file helper, so an image is either complete
- * under its name or absent. libpng reports errors by longjmp; the handlers here
+ * Both writers go through vw_outfile (vwalls/outfile.h), so an image is either
+ * complete under its name or absent. libpng reports errors by longjmp; the handlers here
  * record the message so it can be returned as "path: message".
  */
 #include <errno.h>
@@ -13,6 +13,7 @@
 
 #include "io/io_internal.h"
 #include "vwalls/image.h"
+#include "vwalls/outfile.h"
 
 /* Large enough for any real render, small enough that w*h*3 cannot overflow. */
 #define MAX_SIDE (1 << 20)
@@ -211,19 +212,21 @@ VW_API vw_status vw_image_write_png_threads(const char *path, int w, int h, cons
         vw__errf(err, errlen, "%s: out of memory compressing the image", path);
         return VW_E_NOMEM;
     }
-    vw__atomic_file af;
-    vw_status st = vw__atomic_open(&af, path, err, errlen);
+    vw_outfile *of = NULL;
+    vw_status st = vw_outfile_open(path, &of, err, errlen);
     png_ctx ctx = {""};
-    int ok = st == VW_OK && encode_png(af.f, w, h, b, nb, adler, &ctx);
+    int ok = st == VW_OK && encode_png(vw_outfile_stream(of), w, h, b, nb, adler, &ctx);
     for (int i = 0; i < nb; i++) free(b[i].out);
     free(b);
     if (st != VW_OK) return st;
-    if (!ok) {
-        vw__atomic_abort(&af);
+    /* A failed write of the stream is the commit's to report, with its reason. */
+    if (!ok && !ferror(vw_outfile_stream(of))) {
+        vw_outfile_abort(of);
         vw__errf(err, errlen, "%s: PNG write failed: %s", path, ctx.msg);
         return VW_E_IO;
     }
-    return vw__atomic_commit(&af, err, errlen);
+    st = vw_outfile_commit(of, err, errlen);
+    return st == VW_OK && !ok ? VW_E_IO : st;
 }
 
 VW_API vw_status vw_image_write_png(const char *path, int w, int h, const uint8_t *rgb8,
@@ -237,15 +240,16 @@ VW_API vw_status vw_image_write_pfm(const char *path, int w, int h, const float 
 {
     if (!check_size(path, w, h, rgb, err, errlen))
         return VW_E_INVAL;
-    vw__atomic_file af;
-    vw_status st = vw__atomic_open(&af, path, err, errlen);
+    vw_outfile *of;
+    vw_status st = vw_outfile_open(path, &of, err, errlen);
     if (st != VW_OK)
         return st;
-    fprintf(af.f, "PF\n%d %d\n-1.0\n", w, h);
+    FILE *f = vw_outfile_stream(of);
+    fprintf(f, "PF\n%d %d\n-1.0\n", w, h);
     size_t rowlen = (size_t)w * 3;
     unsigned char *row = malloc(rowlen * 4);
     if (!row) {
-        vw__atomic_abort(&af);
+        vw_outfile_abort(of);
         vw__errf(err, errlen, "%s: out of memory", path);
         return VW_E_NOMEM;
     }
@@ -260,11 +264,11 @@ VW_API vw_status vw_image_write_pfm(const char *path, int w, int h, const float 
             row[4 * i + 2] = (unsigned char)((u >> 16) & 0xff);
             row[4 * i + 3] = (unsigned char)(u >> 24);
         }
-        if (fwrite(row, 4, rowlen, af.f) != rowlen)
+        if (fwrite(row, 4, rowlen, f) != rowlen)
             break;
     }
     free(row);
-    return vw__atomic_commit(&af, err, errlen);
+    return vw_outfile_commit(of, err, errlen);
 }
 
 static int decode_png(FILE *f, int *w, int *h, uint8_t **out, png_ctx *ctx)

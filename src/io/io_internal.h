@@ -1,8 +1,8 @@
 /* src/io/io_internal.h - helpers shared by the scene readers, writers and generators.
  *
  * Not installed. Everything here has a vw__ name and hidden visibility: the scene
- * builder that every reader and generator fills, error formatting, and the atomic
- * file writer that keeps failed writes from leaving partial files behind.
+ * builder that every reader and generator fills, error formatting and whole-file
+ * reading. (Output files are written by vw_outfile, vwalls/outfile.h.)
  */
 #ifndef VW_IO_INTERNAL_H
 #define VW_IO_INTERNAL_H
@@ -71,19 +71,6 @@ vw_status vw__sb_polygon_corner(vw__sb *b, int vertex, const double *normal);
 vw_status vw__sb_polygon_end(vw__sb *b, int material, int has_normals);
 /* Convenience: a polygon from its own fresh vertices (no normals). */
 vw_status vw__sb_add_polygon(vw__sb *b, int material, int n, const double (*v)[3]);
-
-/* Atomic output: write to "path.tmp.XXXXXX" in the same directory, then rename over
-   path on commit. Abort (or a failed commit) removes the temporary file, so a failed
-   write never leaves a partial file under either name. */
-typedef struct vw__atomic_file {
-    FILE *f;
-    char *path;
-    char *tmp;
-} vw__atomic_file;
-
-vw_status vw__atomic_open(vw__atomic_file *af, const char *path, char *err, size_t errlen);
-vw_status vw__atomic_commit(vw__atomic_file *af, char *err, size_t errlen);
-void vw__atomic_abort(vw__atomic_file *af);
 
 /* Reads a whole file into a NUL-terminated buffer (the NUL is not counted in *len). */
 vw_status vw__read_whole_file(const char *path, char **text, size_t *len, char *err,

@@ -10,6 +10,7 @@
 #include <string.h>
 
 #include "io/io_internal.h"
+#include "vwalls/outfile.h"
 
 void vw__errf(char *err, size_t errlen, const char *fmt, ...)
 {
@@ -795,16 +796,17 @@ VW_API vw_status vw_scene_write_nff_file(const vw_scene *s, const char *path, ch
         vw__errf(err, errlen, "vw_scene_write_nff_file: NULL argument");
         return VW_E_INVAL;
     }
-    vw__atomic_file af;
-    vw_status st = vw__atomic_open(&af, path, err, errlen);
+    vw_outfile *of;
+    vw_status st = vw_outfile_open(path, &of, err, errlen);
     if (st != VW_OK)
         return st;
-    st = vw_scene_write_nff(s, af.f);
-    if (st != VW_OK) {
-        vw__atomic_abort(&af);
-        vw__errf(err, errlen, "%s: %s", path,
-                 st == VW_E_IO ? "write failed" : "scene is inconsistent");
+    st = vw_scene_write_nff(s, vw_outfile_stream(of));
+    /* A write error is the commit's to report, with its reason ("No space left on
+       device"). */
+    if (st != VW_OK && st != VW_E_IO) {
+        vw_outfile_abort(of);
+        vw__errf(err, errlen, "%s: scene is inconsistent", path);
         return st;
     }
-    return vw__atomic_commit(&af, err, errlen);
+    return vw_outfile_commit(of, err, errlen);
 }

@@ -33,3 +33,9 @@ add_executable(test_io_number ${PROJECT_SOURCE_DIR}/tests/io/test_io_number.c)
 target_include_directories(test_io_number PRIVATE ${PROJECT_SOURCE_DIR}/tests ${PROJECT_SOURCE_DIR}/src)
 target_link_libraries(test_io_number PRIVATE vwalls_static m)
 add_test(NAME io_number COMMAND test_io_number)
+
+# The command's output files (the script says what it checks; a few seconds).
+add_test(NAME io_cli_outputs
+         COMMAND sh ${PROJECT_SOURCE_DIR}/tests/io/cli_outputs.sh $<TARGET_FILE:vwalls_tool>
+                 ${CMAKE_CURRENT_BINARY_DIR}/io_cli_outputs)
+set_tests_properties(io_cli_outputs PROPERTIES TIMEOUT 60)

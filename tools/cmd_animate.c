@@ -37,7 +37,8 @@ struct vw_anim_session {
     double threshold;            /* rebalance when lambda > 1 + threshold */
     int trigger_work;            /* that lambda is the counted work's, not busy time's */
     rt_farm farm;                /* how the workers share the cells (--farm) */
-    FILE *log;                   /* every edit's outcome (output process), or NULL */
+    vw_outfile *logf;            /* --log on the output process, or NULL */
+    FILE *log;                   /* its stream: every edit's outcome */
     vw_edit batch[MAX_BATCH];
     size_t nbatch;
     rt_anim_stats acc;           /* since the last frame */
@@ -456,11 +457,14 @@ int vw_anim_main(const char *cmd, int argc, char **argv)
         rc = VW_EXIT_FAIL;
         goto done;
     }
-    if (log_path && vw_cli_is_output() && !(s->log = fopen(log_path, "w"))) {
-        vw_cli_error(cmd, "cannot write '%s'", log_path);
-        if (in != stdin) fclose(in);
-        rc = VW_EXIT_FAIL;
-        goto done;
+    if (log_path && vw_cli_is_output()) {
+        if (vw_outfile_open(log_path, &s->logf, err, sizeof err) != VW_OK) {
+            vw_cli_error(cmd, "%s", err);
+            if (in != stdin) fclose(in);
+            rc = VW_EXIT_FAIL;
+            goto done;
+        }
+        s->log = vw_outfile_stream(s->logf);
     }
     /* Whole lines, however long (the parser refuses a long command; a long comment is
        fine), so no tail of a line is ever read as a line of its own. */
@@ -503,10 +507,21 @@ int vw_anim_main(const char *cmd, int argc, char **argv)
         }
         free(extra);
     }
+    /* The log is put in place at the end, a failed session's too: it says how far the
+       edits went. */
+    if (s->logf) {
+        vw_status lst = vw_outfile_commit(s->logf, err, sizeof err);
+        s->logf = NULL;
+        s->log = NULL;
+        if (lst != VW_OK) {
+            vw_cli_error(cmd, "%s", err);
+            if (!s->failed) s->failed = 1;
+        }
+    }
     /* A bad line is bad input even when the session went on past it (--keep-going, edit). */
     rc = s->failed ? s->failed : s->bad_lines ? VW_EXIT_USAGE : VW_EXIT_OK;
 done:
-    if (s->log) fclose(s->log);
+    vw_outfile_abort(s->logf);
     rt_anim_free(s->anim);
     free(s->frames);
     free(s);

@@ -455,7 +455,7 @@ int vw_cmd_radiosity(int argc, char **argv)
            nothing, and its report said so already). */
         if (rad_solver_shots(s) != r.traced_shots)
             trace_line(&r, r.t_state, rad_solver_shots(s), rad_solver_unshot_ratio(s));
-        if (trace && rad_write_atomic(trace, r.trace ? r.trace : "", r.ntrace, err, sizeof err) != VW_OK) {
+        if (trace && vw_outfile_write(trace, r.trace ? r.trace : "", r.ntrace, err, sizeof err) != VW_OK) {
             vw_cli_error(CMD, "%s", err);
             rc = VW_EXIT_FAIL;
             goto done;

@@ -1,8 +1,8 @@
 /* output.c - what the radiosity solver writes: a vertex-coloured PLY, a per-polygon CSV
  * and a picture from a camera (its own small z-buffer rasteriser of the elements,
  * Gouraud shaded), as PNG or as PFM (the same picture in linear radiosity, not tone
- * mapped). Every file is written atomically: a temporary file in the same directory,
- * renamed over the target only once complete.
+ * mapped). Every file is written through vw_outfile (vwalls/outfile.h): complete under
+ * its name or not at all.
  *
  * Display colours: radiosity plus the ambient term of progressive refinement (the
  * unshot power spread evenly, Cohen et al. 1988) for display only, scaled so that the
@@ -11,41 +11,15 @@
 #include "radiosity/radiosity.h"
 #include "radiosity/vec.h"
 
-#include <errno.h>
 #include <stdarg.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
-#include <unistd.h>
 
 #include "vwalls/image.h"
-
-vw_status rad_write_atomic(const char *path, const void *buf, size_t len, char *err, size_t errlen)
-{
-    size_t n = strlen(path);
-    char *tmp = malloc(n + 16);
-    if (!tmp) return VW_E_NOMEM;
-    snprintf(tmp, n + 16, "%s.tmp.XXXXXX", path);
-    int fd = mkstemp(tmp);
-    if (fd < 0) {
-        snprintf(err, errlen, "%s: cannot write: %s", path, strerror(errno));
-        free(tmp);
-        return VW_E_IO;
-    }
-    FILE *f = fdopen(fd, "wb");
-    int ok = f && fwrite(buf, 1, len, f) == len;
-    ok = (f ? fclose(f) == 0 : (close(fd), 0)) && ok;
-    if (!ok || rename(tmp, path) != 0) {
-        snprintf(err, errlen, "%s: cannot write: %s", path, strerror(errno));
-        unlink(tmp);
-        free(tmp);
-        return VW_E_IO;
-    }
-    free(tmp);
-    return VW_OK;
-}
+#include "vwalls/outfile.h"
 
 /* A growing text buffer. */
 typedef struct sbuf {
@@ -324,7 +298,7 @@ vw_status rad_write_ply(const char *path, const rad_mesh *m, const rad_elem_resu
         sb_printf(&b, "\n");
     }
     shaded_free(&sh);
-    vw_status st = b.oom ? VW_E_NOMEM : rad_write_atomic(path, b.s, b.n, err, errlen);
+    vw_status st = b.oom ? VW_E_NOMEM : vw_outfile_write(path, b.s, b.n, err, errlen);
     free(b.s);
     return st;
 }
@@ -355,7 +329,7 @@ vw_status rad_write_csv(const char *path, const rad_mesh *m, const vw_scene *sc,
         area[pg->id] = 0; /* once per polygon */
     }
     free(area), free(B), free(inc);
-    vw_status st = b.oom ? VW_E_NOMEM : rad_write_atomic(path, b.s, b.n, err, errlen);
+    vw_status st = b.oom ? VW_E_NOMEM : vw_outfile_write(path, b.s, b.n, err, errlen);
     free(b.s);
     return st;
 }

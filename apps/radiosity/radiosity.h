@@ -258,8 +258,5 @@ vw_status rad_write_image(const char *path, const vw_camera *cam, const rad_mesh
                           size_t errlen);
 /* The display-only ambient term of progressive refinement (Cohen et al. 1988). */
 void rad_ambient(const rad_mesh *m, const rad_patch_result *p, size_t np, double out[3]);
-/* Writes buf[0..len) to path atomically (temp file in the same directory + rename). */
-vw_status rad_write_atomic(const char *path, const void *buf, size_t len, char *err,
-                           size_t errlen);
 
 #endif

@@ -675,7 +675,7 @@ vw_status rad_solver_write_checkpoint(const rad_solver *s, const char *path, cha
     uint64_t sum = fnv(FNV_BASIS, buf, len - 8);
     PUT(&sum, 8);
 #undef PUT
-    vw_status st = rad_write_atomic(path, buf, len, err, errlen);
+    vw_status st = vw_outfile_write(path, buf, len, err, errlen);
     free(buf);
     return st;
 }

@@ -1,6 +1,7 @@
 /* vwalls.c - the vwalls command: dispatches to one subcommand per file (cmd_*.c).
  * The same binary runs alone (threads engine) and under mpirun (MPI engine).
  */
+#include <signal.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -39,6 +40,34 @@ static void usage(FILE *f)
     fprintf(f, "\nexit status: 0 success, 2 bad input or usage, 1 any other failure\n");
 }
 
+/* SIGINT, SIGTERM, SIGHUP while an output is being written: its temporary file
+   ("path.tmp.XXXXXX") is removed, then the signal's default action ends the process,
+   so the exit status still says which signal killed it. Only async-signal-safe calls. */
+static void on_fatal_signal(int sig)
+{
+    vw_outfile_remove_temps();
+    signal(sig, SIG_DFL);
+    raise(sig); /* blocked until the handler returns, then it ends the process */
+}
+
+/* A signal the process was started with ignored (nohup, a background job of a
+   script) stays ignored. The three block each other while the handler runs. */
+static void install_signal_handlers(void)
+{
+    static const int sigs[] = {SIGINT, SIGTERM, SIGHUP};
+    enum { N = sizeof sigs / sizeof sigs[0] };
+    struct sigaction sa;
+    memset(&sa, 0, sizeof sa);
+    sa.sa_handler = on_fatal_signal;
+    sigemptyset(&sa.sa_mask);
+    for (int k = 0; k < N; k++) sigaddset(&sa.sa_mask, sigs[k]);
+    for (int k = 0; k < N; k++) {
+        struct sigaction old;
+        if (sigaction(sigs[k], NULL, &old) == 0 && old.sa_handler != SIG_IGN)
+            sigaction(sigs[k], &sa, NULL);
+    }
+}
+
 int main(int argc, char **argv)
 {
     if (argc < 2) {
@@ -56,6 +85,7 @@ int main(int argc, char **argv)
     for (size_t i = 0; i < sizeof commands / sizeof commands[0]; i++)
         if (!strcmp(argv[1], commands[i].name)) {
             vw_cli_engine_init(&argc, &argv);
+            install_signal_handlers();
             int rc = commands[i].run(argc - 1, argv + 1);
             vw_cli_engine_finish();
             return rc;

@@ -3,7 +3,8 @@
 # symbolic link keeps the link and writes the file it leads to; a FIFO or a device node
 # stays what it was (written in place; a full device is status 1, "No space left on
 # device"); gen and radiosity write mode 0644 under umask 022 (radiosity's used to be
-# 0600).
+# 0600); SIGTERM while gen writes a big file leaves no "*.tmp.*" and the status says
+# killed by SIGTERM.
 # Device nodes are made here with mknod (skipped when not permitted); /dev is not touched.
 set -u
 V=$1 T=$2
@@ -60,5 +61,17 @@ for f in m.nff m.ply m.csv m.trace m.ck; do
   m=$(stat -c %a "$f")
   [ "$m" = 644 ] || fail "$f: mode $m under umask 022, expected 644"
 done
+
+# SIGTERM as soon as gen's temporary file appears: gone with the process, which ends
+# by the signal (status 128+15).
+"$V" gen spheres --count 1000000 -o big.nff & pid=$!
+i=0
+while [ $i -lt 1000 ] && ! ls | grep -q '^big\.nff\.tmp\.'; do sleep 0.01; i=$((i + 1)); done
+ls | grep -q '^big\.nff\.tmp\.' || { kill $pid; fail "SIGTERM: no temporary file appeared"; }
+kill -TERM $pid
+wait $pid; rc=$?
+[ $rc -eq 143 ] || fail "SIGTERM: status $rc, expected 143 (killed by SIGTERM)"
+[ ! -e big.nff ] || fail "SIGTERM: big.nff was written"
+no_temps .
 
 echo "cli_outputs: all passed"

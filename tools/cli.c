@@ -157,6 +157,16 @@ const char *vw_cli_value(const char *cmd, int argc, char **argv, int *i)
     return argv[++*i];
 }
 
+const char *vw_cli_output(const char *cmd, int argc, char **argv, int *i)
+{
+    const char *v = vw_cli_value(cmd, argc, argv, i);
+    if (v && !*v) {
+        vw_cli_error(cmd, "%s: empty file name", argv[*i - 1]);
+        return NULL;
+    }
+    return v;
+}
+
 double vw_cli_now(void)
 {
     struct timespec ts;

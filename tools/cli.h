@@ -1,5 +1,5 @@
 /* tools/cli.h - what every vwalls subcommand shares: option values, engine set-up,
- * messages, the progress bar and atomic output files.
+ * messages and the progress bar. (Output files are written by vw_outfile.)
  */
 #ifndef VW_TOOLS_CLI_H
 #define VW_TOOLS_CLI_H
@@ -35,6 +35,10 @@ int vw_cli_frame_pattern(const char *cmd, const char *opt, const char *s);
 
 /* The value after option argv[*i] (advancing *i), or an error and NULL. */
 const char *vw_cli_value(const char *cmd, int argc, char **argv, int *i);
+/* The same for an option naming an output file: an empty name is an error too
+   ("vwalls CMD: -o: empty file name"), caught with the other usage errors instead of
+   when the file is written. */
+const char *vw_cli_output(const char *cmd, int argc, char **argv, int *i);
 
 /* Is this process the one that prints (rank 0, or no MPI)? Valid after vw_cli_engine_init. */
 int vw_cli_is_output(void);

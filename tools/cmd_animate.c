@@ -393,9 +393,9 @@ int vw_anim_main(const char *cmd, int argc, char **argv)
         } else if (!strcmp(a, "--keep-going")) {
             s->keep_going = 1;
         } else if (!strcmp(a, "--log")) {
-            if (!(log_path = vw_cli_value(cmd, argc, argv, &i))) goto done;
+            if (!(log_path = vw_cli_output(cmd, argc, argv, &i))) goto done;
         } else if (!strcmp(a, "--stats")) {
-            if (!(stats = vw_cli_value(cmd, argc, argv, &i))) goto done;
+            if (!(stats = vw_cli_output(cmd, argc, argv, &i))) goto done;
         } else if (!strcmp(a, "--full-rebuild")) {
             p.full_rebuild = 1;
         } else if (!strcmp(a, "--brute-force")) {

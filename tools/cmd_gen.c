@@ -78,7 +78,7 @@ int vw_cmd_gen(int argc, char **argv)
                 vw_cli_size(cmd, a, v, &p.width, &p.height))
                 return VW_EXIT_USAGE;
         } else if (!strcmp(a, "-o")) {
-            if (!(out = vw_cli_value(cmd, argc, argv, &i)))
+            if (!(out = vw_cli_output(cmd, argc, argv, &i)))
                 return VW_EXIT_USAGE;
         } else if (a[0] == '-' && a[1]) {
             vw_cli_error(cmd, "unknown option '%s' (try vwalls gen --help)", a);

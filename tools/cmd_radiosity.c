@@ -208,13 +208,14 @@ int vw_cmd_radiosity(int argc, char **argv)
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i], *v;
 #define VALUE() if (!(v = vw_cli_value(CMD, argc, argv, &i))) return VW_EXIT_USAGE
+#define OUTPUT() if (!(v = vw_cli_output(CMD, argc, argv, &i))) return VW_EXIT_USAGE
         if (!strcmp(a, "--help") || !strcmp(a, "-h")) {
             help();
             return VW_EXIT_OK;
         } else if (!strcmp(a, "--quiet")) {
             o.quiet = 1;
         } else if (!strcmp(a, "-o")) {
-            VALUE();
+            OUTPUT();
             r.out = v;
         } else if (!strcmp(a, "--cells")) {
             VALUE();
@@ -265,10 +266,10 @@ int vw_cmd_radiosity(int argc, char **argv)
             if (vw_cli_int(CMD, a, v, 1, 0x7fffffffL, &lv)) return VW_EXIT_USAGE;
             o.max_rounds = (int)lv;
         } else if (!strcmp(a, "--csv")) {
-            VALUE();
+            OUTPUT();
             r.csv = v;
         } else if (!strcmp(a, "--image")) {
-            VALUE();
+            OUTPUT();
             r.image = v;
         } else if (!strcmp(a, "--view")) {
             VALUE();
@@ -281,13 +282,13 @@ int vw_cmd_radiosity(int argc, char **argv)
             if (vw_cli_int(CMD, a, v, 1, 0x7fffffffL, &lv)) return VW_EXIT_USAGE;
             r.snapshot_every = lv;
         } else if (!strcmp(a, "--stats")) {
-            VALUE();
+            OUTPUT();
             r.stats = v;
         } else if (!strcmp(a, "--trace")) {
-            VALUE();
+            OUTPUT();
             trace = v;
         } else if (!strcmp(a, "--checkpoint")) {
-            VALUE();
+            OUTPUT();
             o.checkpoint = v;
         } else if (!strcmp(a, "--checkpoint-every")) {
             VALUE();
@@ -305,6 +306,7 @@ int vw_cmd_radiosity(int argc, char **argv)
             return VW_EXIT_USAGE;
         }
 #undef VALUE
+#undef OUTPUT
     }
     if (!scene_path) {
         vw_cli_error(CMD, "no scene given (try --help)");

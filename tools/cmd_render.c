@@ -193,7 +193,7 @@ int vw_cmd_render(int argc, char **argv)
         } else if (!strcmp(a, "--quiet") || !strcmp(a, "-q")) {
             quiet = 1;
         } else if (!strcmp(a, "-o") || !strcmp(a, "--output")) {
-            if (!(out = vw_cli_value(CMD, argc, argv, &i))) return VW_EXIT_USAGE;
+            if (!(out = vw_cli_output(CMD, argc, argv, &i))) return VW_EXIT_USAGE;
         } else if (!strcmp(a, "--cells")) {
             if (!(v = vw_cli_value(CMD, argc, argv, &i)) || vw_cli_layout(CMD, a, v, dims))
                 return VW_EXIT_USAGE;
@@ -207,9 +207,9 @@ int vw_cmd_render(int argc, char **argv)
             if (!(v = vw_cli_value(CMD, argc, argv, &i)) || vw_cli_int(CMD, a, v, 1, 64, &depth))
                 return VW_EXIT_USAGE;
         } else if (!strcmp(a, "--stats")) {
-            if (!(stats = vw_cli_value(CMD, argc, argv, &i))) return VW_EXIT_USAGE;
+            if (!(stats = vw_cli_output(CMD, argc, argv, &i))) return VW_EXIT_USAGE;
         } else if (!strcmp(a, "--overlay")) {
-            if (!(overlay = vw_cli_value(CMD, argc, argv, &i))) return VW_EXIT_USAGE;
+            if (!(overlay = vw_cli_output(CMD, argc, argv, &i))) return VW_EXIT_USAGE;
         } else if (!strcmp(a, "--balance")) {
             if (!(v = vw_cli_value(CMD, argc, argv, &i))) return VW_EXIT_USAGE;
             if (vw_balance_strategy_parse(v, &strategy) != VW_OK) {

@@ -37,7 +37,7 @@ int vw_example_opts_parse(const char *cmd, int argc, char **argv, vw_example_opt
             if (!(v = vw_cli_value(cmd, argc, argv, &i)) || vw_cli_layout(cmd, a, v, o->dims))
                 return VW_EXIT_USAGE;
         } else if (!strcmp(a, "--stats")) {
-            if (!(o->stats = vw_cli_value(cmd, argc, argv, &i))) return VW_EXIT_USAGE;
+            if (!(o->stats = vw_cli_output(cmd, argc, argv, &i))) return VW_EXIT_USAGE;
         } else if (a[0] == '-' && a[1]) {
             vw_cli_error(cmd, "unknown option '%s' (try --help)", a);
             return VW_EXIT_USAGE;

@@ -4,7 +4,7 @@
 # stays what it was (written in place; a full device is status 1, "No space left on
 # device"); gen and radiosity write mode 0644 under umask 022 (radiosity's used to be
 # 0600); SIGTERM while gen writes a big file leaves no "*.tmp.*" and the status says
-# killed by SIGTERM.
+# killed by SIGTERM; an empty output name is a usage error (status 2) for every command.
 # Device nodes are made here with mknod (skipped when not permitted); /dev is not touched.
 set -u
 V=$1 T=$2
@@ -74,4 +74,17 @@ wait $pid; rc=$?
 [ ! -e big.nff ] || fail "SIGTERM: big.nff was written"
 no_temps .
 
+# An empty output name: status 2 and "OPTION: empty file name", for every command.
+printf 'frame\n' > edits.txt
+for args in "gen cornell -o" "render m.nff -o" "render m.nff --output" "render m.nff -o x.png --stats" \
+            "render m.nff -o x.png --overlay" "radiosity m.nff -o" "radiosity m.nff --csv" \
+            "radiosity m.nff --image" "radiosity m.nff --stats" "radiosity m.nff -o x.ply --trace" \
+            "radiosity m.nff --checkpoint" "animate m.nff edits.txt -o f%d.png --log" \
+            "animate m.nff edits.txt -o f%d.png --stats" "edit m.nff --log" \
+            "example-pairs --stats" "example-components --stats"; do
+  # shellcheck disable=SC2086
+  "$V" $args "" > out 2> err; rc=$?
+  [ $rc -eq 2 ] || fail "$args '': status $rc, expected 2"
+  grep -q -- "^vwalls [a-z-]*: ${args##* }: empty file name\$" err || fail "$args '': message: $(cat err)"
+done
 echo "cli_outputs: all passed"

@@ -103,6 +103,11 @@ int main(int argc, char **argv)
     CHECK_EQ_INT(run(vw_cmd_gen, (const char *[]){"gen", "spheres", "--size", "2", NULL}), 2);
     CHECK_EQ_INT(run(vw_cmd_gen, (const char *[]){"gen", "balls", "--seed", "3", NULL}), 2);
     CHECK_EQ_INT(run(vw_cmd_gen, (const char *[]){"gen", "tree", "--size", "2", "--seed", "3", NULL}), 0);
+    /* An empty -o is a usage error, not a failed rename. */
+    CHECK_EQ_INT(run(vw_cmd_gen, (const char *[]){"gen", "cornell", "-o", "", NULL}), 2);
+    t = text_of(err_path);
+    CHECK(strcmp(t, "vwalls gen: -o: empty file name\n") == 0);
+    free(t);
 
     /* NFF to stdout equals NFF to -o. */
     CHECK_EQ_INT(run(vw_cmd_gen, (const char *[]){"gen", "balls", "--size", "2", "--resolution",

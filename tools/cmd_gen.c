@@ -26,8 +26,8 @@ static void gen_usage(FILE *f)
             "\noptions:\n"
             "  --size N          size factor or depth of balls, rings, tree (default per scene)\n"
             "  --count N         number of spheres for 'spheres' (default 1000)\n"
-            "  --seed S          random seed of spheres and tree (default 1); the same seed\n"
-            "                    gives the same scene\n"
+            "  --seed S          random seed of spheres and tree, 0 to 2^64-1 in decimal\n"
+            "                    (default 1); the same seed gives the same scene\n"
             "  --cluster F       fraction of spheres in the cluster region, 0..1 (default 0)\n"
             "                    (an option the scene has no use for is an error)\n"
             "  --resolution WxH  camera resolution (default 512x512)\n"
@@ -60,11 +60,14 @@ int vw_cmd_gen(int argc, char **argv)
         } else if (!strcmp(a, "--seed")) {
             if (!(v = vw_cli_value(cmd, argc, argv, &i)))
                 return VW_EXIT_USAGE;
+            /* Decimal digits only: strtoull alone also takes leading blanks, a sign
+               (" -1" wrapped to 2^64-1) and, base 0, hex and octal ("010" was 8). */
             char *end;
             errno = 0;
-            unsigned long long s = strtoull(v, &end, 0);
-            if (!*v || *end || errno || v[0] == '-') {
-                vw_cli_error(cmd, "%s: bad value '%s' (expected a whole number >= 0)", a, v);
+            unsigned long long s = strtoull(v, &end, 10);
+            if (!*v || v[strspn(v, "0123456789")] || errno) {
+                vw_cli_error(cmd, "%s: bad value '%s' (expected a whole number from 0 to "
+                                  "18446744073709551615)", a, v);
                 return VW_EXIT_USAGE;
             }
             p.seed = (uint64_t)s;

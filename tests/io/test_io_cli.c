@@ -103,6 +103,18 @@ int main(int argc, char **argv)
     CHECK_EQ_INT(run(vw_cmd_gen, (const char *[]){"gen", "spheres", "--size", "2", NULL}), 2);
     CHECK_EQ_INT(run(vw_cmd_gen, (const char *[]){"gen", "balls", "--seed", "3", NULL}), 2);
     CHECK_EQ_INT(run(vw_cmd_gen, (const char *[]){"gen", "tree", "--size", "2", "--seed", "3", NULL}), 0);
+    /* --seed: decimal digits only. strtoull took " -1" (a blank, then a sign) as
+       2^64-1 and "0x10" as 16; the whole 64-bit range is accepted. */
+    const char *bad_seeds[] = {" -1", "-1", "+1", " 1", "1 ", "0x10", "", "18446744073709551616"};
+    for (size_t k = 0; k < sizeof bad_seeds / sizeof bad_seeds[0]; k++) {
+        CHECK_EQ_INT(run(vw_cmd_gen, (const char *[]){"gen", "spheres", "--count", "5", "--seed",
+                                                      bad_seeds[k], NULL}), 2);
+        t = text_of(err_path);
+        CHECK(strstr(t, "--seed: bad value") && lines(t) == 1);
+        free(t);
+    }
+    CHECK_EQ_INT(run(vw_cmd_gen, (const char *[]){"gen", "spheres", "--count", "5", "--seed",
+                                                  "18446744073709551615", NULL}), 0);
     /* An empty -o is a usage error, not a failed rename. */
     CHECK_EQ_INT(run(vw_cmd_gen, (const char *[]){"gen", "cornell", "-o", "", NULL}), 2);
     t = text_of(err_path);

@@ -34,8 +34,11 @@ target_include_directories(test_io_number PRIVATE ${PROJECT_SOURCE_DIR}/tests ${
 target_link_libraries(test_io_number PRIVATE vwalls_static m)
 add_test(NAME io_number COMMAND test_io_number)
 
-# The command's output files (the script says what it checks; a few seconds).
-add_test(NAME io_cli_outputs
-         COMMAND sh ${PROJECT_SOURCE_DIR}/tests/io/cli_outputs.sh $<TARGET_FILE:vwalls_tool>
-                 ${CMAKE_CURRENT_BINARY_DIR}/io_cli_outputs)
-set_tests_properties(io_cli_outputs PROPERTIES TIMEOUT 60)
+# The command's output files and its help texts (each script says what it checks; a
+# few seconds).
+foreach(t outputs help)
+  add_test(NAME io_cli_${t}
+           COMMAND sh ${PROJECT_SOURCE_DIR}/tests/io/cli_${t}.sh $<TARGET_FILE:vwalls_tool>
+                   ${CMAKE_CURRENT_BINARY_DIR}/io_cli_${t})
+  set_tests_properties(io_cli_${t} PROPERTIES TIMEOUT 60)
+endforeach()

@@ -313,6 +313,7 @@ static void help(const char *cmd)
            "  --brute-force    decide with the O(n^2) reference instead of the cells\n"
            "  --quiet          no banner, frame lines or summary (animate: no rejections\n"
            "                   either; edit always answers every edit)\n"
+           "  --help           this text\n"
            "Exit status: 0 success, 2 bad input (any bad line; it stops animate unless\n"
            "--keep-going), 1 other.\n");
 }

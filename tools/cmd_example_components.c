@@ -28,7 +28,9 @@ static void help(void)
            "  --workers W    worker threads per process (default: number of cores)\n"
            "  --stats FILE   write the stats JSON (counters under \"components\")\n"
            "  --check        also label sequentially (O(N^2)) and fail if any label differs\n"
-           "  --quiet        print only the number of components\n");
+           "  --quiet        print only the number of components\n"
+           "  --help         this text\n"
+           "\nexit status: 0 success, 2 bad input or usage, 1 any other failure\n");
 }
 
 /* Size of the largest component, from labels (smallest id of each sphere's component). */

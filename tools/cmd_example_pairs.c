@@ -26,7 +26,9 @@ static void help(void)
            "  --workers W    worker threads per process (default: number of cores)\n"
            "  --stats FILE   write the stats JSON\n"
            "  --check        also count by brute force and fail if the counts differ\n"
-           "  --quiet        print only the count\n");
+           "  --quiet        print only the count\n"
+           "  --help         this text\n"
+           "\nexit status: 0 success, 2 bad input or usage, 1 any other failure\n");
 }
 
 int vw_cmd_example_pairs(int argc, char **argv)

@@ -60,7 +60,9 @@ static void help(void)
            "                       --patch-size, --elements, --hemicube, --subdivide, --max-level\n"
            "                       and --neighbourhood as the run that wrote it (--sf may change)\n"
            "  --max-rounds N       stop after N rounds without writing outputs (tests: a kill)\n"
-           "  --quiet              no progress bar and no summary\n",
+           "  --quiet              no progress bar and no summary\n"
+           "  --help               this text\n"
+           "\nexit status: 0 success, 2 bad input or usage, 1 any other failure\n",
            RAD_MAX_RES);
 }
 

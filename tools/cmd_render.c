@@ -68,7 +68,9 @@ static void help(void)
            "                   pixel by the worker that made its eye ray (farmed cells show\n"
            "                   their copies' turns)\n"
            "  --quiet          no progress bar and no summary\n"
-           "Runs under mpirun too; only the first process writes files.\n");
+           "  --help           this text\n"
+           "Runs under mpirun too; only the first process writes files.\n"
+           "\nexit status: 0 success, 2 bad input or usage, 1 any other failure\n");
 }
 
 static int ends_with(const char *s, const char *suf)

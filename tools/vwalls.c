@@ -29,7 +29,10 @@ static const vw_command commands[] = {
 static void usage(FILE *f)
 {
     fprintf(f,
-            "usage: vwalls COMMAND [options]   (vwalls COMMAND --help for its options)\n"
+            "usage: vwalls COMMAND [options]\n"
+            "       vwalls help COMMAND   the command's options (as vwalls COMMAND --help)\n"
+            "       vwalls --help         this text\n"
+            "       vwalls --version      the version\n"
             "\n"
             "Distributed geometric computation with the Virtual Walls method: space is cut\n"
             "into cells by axis-aligned walls; cells compute locally and talk to neighbours.\n"
@@ -68,13 +71,22 @@ static void install_signal_handlers(void)
     }
 }
 
+static const vw_command *find_command(const char *name)
+{
+    for (size_t i = 0; i < sizeof commands / sizeof commands[0]; i++)
+        if (!strcmp(name, commands[i].name)) return &commands[i];
+    fprintf(stderr, "vwalls: unknown command '%s' (try vwalls --help)\n", name);
+    return NULL;
+}
+
 int main(int argc, char **argv)
 {
     if (argc < 2) {
         usage(stderr);
         return VW_EXIT_USAGE;
     }
-    if (!strcmp(argv[1], "--help") || !strcmp(argv[1], "-h") || !strcmp(argv[1], "help")) {
+    if (!strcmp(argv[1], "--help") || !strcmp(argv[1], "-h") ||
+        (!strcmp(argv[1], "help") && argc == 2)) {
         usage(stdout);
         return VW_EXIT_OK;
     }
@@ -82,14 +94,20 @@ int main(int argc, char **argv)
         printf("vwalls %s\n", vw_version());
         return VW_EXIT_OK;
     }
-    for (size_t i = 0; i < sizeof commands / sizeof commands[0]; i++)
-        if (!strcmp(argv[1], commands[i].name)) {
-            vw_cli_engine_init(&argc, &argv);
-            install_signal_handlers();
-            int rc = commands[i].run(argc - 1, argv + 1);
-            vw_cli_engine_finish();
-            return rc;
+    if (!strcmp(argv[1], "help")) { /* vwalls help CMD: vwalls CMD --help */
+        const vw_command *c = argc == 3 ? find_command(argv[2]) : NULL;
+        if (!c) {
+            if (argc != 3) fprintf(stderr, "vwalls help: one command name (try vwalls --help)\n");
+            return VW_EXIT_USAGE;
         }
-    fprintf(stderr, "vwalls: unknown command '%s' (try vwalls --help)\n", argv[1]);
-    return VW_EXIT_USAGE;
+        char *help_argv[] = {argv[2], "--help", NULL};
+        return c->run(2, help_argv);
+    }
+    const vw_command *c = find_command(argv[1]);
+    if (!c) return VW_EXIT_USAGE;
+    vw_cli_engine_init(&argc, &argv);
+    install_signal_handlers();
+    int rc = c->run(argc - 1, argv + 1);
+    vw_cli_engine_finish();
+    return rc;
 }

@@ -154,6 +154,13 @@ const char *vw_cli_value(const char *cmd, int argc, char **argv, int *i)
         vw_cli_error(cmd, "%s needs a value", argv[*i]);
         return NULL;
     }
+    /* "--stats --quiet" forgot the value: writing a file named --quiet would hide it.
+       (A value may start with one '-': a negative number, or "-" for stdout.) */
+    const char *v = argv[*i + 1];
+    if (v[0] == '-' && v[1] == '-' && v[2]) {
+        vw_cli_error(cmd, "%s needs a value, not the option '%s'", argv[*i], v);
+        return NULL;
+    }
     return argv[++*i];
 }
 

@@ -33,7 +33,8 @@ int vw_cli_layout(const char *cmd, const char *opt, const char *s, int dims[3]);
    format. */
 int vw_cli_frame_pattern(const char *cmd, const char *opt, const char *s);
 
-/* The value after option argv[*i] (advancing *i), or an error and NULL. */
+/* The value after option argv[*i] (advancing *i), or an error and NULL: when there is
+   none, or it is an option itself ("--stats --quiet"). */
 const char *vw_cli_value(const char *cmd, int argc, char **argv, int *i);
 /* The same for an option naming an output file: an empty name is an error too
    ("vwalls CMD: -o: empty file name"), caught with the other usage errors instead of

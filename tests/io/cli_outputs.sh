@@ -87,4 +87,10 @@ for args in "gen cornell -o" "render m.nff -o" "render m.nff --output" "render m
   [ $rc -eq 2 ] || fail "$args '': status $rc, expected 2"
   grep -q -- "^vwalls [a-z-]*: ${args##* }: empty file name\$" err || fail "$args '': message: $(cat err)"
 done
+# A forgotten value: the next option is not taken as the file name (it used to write a
+# file named --quiet).
+"$V" example-pairs --stats --quiet > out 2> err; rc=$?
+[ $rc -eq 2 ] || fail "--stats --quiet: status $rc, expected 2"
+grep -q -- "--stats needs a value, not the option '--quiet'" err || fail "--stats --quiet: message: $(cat err)"
+[ ! -e ./--quiet ] || fail "--stats --quiet: a file named --quiet was written"
 echo "cli_outputs: all passed"

@@ -59,6 +59,7 @@ static void help(void)
            "                   auto: all, or idle when --balance or --map is given (even\n"
            "                   none or block: their plan decides which worker runs which\n"
            "                   cell); a process hosting no cell farms them all\n"
+           "                   (but with none, it idles)\n"
            "  --map K          block (default) | greedy (by load) | weighted (by --speeds)\n"
            "  --speeds LIST    relative speed of every worker, like 1,1,2,4: --map weighted\n"
            "                   maps by them, and copies of cells take shares of the work\n"

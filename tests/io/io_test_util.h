@@ -1,5 +1,5 @@
 /* io_test_util.h - helpers for the io tests: bit-exact scene comparison, writing a
- * scene's NFF to a string, reading a test data file.
+ * scene's NFF to a string, reading a test data file, a file size limit.
  */
 #ifndef VW_IO_TEST_UTIL_H
 #define VW_IO_TEST_UTIL_H
@@ -8,7 +8,25 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include <signal.h>
+#include <sys/resource.h>
+
 #include "vwalls/scene.h"
+
+/* Limits the size of the files this process writes to `bytes` (as a full disk would
+   stop a write), with SIGXFSZ ignored so the write fails with EFBIG instead of killing
+   the process; *old gets the limit before, for file_size_restore. 0 on success. */
+static inline int file_size_limit(rlim_t bytes, struct rlimit *old)
+{
+    struct rlimit lim;
+    if (getrlimit(RLIMIT_FSIZE, old) != 0) return -1;
+    lim = *old;
+    lim.rlim_cur = bytes;
+    signal(SIGXFSZ, SIG_IGN);
+    return setrlimit(RLIMIT_FSIZE, &lim);
+}
+
+static inline int file_size_restore(const struct rlimit *old) { return setrlimit(RLIMIT_FSIZE, old); }
 
 /* Bit-exact comparison, field by field (structs may have padding). Prints the first
    difference to stderr. */

@@ -13,6 +13,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "io_test_util.h"
 #include "vw_test.h"
 #include "vwalls/image.h"
 
@@ -155,18 +156,14 @@ int main(void)
     fclose(f);
     int before = count_entries(dir);
     uint8_t *big = noise(256, 256, 7);   /* incompressible: ~200 kB of PNG */
-    struct rlimit old, lim;
-    CHECK(getrlimit(RLIMIT_FSIZE, &old) == 0);
-    lim = old;
-    lim.rlim_cur = 4096;
-    signal(SIGXFSZ, SIG_IGN);
-    CHECK(setrlimit(RLIMIT_FSIZE, &lim) == 0);
+    struct rlimit old;
+    CHECK(file_size_limit(4096, &old) == 0);
     vw_status st = vw_image_write_png(path, 256, 256, big, err, sizeof err);
     float *fbig = calloc((size_t)256 * 256 * 3, sizeof *fbig);
     char err2[512];
     vw_status st2 = vw_image_write_pfm(path, 256, 256, fbig, err2, sizeof err2);
     free(fbig);
-    CHECK(setrlimit(RLIMIT_FSIZE, &old) == 0);
+    CHECK(file_size_restore(&old) == 0);
     printf("size-limited write: %s\n", err);
     CHECK_EQ_INT(st, VW_E_IO);
     CHECK_EQ_INT(st2, VW_E_IO);

@@ -24,6 +24,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "io_test_util.h"
 #include "vw_test.h"
 #include "vwalls/outfile.h"
 
@@ -115,16 +116,12 @@ static void regular_files(void)
 
     /* A write that fails (the file size limit, as a full disk would): an error with its
        reason, and neither the file nor a temporary one. */
-    struct rlimit rl, small;
-    CHECK(getrlimit(RLIMIT_FSIZE, &rl) == 0);
-    small = rl;
-    small.rlim_cur = 1000;
-    signal(SIGXFSZ, SIG_IGN);
-    CHECK(setrlimit(RLIMIT_FSIZE, &small) == 0);
+    struct rlimit rl;
+    CHECK(file_size_limit(1000, &rl) == 0);
     char big[5000];
     memset(big, 'x', sizeof big);
     vw_status st = vw_outfile_write(at("big.txt"), big, sizeof big, err, sizeof err);
-    CHECK(setrlimit(RLIMIT_FSIZE, &rl) == 0);
+    CHECK(file_size_restore(&rl) == 0);
     printf("too large: %s\n", err);
     CHECK_EQ_INT(st, VW_E_IO);
     CHECK(strstr(err, "big.txt: write failed: ") != NULL);

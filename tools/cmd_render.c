@@ -185,6 +185,7 @@ int vw_cmd_render(int argc, char **argv)
     int farm = -1, farm_copies = 0; /* -1: auto, resolved once the options are read */
     vw_map_kind map = VW_MAP_BLOCK;
     int map_given = 0, balance_given = 0, by_worker = 0;
+    const char *tuning = NULL; /* a pre-pass option given: it needs --balance or --map */
     long iters = 2, prepass = 0; /* 0: rt_prepass_stride() */
     vw_load_spec lspec;
     vw_load_spec_init(&lspec);
@@ -222,6 +223,7 @@ int vw_cmd_render(int argc, char **argv)
             }
             balance_given = 1;
         } else if (!strcmp(a, "--balance-load")) {
+            tuning = a;
             if (!(v = vw_cli_value(CMD, argc, argv, &i))) return VW_EXIT_USAGE;
             if (!strcmp(v, "busy")) {
                 lspec.model = VW_LOAD_BUSY;
@@ -236,9 +238,11 @@ int vw_cmd_render(int argc, char **argv)
                 return VW_EXIT_USAGE;
             }
         } else if (!strcmp(a, "--balance-iters")) {
+            tuning = a;
             if (!(v = vw_cli_value(CMD, argc, argv, &i)) || vw_cli_int(CMD, a, v, 1, 20, &iters))
                 return VW_EXIT_USAGE;
         } else if (!strcmp(a, "--prepass")) {
+            tuning = a;
             if (!(v = vw_cli_value(CMD, argc, argv, &i)) || vw_cli_int(CMD, a, v, 1, 256, &prepass))
                 return VW_EXIT_USAGE;
         } else if (!strcmp(a, "--map")) {
@@ -434,6 +438,9 @@ int vw_cmd_render(int argc, char **argv)
     /* The mapping of the initial cells (greedy and weighted refine it by load after the
        pre-pass, when there is one). */
     int balancing = strategy != VW_BALANCE_NONE || map != VW_MAP_BLOCK;
+    if (tuning && !balancing && vw_cli_is_output())
+        fprintf(stderr, "vwalls render: warning: %s has no effect without a pre-pass (--balance "
+                        "other than none, or --map greedy or weighted)\n", tuning);
     farm = vw_cli_farm_resolve(farm, balance_given || map_given);
     rt_balance_result bi;
     memset(&bi, 0, sizeof bi);

@@ -117,6 +117,19 @@ foreach(case "--from;1,2,nan;--from: bad value '1,2,nan'"
     message(FATAL_ERROR "${opt} ${val}: exit ${rc}, expected 2, '${want}' and no file (${err})")
   endif()
 endforeach()
+# A pre-pass option without a pre-pass is said to do nothing (and renders); with one, not.
+foreach(case "--balance-iters;3;warn" "--prepass;2;warn" "--balance-load;segments;warn"
+             "--prepass;2;--balance;tensor;quiet")
+  list(GET case -1 want)
+  set(opts ${case})
+  list(REMOVE_AT opts -1)
+  execute_process(COMMAND ${VWALLS} render ${SCENE} -o ${WORK}/pp.png --size 16x12 --quiet ${opts}
+                  RESULT_VARIABLE rc ERROR_VARIABLE err)
+  string(FIND "${err}" "has no effect without a pre-pass" at)
+  if(NOT rc EQUAL 0 OR (want STREQUAL "warn" AND at LESS 0) OR (want STREQUAL "quiet" AND at GREATER -1))
+    message(FATAL_ERROR "${opts}: exit ${rc}, expected 0 and ${want}: ${err}")
+  endif()
+endforeach()
 # Bad usage.
 execute_process(COMMAND ${VWALLS} render ${SCENE} -o ${WORK}/x.jpg RESULT_VARIABLE rc
                 OUTPUT_QUIET ERROR_QUIET)

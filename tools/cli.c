@@ -110,7 +110,6 @@ int vw_cli_size(const char *cmd, const char *opt, const char *s, int *w, int *h)
 int vw_cli_frame_pattern(const char *cmd, const char *opt, const char *s)
 {
     int conversions = 0, ok = 1;
-    size_t n = strlen(s);
     for (const char *p = s; *p; p++) {
         if (*p != '%') continue;
         if (p[1] == '%') {
@@ -132,7 +131,7 @@ int vw_cli_frame_pattern(const char *cmd, const char *opt, const char *s)
         }
         conversions++;
     }
-    if (ok && conversions == 1 && n > 4 && !strcmp(s + n - 4, ".png")) return 0;
+    if (ok && conversions == 1 && vw_image_format_of(s) == VW_IMAGE_PNG) return 0;
     vw_cli_error(cmd, "%s: bad pattern '%s' (expected a .png name with one %%d for the frame "
                       "number, like 'frames/%%04d.png'; %%%% for a percent sign)", opt, s);
     return -1;

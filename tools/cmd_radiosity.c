@@ -321,7 +321,7 @@ int vw_cmd_radiosity(int argc, char **argv)
         return VW_EXIT_USAGE;
     }
     /* Before the solve: a picture that cannot be written would be found only after it. */
-    if (r.image && rad_image_format(r.image) < 0) {
+    if (r.image && vw_image_format_of(r.image) == VW_IMAGE_NONE) {
         vw_cli_error(CMD, "--image %s: the picture must end in .png or .pfm", r.image);
         return VW_EXIT_USAGE;
     }

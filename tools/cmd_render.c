@@ -74,11 +74,6 @@ static void help(void)
            "\nexit status: 0 success, 2 bad input or usage, 1 any other failure\n");
 }
 
-static int ends_with(const char *s, const char *suf)
-{
-    size_t n = strlen(s), m = strlen(suf);
-    return n >= m && !strcasecmp(s + n - m, suf);
-}
 
 /* The progress bar: a small thread polls the output handler's atomic counter, so the
    workers never wait for the terminal. */
@@ -320,12 +315,13 @@ int vw_cmd_render(int argc, char **argv)
         vw_cli_error(CMD, "need a scene and -o OUT.png (try --help)");
         return VW_EXIT_USAGE;
     }
-    int pfm = ends_with(out, ".pfm");
-    if (!pfm && !ends_with(out, ".png")) {
+    vw_image_format format = vw_image_format_of(out);
+    int pfm = format == VW_IMAGE_PFM;
+    if (format == VW_IMAGE_NONE) {
         vw_cli_error(CMD, "-o %s: the output must end in .png or .pfm", out);
         return VW_EXIT_USAGE;
     }
-    if (overlay && !ends_with(overlay, ".png")) {
+    if (overlay && vw_image_format_of(overlay) != VW_IMAGE_PNG) {
         vw_cli_error(CMD, "--overlay %s: the overlay must end in .png", overlay);
         return VW_EXIT_USAGE;
     }

@@ -336,25 +336,17 @@ vw_status rad_write_csv(const char *path, const rad_mesh *m, const vw_scene *sc,
 
 /* ---- the image: perspective z-buffer over triangles with Gouraud colour ---- */
 
-int rad_image_format(const char *path)
-{
-    size_t n = strlen(path);
-    if (n >= 4 && !strcasecmp(path + n - 4, ".png")) return RAD_IMAGE_PNG;
-    if (n >= 4 && !strcasecmp(path + n - 4, ".pfm")) return RAD_IMAGE_PFM;
-    return -1;
-}
-
 vw_status rad_write_image(const char *path, const vw_camera *cam, const rad_mesh *m,
                           const rad_elem_result *e, size_t n, const double ambient[3], char *err,
                           size_t errlen)
 {
     int W = cam->width > 0 ? cam->width : 512, H = cam->height > 0 ? cam->height : 512;
-    int format = rad_image_format(path);
-    if (format < 0) {
+    vw_image_format format = vw_image_format_of(path);
+    if (format == VW_IMAGE_NONE) {
         snprintf(err, errlen, "%s: the picture must end in .png or .pfm", path);
         return VW_E_INVAL;
     }
-    int pfm = format == RAD_IMAGE_PFM;
+    int pfm = format == VW_IMAGE_PFM;
     shaded sh;
     if (shade(m, e, n, ambient, pfm, &sh)) return VW_E_NOMEM;
     float *zb = malloc(sizeof(float) * (size_t)W * (size_t)H);

@@ -247,12 +247,9 @@ vw_status rad_write_ply(const char *path, const rad_mesh *m, const rad_elem_resu
                         const double ambient[3], char *err, size_t errlen);
 vw_status rad_write_csv(const char *path, const rad_mesh *m, const vw_scene *sc,
                         const rad_elem_result *e, size_t n, char *err, size_t errlen);
-/* The picture's format from its name (case aside): RAD_IMAGE_PNG for .png (8-bit,
-   tone mapped), RAD_IMAGE_PFM for .pfm (float: the display radiosity, radiosity plus
-   the ambient term, not tone mapped), -1 for anything else. */
-enum { RAD_IMAGE_PNG, RAD_IMAGE_PFM };
-int rad_image_format(const char *path);
-/* Writes the picture in the format of its name; VW_E_INVAL for another name. */
+/* Writes the picture in the format of its name (vw_image_format_of): .png 8-bit and
+   tone mapped, .pfm float (the display radiosity, radiosity plus the ambient term, not
+   tone mapped); VW_E_INVAL for another name. */
 vw_status rad_write_image(const char *path, const vw_camera *cam, const rad_mesh *m,
                           const rad_elem_result *e, size_t n, const double ambient[3], char *err,
                           size_t errlen);

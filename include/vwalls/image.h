@@ -34,6 +34,15 @@ VW_API vw_status vw_image_read_png(const char *path, int *w, int *h, uint8_t **r
                                    char *err, size_t errlen);
 VW_API void vw_image_free(void *pixels);
 
+/* The format a file name asks for by its extension, case aside: the commands write a
+   PNG for .png and a PFM for .pfm, and refuse other names before any work. */
+typedef enum vw_image_format {
+    VW_IMAGE_NONE = -1, /* neither */
+    VW_IMAGE_PNG = 0,
+    VW_IMAGE_PFM = 1
+} vw_image_format;
+VW_API vw_image_format vw_image_format_of(const char *path);
+
 #ifdef __cplusplus
 }
 #endif

@@ -12,6 +12,7 @@
 #include <zlib.h>
 
 #include "io/io_internal.h"
+#include <strings.h>
 #include "vwalls/image.h"
 #include "vwalls/outfile.h"
 
@@ -350,4 +351,12 @@ VW_API vw_status vw_image_read_png(const char *path, int *w, int *h, uint8_t **r
 VW_API void vw_image_free(void *pixels)
 {
     free(pixels);
+}
+
+vw_image_format vw_image_format_of(const char *path)
+{
+    size_t n = path ? strlen(path) : 0;
+    if (n > 4 && !strcasecmp(path + n - 4, ".png")) return VW_IMAGE_PNG;
+    if (n > 4 && !strcasecmp(path + n - 4, ".pfm")) return VW_IMAGE_PFM;
+    return VW_IMAGE_NONE;
 }

@@ -15,6 +15,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 
 void rad_options_init(rad_options *o)
 {
@@ -178,8 +179,7 @@ double rad_default_patch_size(const vw_scene *s)
 static int polygon_line(const char *path, size_t k)
 {
     size_t plen = path ? strlen(path) : 0;
-    int nff = plen >= 4 && path[plen - 4] == '.' && (path[plen - 3] | 32) == 'n' &&
-              (path[plen - 2] | 32) == 'f' && (path[plen - 1] | 32) == 'f';
+    int nff = plen >= 4 && !strcasecmp(path + plen - 4, ".nff");
     FILE *f = path ? fopen(path, "r") : NULL;
     if (!f) return 0;
     char buf[4096];

@@ -7,8 +7,8 @@
 # Phases per frame (means over frames 1..FRAMES-1, from the stats JSON):
 #   decide = the distributed collision/sweep query of the frame's moves,
 #   update = vw_world_update_object in both worlds, build = commit (cell rebuilds),
-#   render = the ray-traced frame; cells = cells a moved sphere left or joined (what the
-#   incremental update rebuilds; --full-rebuild rebuilds all CELLS).
+#   render = the ray-traced frame; cells = cells rebuilt (incremental: those a moved
+#   sphere left or joined; all CELLS with --full-rebuild and after a rebalance).
 set -euo pipefail
 . "$(dirname "$0")/lib.sh"
 N=${N:-10000}

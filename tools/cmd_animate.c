@@ -95,7 +95,7 @@ static int flush(vw_anim_session *s)
     }
     s->acc.accepted += st.accepted, s->acc.collisions += st.collisions;
     s->acc.sweeps += st.sweeps, s->acc.invalid += st.invalid;
-    s->acc.records_updated += st.records_updated, s->acc.cells_touched += st.cells_touched;
+    s->acc.records_updated += st.records_updated;
     s->acc.apply_s += st.apply_s, s->acc.update_s += st.update_s;
     s->total_acc += st.accepted, s->total_coll += st.collisions;
     s->total_sweep += st.sweeps, s->total_invalid += st.invalid;
@@ -180,7 +180,7 @@ static int do_frame(vw_anim_session *s)
     f->rejected = s->acc.collisions + s->acc.sweeps + s->acc.invalid;
     f->edits = f->accepted + f->rejected;
     f->records = s->acc.records_updated;
-    f->cells = s->acc.cells_touched;
+    f->cells = st.cells_rebuilt;
     f->apply_s = s->acc.apply_s;
     f->update_s = s->acc.update_s;
     f->build_s = st.build_s;

@@ -24,6 +24,13 @@ struct rt_anim {
     double last_lambda, last_work_lambda;
     rt_object *rec;       /* the records as last placed in the render world, by slot */
     size_t nrec, caprec;
+    /* The cells the edits since the last frame touched, each marked once (several
+       batches may touch one cell), so the frame reports each rebuilt cell once;
+       rebuild_all when the next commit builds every cell (first frame, rebalance). */
+    unsigned char *touched;
+    int ntouched_cells;   /* cells the mark array covers (the layout may change) */
+    size_t ntouched;
+    int rebuild_all;
 };
 
 static double now(void)
@@ -45,6 +52,7 @@ void rt_anim_free(rt_anim *a)
     rt_job_free(a->job);
     vw_dynscene_free(a->ds);
     free(a->rec);
+    free(a->touched);
     free(a);
 }
 
@@ -71,6 +79,7 @@ vw_status rt_anim_create(vw_scene *s, const rt_anim_params *p, rt_anim **out, ch
     }
     a->full_rebuild = p->full_rebuild;
     a->farm = p->farm;
+    a->rebuild_all = 1; /* the first frame builds every cell */
     double lo[3], hi[3], diag = 0;
     vw_scene_bounds(s, lo, hi);
     for (int k = 0; k < 3; k++) diag += (hi[k] - lo[k]) * (hi[k] - lo[k]);
@@ -183,9 +192,17 @@ vw_status rt_anim_apply(rt_anim *a, const vw_edit *edits, size_t n, int check, i
     const rt_shared *sh = rt_job_shared(a->job);
     const vw_scene *s = vw_dynscene_scene(a->ds);
     int nc = vw_decomp_cell_count(d);
-    unsigned char *mark = calloc((size_t)nc, 1);
+    if (a->ntouched_cells != nc) {
+        /* A new layout (rebalanced): its first frame builds every cell anyway. */
+        free(a->touched);
+        a->touched = calloc((size_t)nc, 1);
+        a->ntouched_cells = a->touched ? nc : 0;
+        a->ntouched = 0;
+    }
+    unsigned char *mark = a->touched;
     int *cells = malloc(sizeof(int) * (size_t)nc);
     if (!mark || !cells) st = VW_E_NOMEM;
+    size_t touched_before = rs->cells_touched;
     for (size_t i = 0; i < nchanged && st == VW_OK; i++) {
         int id = changed[i];
         size_t first, ns;
@@ -218,7 +235,7 @@ vw_status rt_anim_apply(rt_anim *a, const vw_edit *edits, size_t n, int check, i
             rs->records_updated++;
         }
     }
-    free(mark);
+    a->ntouched += rs->cells_touched - touched_before;
     free(cells);
     free(changed);
     rs->apply_s += t1 - t0;
@@ -247,6 +264,11 @@ vw_status rt_anim_render(rt_anim *a, rt_anim_stats *rs, char *err, size_t errlen
             return st;
         }
     }
+    int nc = vw_decomp_cell_count(vw_world_decomp(w));
+    if (rs) rs->cells_rebuilt = a->full_rebuild || a->rebuild_all ? (size_t)nc : a->ntouched;
+    if (a->touched) memset(a->touched, 0, (size_t)a->ntouched_cells);
+    a->ntouched = 0;
+    a->rebuild_all = 0;
     st = rt_job_reset(a->job); /* cells keep their state; run() restarts eye rays */
     double t0 = now();
     /* The workers share the cells as a->farm says; copies follow the objects' edits
@@ -298,6 +320,7 @@ vw_status rt_anim_balance(rt_anim *a, const char *strategy, double *before, doub
         vw_balance_apply ap;
         memset(&ap, 0, sizeof ap);
         st = vw_balance_world(w, f, &bp, &ap, &rep);
+        if (st == VW_OK && rep.applied) a->rebuild_all = 1; /* new cells, all built anew */
     }
     if (st == VW_OK) {
         /* The collider follows the render world's new walls and mapping. */

@@ -33,7 +33,12 @@ typedef struct rt_anim_params {
 typedef struct rt_anim_stats {
     size_t accepted, collisions, sweeps, invalid;
     size_t records_updated;     /* records replaced in the render world */
-    size_t cells_touched;       /* cells a changed record left or joined: rebuilt next */
+    size_t cells_touched;       /* apply: cells a changed record left or joined that no
+                                   earlier batch since the last frame touched */
+    size_t cells_rebuilt;       /* render: the cells this frame's commit built: every
+                                   cell on the first frame, with full_rebuild and after
+                                   a rebalance, else those the edits since the last
+                                   frame touched (each once, however many batches) */
     double apply_s, update_s;   /* deciding (distributed query), updating the worlds */
     double build_s, render_s;   /* the last frame: commit (rebuild of dirty cells), run */
 } rt_anim_stats;

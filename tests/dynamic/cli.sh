@@ -64,6 +64,20 @@ grep -q "trigger: bad value 'most'" yerr.txt || fail "--trigger most message: $(
 [ $rc -eq 2 ] || fail "--farm most: status $rc, expected 2"
 grep -q "farm: bad value 'most'" xerr.txt || fail "--farm most message: $(cat xerr.txt)"
 [ -e x00.png ] && fail "a frame was rendered with a bad --farm"
+# Cells rebuilt per frame: every cell on the first frame and with --full-rebuild, else
+# each cell the frame's edits touched, once however many batches touched it (vwalls edit
+# makes a batch of every line: five moves of one sphere used to count its cells five
+# times, more cells than the layout has).
+printf 'frame\nmove 0 0.001 0 0\nmove 0 0.001 0 0\nmove 0 0.001 0 0\nmove 0 0.001 0 0\nmove 0 0.001 0 0\nframe\n' |
+  "$V" edit scene.nff --cells 2x2x1 --workers 2 --quiet --stats rb.json > /dev/null || fail "edit (cells rebuilt): status $?"
+"$V" animate scene.nff ok.txt -o 'fr%02d.png' --cells 2x2x1 --workers 2 --full-rebuild --quiet \
+  --stats fr.json || fail "--full-rebuild: status $?"
+python3 - rb.json fr.json <<'PY' || fail "cells_rebuilt per frame"
+import json, sys
+rb, fr = ([f["cells_rebuilt"] for f in json.load(open(x))["animation"]["per_frame"]] for x in sys.argv[1:])
+assert rb[0] == 4 and 1 <= rb[1] <= 4, rb
+assert fr == [4, 4], fr
+PY
 # One cell on two workers: the idle worker farms it (a copy, rebuilt with the cell
 # after the edits); the frames are the same bytes.
 "$V" animate scene.nff ok.txt -o 'g%02d.png' --cells 1 --workers 2 > gout.txt \

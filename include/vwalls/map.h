@@ -61,7 +61,10 @@ VW_API vw_status vw_world_remap(vw_world *w, const int *cell_worker);
 
 /* Share of neighbour traffic that stayed inside the sending worker, inside its process
    and inside its machine (messages and bytes, from the runtime's counters by
-   destination class) since the last vw_world_reset_stats. Collective under MPI. */
+   destination class) since the last vw_world_reset_stats. Collective under MPI.
+   Only messages sent count: work a module does in a cell of its own worker through
+   vw_ctx_enter is no message (the ray tracer hands every ray on that way, so its
+   msgs_worker stays 0 unless VW_STRESS refuses hand-offs). */
 typedef struct vw_traffic {
     uint64_t msgs, bytes;                 /* cell-to-cell messages */
     uint64_t msgs_worker, bytes_worker;   /* ... whose destination is the same worker */

@@ -2,6 +2,7 @@
 # processes, and ratios. Source it; do not run it.
 BUILD=${VW_BUILD_DIR:-$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)/build}
 VWALLS=$BUILD/vwalls
+[ -x "$VWALLS" ] || { echo "bench: no $VWALLS (build first: ./run build; VW_BUILD_DIR picks the build)" >&2; exit 1; }
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
 
 # best_of N CMD...: the smallest wall time in seconds of N runs (noise only adds time).

@@ -2,9 +2,10 @@
 # bench/mpi.sh - the MPI engine against the threads engine on the example module (a
 # bigger problem): 1 process x 1 worker, 1 process x 2 workers, 2 processes x 1 worker,
 # side by side, best of REPEAT runs each; prints compute time, ratios against 1x1, the
-# busiest worker's time in the module (the rest of compute is placing every object and
-# building cells, which every process does for the whole scene), the imbalance, and the
-# messages and bytes that crossed processes.
+# busiest worker's time in the module (the rest of the compute phase is the runtime's:
+# packets, waiting, and under MPI the termination waves; placing the objects and
+# building the cells are phases of their own), the imbalance, and the messages and
+# bytes that crossed processes.
 # usage: bench/mpi.sh [BUILD_DIR] [SPHERES] [CELLS] [REPEAT]
 set -eu
 repo=$(cd "$(dirname "$0")/.." && pwd)
@@ -13,7 +14,7 @@ n=${2:-400000}
 cells=${3:-4x4x4}
 repeat=${4:-3}
 vwalls=$build/vwalls
-[ -x "$vwalls" ] || { echo "bench/mpi.sh: no $vwalls (build first)"; exit 1; }
+[ -x "$vwalls" ] || { echo "bench/mpi.sh: no $vwalls (build first)" >&2; exit 1; }
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
 flags=""
 mpiexec --version 2>/dev/null | grep -q "Open MPI" && flags="--oversubscribe"

@@ -11,6 +11,9 @@ set -eu
 B=${1:-${VW_BUILD_DIR:-$(dirname "$0")/../build}}
 O=${2:-/tmp/vwalls-bench-radiosity}
 V=$B/vwalls
+for x in "$V" "$B/test_radiosity"; do
+  [ -x "$x" ] || { echo "radiosity.sh: no $x (build first: ./run build)" >&2; exit 1; }
+done
 mkdir -p "$O"
 "$B/test_radiosity" gen room "$O/room.nff"
 SF=${SF:-1e-4}

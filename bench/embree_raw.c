@@ -142,7 +142,7 @@ int main(int argc, char **argv)
             trace(&b, sh->view.eye, dir, 1, 1.0);
         }
     double t2 = now();
-    printf("embree_raw: %dx%d depth %d: build %.3f s, trace %.3f s, rays %lld, %.3f Mrays/s "
+    printf("embree_raw: %dx%d depth %d: build %.6f s, trace %.6f s, rays %lld, %.3f Mrays/s "
            "(checksum %.3g)\n",
            W, H, depth, t1 - t0, t2 - t1, b.rays, b.rays / (t2 - t1) * 1e-6, b.sink);
     rt_cell_geo_free(&b.geo);

@@ -43,6 +43,11 @@ set_tests_properties(raytrace_cli PROPERTIES ENVIRONMENT "${VW_RT_TSAN}")
 if(EXISTS ${PROJECT_SOURCE_DIR}/bench/embree_raw.c)
   add_executable(vw_bench_embree_raw ${PROJECT_SOURCE_DIR}/bench/embree_raw.c)
   target_link_libraries(vw_bench_embree_raw PRIVATE vwalls_apps)
+  # Its time and rate agree to the digits the benchmarks divide.
+  add_test(NAME bench_embree_raw
+           COMMAND sh ${PROJECT_SOURCE_DIR}/tests/raytrace/embree_raw.sh
+                   $<TARGET_FILE:vw_bench_embree_raw> ${PROJECT_SOURCE_DIR}/tests/raytrace/mixed.nff)
+  set_tests_properties(bench_embree_raw PROPERTIES LABELS "bench")
 endif()
 
 # Under mpirun (when the build has MPI; launcher flags: cmake/mpi_launcher.cmake): the

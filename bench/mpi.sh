@@ -3,9 +3,10 @@
 # bigger problem): 1 process x 1 worker, 1 process x 2 workers, 2 processes x 1 worker,
 # side by side, best of REPEAT runs each; prints compute time, ratios against 1x1, the
 # busiest worker's time in the module (the rest of the compute phase is the runtime's:
-# packets, waiting, and under MPI the termination waves; placing the objects and
-# building the cells are phases of their own), the imbalance, and the messages and
-# bytes that crossed processes.
+# packets, waiting, and under MPI the termination waves; placing the objects, which
+# every process does for the whole scene before keeping its own cells, and building
+# the cells are phases of their own), the imbalance, and the messages and bytes that
+# crossed processes.
 # usage: bench/mpi.sh [BUILD_DIR] [SPHERES] [CELLS] [REPEAT]
 set -eu
 repo=$(cd "$(dirname "$0")/.." && pwd)

@@ -199,7 +199,7 @@ done
 if [ $HAVE_BALANCE = 1 ] && [ ${#SCENES[@]} -gt 0 ]; then
   hard=${SCENES[${#SCENES[@]}-1]} last=${LAYOUTS##* }
   n=$(cells_of "$last")
-  # the strategies `vwalls render --help` lists (DESIGN.md names five; a build may have fewer)
+  # the strategies `vwalls render --help` lists (docs/balancing.md names five; a build may have fewer)
   strats=$("$VW" render --help 2>&1 | sed -n 's/.*--balance S *\([a-z|]*\).*/\1/p' | tr '|' ' ')
   for b in ${strats:-tensor rotate staggered divide duplicate}; do
     [ "$b" = none ] || [[ " $BALANCE " == *" $b "* ]] && continue

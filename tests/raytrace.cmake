@@ -1,5 +1,5 @@
 # raytrace.cmake - tests of the distributed ray tracer (apps/raytrace) and the
-# Embree-raw benchmark helper. Images are compared bit for bit: DESIGN.md promises
+# Embree-raw benchmark helper. Images are compared bit for bit: docs/raytrace.md promises
 # identical images for every decomposition, worker count and engine.
 
 add_executable(vw_test_raytrace ${PROJECT_SOURCE_DIR}/tests/raytrace/rt_test.c)

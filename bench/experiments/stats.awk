@@ -1,4 +1,4 @@
-# stats.awk - reads one vwalls stats JSON (DESIGN.md section 9) and prints the figures
+# stats.awk - reads one vwalls stats JSON (docs/runtime.md, Statistics) and prints the figures
 # bench/experiments.sh needs as KEY=VALUE lines, so the benchmark and its ctest smoke run
 # need no JSON library. It relies on the writer's layout (one top-level key per line, one
 # array element per line); a change there shows up as missing keys, which the CSV checker

@@ -17,6 +17,7 @@
 # Whole processes are timed with date +%s.%N: best of REPEAT runs, the configurations
 # interleaved (one run of each per round: the shared machine's speed drifts).
 # usage: bench/raytrace.sh [BUILD_DIR] [SIZE] [REPEAT]     (e.g. bench/raytrace.sh build 512 3)
+# Needs povray and python3 (scripts/setup.sh bench); valgrind for (d), skipped without.
 set -euo pipefail
 B=${1:-${VW_BUILD_DIR:-build}}
 SIZE=${2:-512}
@@ -29,6 +30,10 @@ trap 'rm -rf "$T"' EXIT
 
 for x in "$VW" "$RAW"; do
   [ -x "$x" ] || { echo "raytrace.sh: $x not built (cmake --build $B)" >&2; exit 1; }
+done
+for x in povray python3; do
+  command -v "$x" > /dev/null ||
+    { echo "raytrace.sh: $x is needed (scripts/setup.sh bench installs it)" >&2; exit 1; }
 done
 
 # The scene: SPD "balls" (sphereflake, level 4: 7382 spheres, 3 lights).

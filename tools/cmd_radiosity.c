@@ -351,7 +351,7 @@ int vw_cmd_radiosity(int argc, char **argv)
     if (!cells_given)
         for (int a = 0; gw > 1 && o.dims[0] * o.dims[1] * o.dims[2] < 4 * gw; a = (a + 1) % 3)
             o.dims[a] *= 2;
-    else if (o.dims[0] * o.dims[1] * o.dims[2] < gw && !o.quiet && vw_cli_is_output()) {
+    else if (o.dims[0] * o.dims[1] * o.dims[2] < gw && vw_cli_is_output()) {
         int nc = o.dims[0] * o.dims[1] * o.dims[2];
         fprintf(stderr, "vwalls radiosity: warning: %d cell%s for %d workers: %d of them will "
                 "idle (a radiosity cell cannot be shared); give --cells with at least %d cells\n",
@@ -379,9 +379,10 @@ int vw_cmd_radiosity(int argc, char **argv)
     }
     rad_mesh mesh;
     double t1 = vw_cli_now();
-    /* Every process meshes the whole scene; only the output process warns. */
+    /* Every process meshes the whole scene; only the output process warns, --quiet
+       or not (it silences the progress bar and the summary, never a warning). */
     rad_options mo = o;
-    if (!vw_cli_is_output()) mo.quiet = 1;
+    mo.quiet = !vw_cli_is_output();
     st = rad_mesh_build(sc, scene_path, d, &mo, &mesh, err, sizeof err);
     if (st != VW_OK) {
         if (vw_cli_is_output()) fprintf(stderr, "%s\n", err);
@@ -497,13 +498,14 @@ int vw_cmd_radiosity(int argc, char **argv)
                    (long long)rad_solver_shots(s), rad_solver_unshot_ratio(s), o.sf, L.error, t4 - t3);
             printf("shot messages %lld (%lld bytes), full notices %lld\n", (long long)sm, (long long)sb,
                    (long long)fm);
-            /* sf bounds the largest patch's share of the emitted power: emitters meshed
-               into more than 1/sf patches start below it, and nothing is lit. */
-            if (converged && rad_solver_shots(s) == 0)
-                fprintf(stderr, "vwalls radiosity: warning: converged before the first shot: no "
-                                "patch holds sf = %g of the emitted power (the emitters are meshed "
-                                "finer); give a smaller --sf or a larger --patch-size\n", o.sf);
         }
+        /* sf bounds the largest patch's share of the emitted power: emitters meshed
+           into more than 1/sf patches start below it, and nothing is lit. A warning, so
+           --quiet (no progress bar, no summary) keeps it. */
+        if (converged && rad_solver_shots(s) == 0)
+            fprintf(stderr, "vwalls radiosity: warning: converged before the first shot: no "
+                            "patch holds sf = %g of the emitted power (the emitters are meshed "
+                            "finer); give a smaller --sf or a larger --patch-size\n", o.sf);
         if (!(L.error <= 1e-6)) { /* NaN too */
             vw_cli_error(CMD, "energy ledger off by %.3g (relative)", L.error);
             rc = VW_EXIT_FAIL;

@@ -47,6 +47,15 @@ grep -q "patch size 1e-09 is too small" "$T/err" || fail "--patch-size 1e-9: mes
 grep -q "warning: converged before the first shot" "$T/err" || fail "--sf 0.5: no warning"
 "$V" radiosity "$T/cornell.nff" -o "$T/p.ply" --max-shots 4 >/dev/null 2>"$T/err" || fail "a run"
 ! grep -q "before the first shot" "$T/err" || fail "a run that shot: a warning: $(cat "$T/err")"
+# --quiet silences the progress bar and the summary, not the warnings (it used to drop
+# all three: the meshing warning, the idle workers, nothing lit).
+"$V" radiosity "$T/cornell.nff" -o "$T/p.ply" --sf 0.5 --cells 2 --workers 4 --quiet \
+  >"$T/out" 2>"$T/qerr" || fail "--quiet: $(cat "$T/qerr")"
+[ ! -s "$T/out" ] || fail "--quiet printed a summary: $(cat "$T/out")"
+for w in "warning: polygon (id 8) is not planar" "warning: 2 cells for 4 workers" \
+         "warning: converged before the first shot"; do
+  grep -q "$w" "$T/qerr" || fail "--quiet dropped '$w': $(cat "$T/qerr")"
+done
 # The published Cornell data's red wall is 0.8 mm off planar: one warning, at its own
 # line (57; counting NFF 'f' material lines as polygons named line 44).
 [ "$(grep -c "warning: polygon" "$T/err")" = 1 ] &&

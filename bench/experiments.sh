@@ -16,8 +16,10 @@
 #
 # usage: bench/experiments.sh [--smoke] [--out DIR] [--build DIR] [--publish]
 #   --smoke    tiny scenes, two layouts, no peers or plots (ctest: tests/experiments.cmake)
-#   --out      where the CSV, Markdown, JSON and plots go (default out/experiments)
-#   --build    the build directory holding vwalls (default $VW_BUILD_DIR or ./build)
+#   --out      where the CSV, Markdown, JSON and plots go (default out/experiments of
+#              this repository, wherever it is run from)
+#   --build    the build directory holding vwalls (default $VW_BUILD_DIR, else build/ of
+#              this repository)
 #   --publish  also copy the plots to docs/bench/ and rewrite BENCHMARKS.md
 # Environment: REPEAT (render runs per row, best kept), SIZE (image side), RSF (radiosity
 # stopping ratio), BALANCE (strategies for the balanced rows, default "tensor").

@@ -12,6 +12,9 @@ source "$(dirname "${BASH_SOURCE[0]}")/lib.sh"
 OUT=${1:-$(dirname "${BASH_SOURCE[0]}")/out/balance}
 SIZE=${SIZE:-256x256}
 mkdir -p "$OUT"
+# Scratch (the rendered images, each run's stats, the frames) goes to T, removed at exit.
+T=$(mktemp -d)
+trap 'rm -rf "$T"' EXIT
 
 "$VWALLS" gen spheres --count 1000 --seed 7 -o "$OUT/uniform.nff"
 "$VWALLS" gen spheres --count 1000 --cluster 0.5 --seed 7 -o "$OUT/cluster50.nff"
@@ -44,17 +47,17 @@ for scene in uniform cluster50 cluster100 oblique; do
     base=""
     for s in none tensor rotate staggered divide duplicate; do
       # Deterministic: one worker per cell, loads = counted ray-cell visits.
-      "$VWALLS" render "$OUT/$scene.nff" -o "$OUT/img.png" --size "$SIZE" --cells "$L" \
+      "$VWALLS" render "$OUT/$scene.nff" -o "$T/img.png" --size "$SIZE" --cells "$L" \
         --workers "$cells" --farm none --balance "$s" --balance-load segments --quiet \
-        --stats "$OUT/w.json"
-      read -r lw mig nb < <(json "$OUT/w.json" "['balance_detail']['imbalance_work']" \
+        --stats "$T/w.json"
+      read -r lw mig nb < <(json "$T/w.json" "['balance_detail']['imbalance_work']" \
         "['balance_detail']['migrated_objects']" "['balance_detail']['max_neighbours']")
       # Measured: 2 workers, loads = busy time; best compute time of 3.
       best=""; lb=""
       for _ in 1 2 3; do
-        "$VWALLS" render "$OUT/$scene.nff" -o "$OUT/img.png" --size "$SIZE" --cells "$L" \
-          --workers 2 --farm none --balance "$s" --quiet --stats "$OUT/b.json"
-        read -r c l < <(json "$OUT/b.json" "['time_s']['compute']" "['balance']['imbalance']")
+        "$VWALLS" render "$OUT/$scene.nff" -o "$T/img.png" --size "$SIZE" --cells "$L" \
+          --workers 2 --farm none --balance "$s" --quiet --stats "$T/b.json"
+        read -r c l < <(json "$T/b.json" "['time_s']['compute']" "['balance']['imbalance']")
         if [ -z "$best" ] || awk -v a="$c" -v b="$best" 'BEGIN { exit !(a < b) }'; then best=$c; lb=$l; fi
       done
       [ "$s" = none ] && base=$best
@@ -90,10 +93,10 @@ MOVING="$OUT/moving.md"
 { echo "| moving cluster, 20 frames, 2x2x2, 8 workers | λ work mean | λ work max | λ work last 10 mean | λ busy mean | λ busy max | rebalances |"
   echo "|---|---|---|---|---|---|---|"; } > "$MOVING"
 for s in none tensor staggered divide; do
-  mkdir -p "$OUT/frames"
-  "$VWALLS" animate "$OUT/moving.nff" "$OUT/moving.edits" -o "$OUT/frames/$s-%04d.png" --cells 2x2x2 \
-    --workers 8 --balance "$s" --trigger work --quiet --stats "$OUT/anim.json"
-  python3 - "$OUT/anim.json" "$s" >> "$MOVING" <<'PY'
+  mkdir -p "$T/frames"
+  "$VWALLS" animate "$OUT/moving.nff" "$OUT/moving.edits" -o "$T/frames/$s-%04d.png" --cells 2x2x2 \
+    --workers 8 --balance "$s" --trigger work --quiet --stats "$T/anim.json"
+  python3 - "$T/anim.json" "$s" >> "$MOVING" <<'PY'
 import json, sys
 fr = json.load(open(sys.argv[1]))["animation"]["per_frame"]
 lam = [f["lambda"] for f in fr]
@@ -106,11 +109,11 @@ cat "$MOVING"
 
 # Walls before and after for the 50% clustered scene (8 cells, staggered), and the
 # mapping of 16 cells onto 2 workers.
-"$VWALLS" render "$OUT/cluster50.nff" -o "$OUT/img.png" --size 384x384 --cells 2x2x2 --workers 8 \
+"$VWALLS" render "$OUT/cluster50.nff" -o "$T/img.png" --size 384x384 --cells 2x2x2 --workers 8 \
   --farm none --quiet --overlay "$OUT/walls_before.png"
-"$VWALLS" render "$OUT/cluster50.nff" -o "$OUT/img.png" --size 384x384 --cells 2x2x2 --workers 8 \
+"$VWALLS" render "$OUT/cluster50.nff" -o "$T/img.png" --size 384x384 --cells 2x2x2 --workers 8 \
   --balance staggered --balance-load segments --quiet --overlay "$OUT/walls_staggered.png"
-"$VWALLS" render "$OUT/cluster50.nff" -o "$OUT/img.png" --size 384x384 --cells 2x2x2 --workers 8 \
+"$VWALLS" render "$OUT/cluster50.nff" -o "$T/img.png" --size 384x384 --cells 2x2x2 --workers 8 \
   --balance tensor --balance-load segments --quiet --overlay "$OUT/walls_tensor.png"
 if command -v convert >/dev/null; then
   convert "$OUT/walls_before.png" "$OUT/walls_tensor.png" "$OUT/walls_staggered.png" +append \

@@ -11,6 +11,9 @@ source "$(dirname "${BASH_SOURCE[0]}")/lib.sh"
 OUT=${1:-$(dirname "${BASH_SOURCE[0]}")/out/map}
 SIZE=${SIZE:-256x256}
 mkdir -p "$OUT"
+# Scratch (the rendered images, each run's stats) goes to T, removed at exit.
+T=$(mktemp -d)
+trap 'rm -rf "$T"' EXIT
 "$VWALLS" gen spheres --count 1000 --cluster 0.5 --seed 7 -o "$OUT/cluster50.nff"
 json() { python3 -c "import json,sys; d=json.load(open(sys.argv[1])); print(' '.join(str(eval('d'+k)) for k in sys.argv[2:]))" "$@"; }
 
@@ -18,18 +21,18 @@ echo "| case | map | λ busy | λ work (speed-weighted) | compute s | messages b
 echo "|---|---|---|---|---|---|"
 for k in 2 4; do
   for m in block weighted; do
-    "$VWALLS" render "$OUT/cluster50.nff" -o "$OUT/img.png" --size "$SIZE" --cells 4x4x2 \
-      --workers 2 --map "$m" --slow "1:$k" --quiet --stats "$OUT/s.json"
-    read -r lb lw c xm < <(json "$OUT/s.json" "['balance']['imbalance']" \
+    "$VWALLS" render "$OUT/cluster50.nff" -o "$T/img.png" --size "$SIZE" --cells 4x4x2 \
+      --workers 2 --map "$m" --slow "1:$k" --quiet --stats "$T/s.json"
+    read -r lb lw c xm < <(json "$T/s.json" "['balance']['imbalance']" \
       "['balance_detail']['imbalance_work']" "['time_s']['compute']" \
       "['traffic']['messages'] - d['traffic']['worker_messages']")
     echo "| 32 cells, worker 1 slowed ${k}x | $m | $lb | $lw | $c | $xm |"
   done
 done
 for m in block greedy; do
-  "$VWALLS" render "$OUT/cluster50.nff" -o "$OUT/img.png" --size "$SIZE" --cells 4x4x4 \
-    --workers 2 --map "$m" --quiet --stats "$OUT/s.json" --overlay "$OUT/map_$m.png" --overlay-by worker
-  read -r lb lw c xm < <(json "$OUT/s.json" "['balance']['imbalance']" \
+  "$VWALLS" render "$OUT/cluster50.nff" -o "$T/img.png" --size "$SIZE" --cells 4x4x4 \
+    --workers 2 --map "$m" --quiet --stats "$T/s.json" --overlay "$OUT/map_$m.png" --overlay-by worker
+  read -r lb lw c xm < <(json "$T/s.json" "['balance']['imbalance']" \
     "['balance_detail']['imbalance_work']" "['time_s']['compute']" \
     "['traffic']['messages'] - d['traffic']['worker_messages']")
   echo "| 64 cells on 2 workers | $m | $lb | $lw | $c | $xm |"

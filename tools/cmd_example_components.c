@@ -94,8 +94,9 @@ int vw_cmd_example_components(int argc, char **argv)
             vw_decomp_layout_string(d, layout, sizeof layout);
             printf("components: %lld (largest %lld spheres)\n", (long long)ncomp,
                    (long long)largest(labels, (size_t)n));
-            printf("spheres %ld, cells %s (%d), workers %d x %d processes\n", n, layout,
-                   vw_decomp_cell_count(d), vw_world_workers(w), vw_world_processes(w));
+            printf("spheres %ld, cells %s (%d), workers %d x %d process%s\n", n, layout,
+                   vw_decomp_cell_count(d), vw_world_workers(w), vw_world_processes(w),
+                   vw_world_processes(w) == 1 ? "" : "es");
             printf("local components %lld, label messages %lld, relabels %lld\n",
                    (long long)vw_world_counter(w, EX_COMPONENTS_CNT_LOCAL),
                    (long long)vw_world_counter(w, EX_COMPONENTS_CNT_LABEL_MSGS),

@@ -77,8 +77,9 @@ int vw_cmd_example_pairs(int argc, char **argv)
             char layout[64];
             vw_decomp_layout_string(d, layout, sizeof layout);
             printf("touching pairs: %lld\n", (long long)pairs);
-            printf("spheres %ld, cells %s (%d), workers %d x %d processes\n", n, layout,
-                   vw_decomp_cell_count(d), vw_world_workers(w), vw_world_processes(w));
+            printf("spheres %ld, cells %s (%d), workers %d x %d process%s\n", n, layout,
+                   vw_decomp_cell_count(d), vw_world_workers(w), vw_world_processes(w),
+                   vw_world_processes(w) == 1 ? "" : "es");
             printf("ghosts sent %lld, time %.3f s, imbalance %.3f\n", (long long)vw_world_counter(w, 1),
                    t2 - t1, vw_world_imbalance(w));
             printf("phases: generate %.3f s, place %.3f s, build %.3f s, compute %.3f s\n", t1 - t0,

@@ -13,6 +13,9 @@ for p in efficiency.png speedup.png unshot.png "$OUT"/overlay-*.png; do
   [ -f "$OUT/$p" ] && cp "$OUT/$p" "$DOCS/$p"
 done
 env_() { sed -n "s/^$1=//p" "$OUT/run.env"; }
+# The run's length as prose: "1 minute", "2 minutes" (rounded up).
+took_min=$(( $(env_ seconds) / 60 + 1 ))
+took="$took_min minute$([ "$took_min" = 1 ] || echo s)"
 CSV=$OUT/results.csv
 cpu=$(sed -n 's/^model name[^:]*: //p' /proc/cpuinfo | head -1)
 mem=$(awk '/^MemTotal/ { printf "%.1f GiB", $2 / 1048576 }' /proc/meminfo)
@@ -72,7 +75,7 @@ with the threads engine and (a subset) under \`mpirun\`, beside POV-Ray 3.7, Emb
 ray-casting loop, and per-process memory under MPI. Everything below comes from one run
 on the machine described here; nothing is edited by hand but this file's fixed prose.
 
-Regenerate (about $(( $(env_ seconds) / 60 + 1 )) minutes here; writes \`out/experiments/\`, this file and \`docs/bench/*.png\`):
+Regenerate (about ${took} here; writes \`out/experiments/\`, this file and \`docs/bench/*.png\`):
 
 \`\`\`sh
 ./run bench experiments --publish        # = bench/experiments.sh --publish

@@ -53,7 +53,10 @@ VW_API vw_status vw_decomp_create_grid(const vw_box *world, const int dims[3], v
 VW_API vw_status vw_decomp_create_grid_walls(const vw_box *world, const int dims[3],
                                              const double *const walls[3], const double *frame,
                                              vw_decomp **out);
-/* Any kd-tree. world is in frame coordinates; frame may be NULL (identity). */
+/* Any kd-tree. world is in frame coordinates; frame may be NULL (identity). kind is
+   VW_DECOMP_STAGGERED or VW_DECOMP_DIVIDED: a grid is made by the two calls above, which
+   record its walls per axis (VW_E_INVAL for any other kind, or a frame that is not
+   orthonormal). */
 VW_API vw_status vw_decomp_create_kd(const vw_box *world, const vw_kd_node *nodes, int nnodes,
                                      const double *frame, vw_decomp_kind kind, vw_decomp **out);
 VW_API vw_status vw_decomp_clone(const vw_decomp *d, vw_decomp **out);

@@ -48,8 +48,9 @@ static int kd_check(vw_decomp *d, int node, vw_box box, int depth, unsigned char
 
 static void build_neighbours(vw_decomp *d);
 
-vw_status vw_decomp_create_kd(const vw_box *world, const vw_kd_node *nodes, int nnodes,
-                              const double *frame, vw_decomp_kind kind, vw_decomp **out)
+/* vw_decomp_create_kd for every kind; the grid constructor adds its dims and walls. */
+static vw_status kd_create(const vw_box *world, const vw_kd_node *nodes, int nnodes,
+                           const double *frame, vw_decomp_kind kind, vw_decomp **out)
 {
     if (!out) return VW_E_INVAL;
     *out = NULL;
@@ -92,7 +93,7 @@ vw_status vw_decomp_create_kd(const vw_box *world, const vw_kd_node *nodes, int 
             for (int j = 0; j < 3; j++) {
                 double dot = 0;
                 for (int k = 0; k < 3; k++) dot += frame[3 * i + k] * frame[3 * j + k];
-                if (fabs(dot - (i == j)) > 1e-9) ok = 0;
+                if (!(fabs(dot - (i == j)) <= 1e-9)) ok = 0; /* NaN too */
             }
         if (!ok) {
             vw_decomp_free(d);
@@ -115,6 +116,18 @@ vw_status vw_decomp_create_kd(const vw_box *world, const vw_kd_node *nodes, int 
     }
     *out = d;
     return VW_OK;
+}
+
+vw_status vw_decomp_create_kd(const vw_box *world, const vw_kd_node *nodes, int nnodes,
+                              const double *frame, vw_decomp_kind kind, vw_decomp **out)
+{
+    /* A grid knows its walls per axis (vw_decomp_grid_walls, the tensor balancer, the
+       clone rebuilds it from them); a tree given here has none, so it cannot be one. */
+    if (kind != VW_DECOMP_STAGGERED && kind != VW_DECOMP_DIVIDED) {
+        if (out) *out = NULL;
+        return VW_E_INVAL;
+    }
+    return kd_create(world, nodes, nnodes, frame, kind, out);
 }
 
 /* Appends the nodes splitting axis `axis` of grid index range [i0, i1) with boundary
@@ -185,7 +198,7 @@ vw_status vw_decomp_create_grid_walls(const vw_box *world, const int dims[3],
         int nn = 0, idx[3] = {0, 0, 0};
         const double *cb[3] = {b[0], b[1], b[2]};
         grid_build(nodes, &nn, dims, cb, 0, 0, dims[0], idx);
-        st = vw_decomp_create_kd(world, nodes, nn, frame, VW_DECOMP_GRID, out);
+        st = kd_create(world, nodes, nn, frame, VW_DECOMP_GRID, out);
     }
     if (st == VW_OK) {
         vw_decomp *d = *out;

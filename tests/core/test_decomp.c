@@ -355,6 +355,24 @@ int main(void)
         CHECK_EQ_INT(vw_decomp_create_kd(&world, cyc, 3, NULL, VW_DECOMP_DIVIDED, &d), VW_E_INVAL);
         vw_kd_node outside[3] = {{0, 1.5, 1, 2, -1}, {-1, 0, -1, -1, 0}, {-1, 0, -1, -1, 1}};
         CHECK_EQ_INT(vw_decomp_create_kd(&world, outside, 3, NULL, VW_DECOMP_DIVIDED, &d), VW_E_INVAL);
+        /* A frame with a NaN is no rotation: accepted, it would put every point
+           outside the world (vw_decomp_locate -1). */
+        vw_kd_node two[3] = {{0, 0.3, 1, 2, -1}, {-1, 0, -1, -1, 0}, {-1, 0, -1, -1, 1}};
+        double nan_frame[9] = {NAN, 0, 0, 0, 1, 0, 0, 0, 1};
+        CHECK_EQ_INT(vw_decomp_create_kd(&world, two, 3, nan_frame, VW_DECOMP_DIVIDED, &d), VW_E_INVAL);
+        int dims[3] = {2, 1, 1};
+        CHECK_EQ_INT(vw_decomp_create_grid_walls(&world, dims, NULL, nan_frame, &d), VW_E_INVAL);
+        /* A tree is not a grid: it has no walls per axis, and a clone made as a grid
+           would have moved the wall at 0.3 to 0.5. */
+        CHECK_EQ_INT(vw_decomp_create_kd(&world, two, 3, NULL, VW_DECOMP_GRID, &d), VW_E_INVAL);
+        CHECK_EQ_INT(vw_decomp_create_kd(&world, two, 3, NULL, (vw_decomp_kind)7, &d), VW_E_INVAL);
+        CHECK_EQ_INT(vw_decomp_create_kd(&world, two, 3, NULL, VW_DECOMP_DIVIDED, &d), VW_OK);
+        vw_decomp *e;
+        CHECK_EQ_INT(vw_decomp_clone(d, &e), VW_OK);
+        CHECK(vw_decomp_equal(d, e));
+        CHECK_EQ_INT(vw_decomp_cell_box(e, 0).hi[0] == 0.3, 1);
+        vw_decomp_free(e);
+        vw_decomp_free(d);
     }
     /* Layout strings. */
     {

@@ -25,7 +25,11 @@ set_tests_properties(core_storm core_storm_stress core_storm_split PROPERTIES LA
 vw_core_test(test_misuse)
 add_test(NAME core_misuse_create COMMAND test_misuse create)
 add_test(NAME core_misuse_post COMMAND test_misuse post)
-set_tests_properties(core_misuse_create core_misuse_post PROPERTIES LABELS "core")
+# Calls a careless or hostile program makes: a bad mapping for new walls leaves the world
+# as it was.
+add_test(NAME core_misuse_redecompose COMMAND test_misuse redecompose)
+set_tests_properties(core_misuse_create core_misuse_post core_misuse_redecompose
+  PROPERTIES LABELS "core")
 foreach(case "send;sent message kind 1 to cell 0, but the kind has no handle"
              "output;sent message kind 0 to the output, but the kind has no output handler"
              "count;counted into counter 5 of 1")

@@ -83,7 +83,8 @@ VW_API vw_status vw_world_post(vw_world *w, int cell, int kind, const void *msg)
 VW_API vw_status vw_world_run(vw_world *w);
 
 /* Replace the decomposition (and optionally the mapping) between runs: objects are
-   re-placed, moved between workers/processes, and the cells rebuilt. */
+   re-placed, moved between workers/processes, and the cells rebuilt. A mapping to a
+   worker that does not exist is VW_E_INVAL, and the world stays as it was. */
 VW_API vw_status vw_world_redecompose(vw_world *w, const vw_decomp *d, const int *cell_worker);
 /* Replace object `id` (dynamic scenes): it leaves cells it no longer overlaps, joins
    the new ones; only the touched cells are rebuilt at the next commit/run. */

@@ -515,6 +515,13 @@ vw_status vw_world_run(vw_world *w)
 vw_status vw_world_redecompose(vw_world *w, const vw_decomp *d, const int *cell_worker)
 {
     if (!w || !d) return VW_E_INVAL;
+    /* A bad mapping is refused before the old cells are torn down: found by map_cells
+       after that, it left a world with no objects placed and its workers' cell lists
+       from the old decomposition, whose next run called handlers without cell state. */
+    for (int c = 0; cell_worker && c < vw_decomp_cell_count(d); c++)
+        if (cell_worker[c] < 0 || cell_worker[c] >= w->gworkers)
+            return vw__world_error(w, VW_E_INVAL, "mapping sends cell %d to worker %d of %d", c,
+                                   cell_worker[c], w->gworkers);
     /* Which worker held each object before, to count migrations. */
     size_t n = w->nobjects;
     unsigned char *held = calloc(n ? n * (size_t)w->gworkers : 1, 1);

@@ -1,6 +1,7 @@
 /* test_misuse.c - a module's mistakes get a message, never silence:
  *   create   a world that cannot be created says why through vw_world_errmsg(NULL)
  *   post     posting a kind without handle is VW_E_INVAL with a message
+ *   redecompose   a bad mapping is refused and leaves the world as it was
  *   send | output | count   a module's bad send or count stops the process (abort)
  *            with a message on stderr: run in a child, whose end and stderr are checked
  * Usage: test_misuse MODE [EXPECTED-MESSAGE]
@@ -100,7 +101,33 @@ int main(int argc, char **argv)
         CHECK(vw_world_create(&m, NULL, d, &cfg, &w) == VW_OK);
         obj o[2] = {{{0.25, 0.5, 0.5}}, {{0.75, 0.5, 0.5}}};
         CHECK(vw_world_add_objects(w, o, 2) == VW_OK);
-        if (!strcmp(mode, "post")) {
+        if (!strcmp(mode, "redecompose")) {
+            CHECK(vw_world_run(w) == VW_OK);
+            vw_box world2 = {{0, 0, 0}, {1, 1, 1}};
+            int dims2[3] = {4, 1, 1};
+            vw_decomp *d2;
+            CHECK(vw_decomp_create_grid(&world2, dims2, &d2) == VW_OK);
+            int map[4] = {0, 1, 0, 7}; /* two workers: 7 is none of them */
+            CHECK(vw_world_redecompose(w, d2, map) == VW_E_INVAL);
+            printf("redecompose: %s\n", vw_world_errmsg(w));
+            CHECK(strstr(vw_world_errmsg(w), "cell 3 to worker 7") != NULL);
+            int remap[2] = {1, -1};
+            CHECK(vw_world_remap(w, remap) == VW_E_INVAL);
+            /* The world is the one before: its walls, its objects in their cells. */
+            CHECK(vw_decomp_equal(vw_world_decomp(w), d));
+            int cell = -1;
+            CHECK(vw_world_cells_of_object(w, 0, &cell, 1) == 1 && cell == 0);
+            CHECK(vw_world_cells_of_object(w, 1, &cell, 1) == 1 && cell == 1);
+            int x = 0;
+            CHECK(vw_world_post(w, 1, 0, &x) == VW_OK);
+            CHECK(vw_world_run(w) == VW_OK);
+            vw_cell_stats cs;
+            CHECK(vw_world_cell_stats(w, 1, &cs) == VW_OK && cs.messages_in == 1 && cs.objects == 1);
+            map[3] = 1;
+            CHECK(vw_world_redecompose(w, d2, map) == VW_OK);
+            CHECK(vw_world_run(w) == VW_OK);
+            vw_decomp_free(d2);
+        } else if (!strcmp(mode, "post")) {
             int x = 0;
             CHECK(vw_world_post(w, 1, 1, &x) == VW_E_INVAL);
             printf("post: %s\n", vw_world_errmsg(w));

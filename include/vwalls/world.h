@@ -25,7 +25,8 @@ typedef struct vw_world vw_world;
 
 typedef struct vw_config {
     int workers;             /* worker threads per process; 0 = number of cores */
-    size_t packet_bytes;     /* flush a packet when it holds this much (default 32 KiB) */
+    size_t packet_bytes;     /* flush a packet when it holds this much (default 32 KiB;
+                                at most 1 GiB, VW_E_LIMIT above) */
     size_t cap_bytes;        /* a worker whose unconsumed sent bytes exceed this drains its
                                 inbox before step() creates new work (default 64 MiB) */
     /* Stress switches (also from the environment: VW_STRESS=seed, VW_STRESS_SPLIT=1). */

@@ -222,6 +222,14 @@ vw_status vw_world_create(const vw_module *m, void *user, const vw_decomp *d, co
         free(w);
         return VW_E_LIMIT;
     }
+    /* A packet is one allocation of its header plus packet_bytes, and one MPI message
+       counted in an int: near SIZE_MAX the allocation's size wrapped to a few bytes. */
+    if (w->cfg.packet_bytes > VW__MAX_PACKET_BYTES) {
+        create_failed(VW_E_LIMIT, "vw_world_create: packets of %zu bytes (at most %zu)",
+                      w->cfg.packet_bytes, (size_t)VW__MAX_PACKET_BYTES);
+        free(w);
+        return VW_E_LIMIT;
+    }
     w->steal = w->cfg.steal > 0 || (w->cfg.steal < 0 && w->nworkers <= default_workers());
     w->cfg.cell_worker = NULL; /* copied into w->cell_worker below */
     pthread_mutex_init(&w->output_mu, NULL);
@@ -354,9 +362,12 @@ vw_status vw_world_add_objects(vw_world *w, const void *objects, size_t n)
     size_t osz = w->m->object_size;
     if (!osz) return n ? VW_E_INVAL : VW_OK;
     if (n == 0) return VW_OK; /* also keeps memcpy away from a NULL buffer */
+    /* The records' bytes must fit a size_t: a count near SIZE_MAX wrapped the capacity
+       to a small allocation and the copy ran past it. */
+    if (n > SIZE_MAX / osz - w->nobjects) return VW_E_NOMEM;
     if (w->nobjects + n > w->capobjects) {
         size_t cap = w->capobjects ? w->capobjects : 64;
-        while (cap < w->nobjects + n) cap *= 2;
+        while (cap < w->nobjects + n) cap = cap > SIZE_MAX / osz / 2 ? w->nobjects + n : 2 * cap;
         unsigned char *o = realloc(w->objects, cap * osz);
         if (!o) return VW_E_NOMEM;
         w->objects = o;

@@ -41,6 +41,8 @@ typedef struct vw__packet {
     size_t used, cap;  /* bytes of data */
     unsigned char data[];
 } vw__packet;
+/* The largest vw_config.packet_bytes (vw_world_create refuses more). */
+#define VW__MAX_PACKET_BYTES ((size_t)1 << 30)
 
 /* Cache-line alignment of what one worker writes on its hot path (a cell's figures and
    counters, a worker's own state): two workers never write the same line. Arrays of

@@ -2,6 +2,7 @@
  *   create   a world that cannot be created says why through vw_world_errmsg(NULL)
  *   post     posting a kind without handle is VW_E_INVAL with a message
  *   redecompose   a bad mapping is refused and leaves the world as it was
+ *   limits   counts whose bytes overflow a size_t are refused, not wrapped
  *   send | output | count   a module's bad send or count stops the process (abort)
  *            with a message on stderr: run in a child, whose end and stderr are checked
  * Usage: test_misuse MODE [EXPECTED-MESSAGE]
@@ -127,6 +128,17 @@ int main(int argc, char **argv)
             CHECK(vw_world_redecompose(w, d2, map) == VW_OK);
             CHECK(vw_world_run(w) == VW_OK);
             vw_decomp_free(d2);
+        } else if (!strcmp(mode, "limits")) {
+            /* n records of 24 bytes are more bytes than a size_t holds. */
+            CHECK(vw_world_add_objects(w, o, SIZE_MAX / 2) == VW_E_NOMEM);
+            CHECK(vw_world_add_objects(w, o, SIZE_MAX / sizeof(obj)) == VW_E_NOMEM);
+            CHECK(vw_world_cells_of_object(w, 2, NULL, 0) == 0);
+            CHECK(vw_world_run(w) == VW_OK);
+            vw_world *w2 = NULL;
+            cfg.packet_bytes = SIZE_MAX;
+            CHECK(vw_world_create(&m, NULL, d, &cfg, &w2) == VW_E_LIMIT && !w2);
+            printf("packets: %s\n", vw_world_errmsg(NULL));
+            CHECK(strstr(vw_world_errmsg(NULL), "packets of") != NULL);
         } else if (!strcmp(mode, "post")) {
             int x = 0;
             CHECK(vw_world_post(w, 1, 1, &x) == VW_E_INVAL);

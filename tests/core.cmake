@@ -26,11 +26,12 @@ vw_core_test(test_misuse)
 add_test(NAME core_misuse_create COMMAND test_misuse create)
 add_test(NAME core_misuse_post COMMAND test_misuse post)
 # Calls a careless or hostile program makes: a bad mapping for new walls leaves the world
-# as it was, counts too large for memory are refused.
+# as it was, counts too large for memory are refused, phases keep their names.
 add_test(NAME core_misuse_redecompose COMMAND test_misuse redecompose)
 add_test(NAME core_misuse_limits COMMAND test_misuse limits)
+add_test(NAME core_misuse_stats COMMAND test_misuse stats)
 set_tests_properties(core_misuse_create core_misuse_post core_misuse_redecompose
-  core_misuse_limits PROPERTIES LABELS "core")
+  core_misuse_limits core_misuse_stats PROPERTIES LABELS "core")
 set_tests_properties(core_misuse_limits PROPERTIES TIMEOUT 30) # an overflowed size loops
 foreach(case "send;sent message kind 1 to cell 0, but the kind has no handle"
              "output;sent message kind 0 to the output, but the kind has no output handler"

@@ -139,7 +139,8 @@ VW_API double vw_world_imbalance(const vw_world *w);
 VW_API void vw_world_reset_stats(vw_world *w);
 
 /* Times of phases the application measured itself, for the stats JSON
-   ("load", "build", "compute", "balance", ...). Accumulates. */
+   ("load", "build", "compute", "balance", ...). Accumulates; a phase may have any name
+   (it is escaped in the JSON), and there may be any number of them. */
 VW_API void vw_world_add_time(vw_world *w, const char *phase, double seconds);
 /* The time accumulated for a phase (0 if none). */
 VW_API double vw_world_time(const vw_world *w, const char *phase);

@@ -67,19 +67,22 @@ static void write_body(vw_world *w, FILE *f, const char *command, const char *ex
             vw_decomp_kind_name(vw_decomp_get_kind(w->decomp)), layout, w->ncells,
             vw_decomp_max_neighbours(w->decomp), vw_decomp_frame(w->decomp) ? "true" : "false");
     double lambda = vw_world_imbalance(w);
-    fprintf(f, "  \"balance\": {\"strategy\": \"%s\", \"imbalance_before\": %.6g, \"imbalance_after\": %.6g, \"migrated_objects\": %llu, \"imbalance\": %.6g, \"efficiency\": %.6g},\n",
-            w->balance_strategy[0] ? w->balance_strategy : "none",
+    /* The strategy and the phases are named by the caller: escaped like every string. */
+    fprintf(f, "  \"balance\": {\"strategy\": ");
+    json_string(f, w->balance_strategy[0] ? w->balance_strategy : "none");
+    fprintf(f, ", \"imbalance_before\": %.6g, \"imbalance_after\": %.6g, \"migrated_objects\": %llu, \"imbalance\": %.6g, \"efficiency\": %.6g},\n",
             num(w->balance_strategy[0] ? w->imbalance_before : lambda),
             num(w->balance_strategy[0] ? w->imbalance_after : lambda),
             (unsigned long long)w->migrated, num(lambda), num(lambda > 0 ? 1.0 / lambda : 0));
     fprintf(f, "  \"time_s\": {");
     double total = 0;
     for (int i = 0; i < w->nphases; i++) {
-        fprintf(f, "\"%s\": %.6f, ", w->phase_name[i], num(w->time_phase[i]));
-        if (strcmp(w->phase_name[i], "total") != 0) total += num(w->time_phase[i]);
+        json_string(f, w->phases[i].name);
+        fprintf(f, ": %.6f, ", num(w->phases[i].s));
+        if (strcmp(w->phases[i].name, "total") != 0) total += num(w->phases[i].s);
     }
     int has_total = 0;
-    for (int i = 0; i < w->nphases; i++) has_total |= strcmp(w->phase_name[i], "total") == 0;
+    for (int i = 0; i < w->nphases; i++) has_total |= strcmp(w->phases[i].name, "total") == 0;
     if (!has_total)
         fprintf(f, "\"total\": %.6f", num(total));
     else

@@ -311,6 +311,8 @@ void vw_world_free(vw_world *w)
     pthread_cond_destroy(&w->pool_cv);
     vw_decomp_free(w->decomp);
     free(w->objects);
+    for (int i = 0; i < w->nphases; i++) free(w->phases[i].name);
+    free(w->phases);
     free(w);
 }
 
@@ -846,22 +848,33 @@ void vw_world_reset_stats(vw_world *w)
     memset(w->wstats, 0, sizeof *w->wstats * (size_t)w->gworkers);
 }
 
+/* Names are kept whole and phases are not counted: a name cut to a fixed size, or a
+   phase past a fixed number, was dropped without a word and vw_world_time said 0. */
 void vw_world_add_time(vw_world *w, const char *phase, double seconds)
 {
+    if (!w || !phase) return;
     for (int i = 0; i < w->nphases; i++)
-        if (strcmp(w->phase_name[i], phase) == 0) {
-            w->time_phase[i] += seconds;
+        if (strcmp(w->phases[i].name, phase) == 0) {
+            w->phases[i].s += seconds;
             return;
         }
-    if (w->nphases == 8) return;
-    snprintf(w->phase_name[w->nphases], sizeof w->phase_name[0], "%s", phase);
-    w->time_phase[w->nphases++] = seconds;
+    if (w->nphases == w->capphases) {
+        int cap = w->capphases ? 2 * w->capphases : 8;
+        struct vw__phase *p = realloc(w->phases, sizeof *p * (size_t)cap);
+        if (!p) return; /* (a time is not worth failing the caller for) */
+        w->phases = p;
+        w->capphases = cap;
+    }
+    char *name = strdup(phase);
+    if (!name) return;
+    w->phases[w->nphases].name = name;
+    w->phases[w->nphases++].s = seconds;
 }
 
 double vw_world_time(const vw_world *w, const char *phase)
 {
-    for (int i = 0; i < w->nphases; i++)
-        if (strcmp(w->phase_name[i], phase) == 0) return w->time_phase[i];
+    for (int i = 0; w && phase && i < w->nphases; i++)
+        if (strcmp(w->phases[i].name, phase) == 0) return w->phases[i].s;
     return 0;
 }
 

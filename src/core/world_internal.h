@@ -197,9 +197,11 @@ struct vw_world {
     char errmsg[512];
     vw_status err;
     /* stats */
-    double time_phase[8];
-    char phase_name[8][16];
-    int nphases;
+    struct vw__phase {         /* vw_world_add_time, in the order first added */
+        char *name;
+        double s;
+    } *phases;
+    int nphases, capphases;
     char balance_strategy[32];
     double imbalance_before, imbalance_after;
     uint64_t migrated;

@@ -3,6 +3,7 @@
  *   post     posting a kind without handle is VW_E_INVAL with a message
  *   redecompose   a bad mapping is refused and leaves the world as it was
  *   limits   counts whose bytes overflow a size_t are refused, not wrapped
+ *   stats    phase names of any length and number, escaped in the stats JSON
  *   send | output | count   a module's bad send or count stops the process (abort)
  *            with a message on stderr: run in a child, whose end and stderr are checked
  * Usage: test_misuse MODE [EXPECTED-MESSAGE]
@@ -139,6 +140,33 @@ int main(int argc, char **argv)
             CHECK(vw_world_create(&m, NULL, d, &cfg, &w2) == VW_E_LIMIT && !w2);
             printf("packets: %s\n", vw_world_errmsg(NULL));
             CHECK(strstr(vw_world_errmsg(NULL), "packets of") != NULL);
+        } else if (!strcmp(mode, "stats")) {
+            const char *lng = "a phase whose name is longer than sixteen bytes";
+            vw_world_add_time(w, lng, 1.5);
+            vw_world_add_time(w, lng, 1.0);
+            CHECK_NEAR(vw_world_time(w, lng), 2.5, 0);
+            char name[16];
+            for (int i = 0; i < 20; i++) {
+                snprintf(name, sizeof name, "p%d", i);
+                vw_world_add_time(w, name, i);
+            }
+            CHECK_NEAR(vw_world_time(w, "p19"), 19, 0);
+            vw_world_add_time(w, "say \"hi\"\\", 3);
+            vw_world_set_balance_info(w, "my \"own\"", 1, 1, 0);
+            CHECK(vw_world_run(w) == VW_OK);
+            const char *path = "misuse_stats.json";
+            CHECK(vw_world_write_stats(w, path, "misuse", NULL) == VW_OK);
+            FILE *f = fopen(path, "r");
+            CHECK(f != NULL);
+            static char json[65536];
+            size_t n = fread(json, 1, sizeof json - 1, f);
+            json[n] = 0;
+            fclose(f);
+            remove(path);
+            CHECK(strstr(json, "\"a phase whose name is longer than sixteen bytes\": 2.5") != NULL);
+            CHECK(strstr(json, "\"p19\": 19.0") != NULL);
+            CHECK(strstr(json, "\"say \\\"hi\\\"\\\\\": 3.0") != NULL);
+            CHECK(strstr(json, "\"strategy\": \"my \\\"own\\\"\"") != NULL);
         } else if (!strcmp(mode, "post")) {
             int x = 0;
             CHECK(vw_world_post(w, 1, 1, &x) == VW_E_INVAL);

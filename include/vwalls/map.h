@@ -38,7 +38,8 @@ VW_API vw_status vw_map_block(const vw_decomp *d, int nprocs, int wpp, int *cell
 
 /* Greedy (over-decomposition): cells sorted by load, longest first, each to the worker
    that finishes it first (load / speed); among workers within `slack` (relative) of the
-   best, one already hosting a face neighbour is preferred. speeds NULL = all equal. */
+   best, one already hosting a face neighbour is preferred. speeds NULL = all equal;
+   VW_E_INVAL for a speed that is not positive and finite, or a negative slack. */
 VW_API vw_status vw_map_greedy(const vw_decomp *d, const double *cell_load, int gworkers,
                                const double *speeds, double slack, int *cell_worker);
 

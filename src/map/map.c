@@ -9,6 +9,7 @@
 #include "core/world_internal.h"
 #include "vwalls/map.h"
 
+#include <limits.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -145,7 +146,11 @@ static int cmp_load_desc(const void *a, const void *b)
 vw_status vw_map_greedy(const vw_decomp *d, const double *cell_load, int gworkers,
                         const double *speeds, double slack, int *cell_worker)
 {
-    if (!d || gworkers < 1 || !cell_worker) return VW_E_INVAL;
+    if (!d || gworkers < 1 || !cell_worker || !(slack >= 0)) return VW_E_INVAL;
+    /* A speed that is not positive (or a negative slack) left no worker within the
+       slack of the best, and the cell went to worker -1, past the start of t. */
+    for (int g = 0; speeds && g < gworkers; g++)
+        if (!(speeds[g] > 0) || !isfinite(speeds[g])) return VW_E_INVAL;
     int nc = vw_decomp_cell_count(d);
     int *order = malloc(sizeof(int) * (size_t)nc);
     double *ones = NULL, *t = calloc((size_t)gworkers, sizeof *t);
@@ -209,6 +214,8 @@ vw_status vw_map_weighted(const vw_decomp *d, const double *cell_load, int gwork
 vw_status vw_map_compute(vw_map_kind kind, const vw_decomp *d, const double *cell_load,
                          int nprocs, int wpp, const double *speeds, int *cell_worker)
 {
+    /* nprocs * wpp is the worker count: it must be an int (a signed overflow before). */
+    if (nprocs < 1 || wpp < 1 || nprocs > INT_MAX / wpp) return VW_E_INVAL;
     switch (kind) {
     case VW_MAP_BLOCK: return vw_map_block(d, nprocs, wpp, cell_worker);
     case VW_MAP_GREEDY: return vw_map_greedy(d, cell_load, nprocs * wpp, speeds, 0.05, cell_worker);

@@ -499,6 +499,29 @@ static int t_map(void)
         }
         vw_decomp_free(d);
     }
+    /* Bad speeds or slack are refused: a speed <= 0 (or a negative slack) left no
+       worker near the best, and the cell went to worker -1 (a write before t[0]). */
+    {
+        int dims[3] = {2, 2, 2};
+        vw_decomp *d;
+        vw_decomp_create_grid(&world, dims, &d);
+        double load[8] = {1, 2, 3, 4, 5, 6, 7, 8};
+        int cw[8];
+        const double bad[][4] = {{1, 1, 1, -1}, {1, 0, 1, 1}, {1, NAN, 1, 1}, {1, 1, INFINITY, 1}};
+        for (int i = 0; i < 4; i++) {
+            EXPECT(vw_map_greedy(d, load, 4, bad[i], 0.05, cw) == VW_E_INVAL, "speeds %d", i);
+            EXPECT(vw_map_weighted(d, load, 4, bad[i], cw) == VW_E_INVAL, "speeds %d", i);
+            EXPECT(vw_map_compute(VW_MAP_GREEDY, d, load, 2, 2, bad[i], cw) == VW_E_INVAL,
+                   "speeds %d", i);
+        }
+        EXPECT(vw_map_greedy(d, load, 4, NULL, -1, cw) == VW_E_INVAL, "slack -1");
+        EXPECT(vw_map_greedy(d, load, 4, NULL, NAN, cw) == VW_E_INVAL, "slack NaN");
+        /* 65536 x 65536 workers are more than an int counts. */
+        EXPECT(vw_map_compute(VW_MAP_GREEDY, d, load, 65536, 65536, NULL, cw) == VW_E_INVAL,
+               "workers overflow");
+        EXPECT(vw_map_compute(VW_MAP_BLOCK, d, load, 0, 2, NULL, cw) == VW_E_INVAL, "0 processes");
+        vw_decomp_free(d);
+    }
     return vw_test_failures ? 1 : 0;
 }
 

@@ -82,11 +82,18 @@ vw_status vw_edit_parse(const char *line, const char *name, int lineno, vw_edit 
     if (len >= sizeof buf) return fail(err, errlen, name, lineno, "line too long");
     memcpy(buf, line, len);
     buf[len] = 0;
+    /* Words cut by hand, not by strtok: its hidden state is shared with the caller (who
+       may be cutting a script into lines with strtok, and found the rest gone after the
+       first line) and with every other thread. */
     char *w[MAX_WORDS + 1];
     int n = 0;
-    for (char *t = strtok(buf, " \t\v\f"); t; t = strtok(NULL, " \t\v\f")) {
+    for (char *q = buf;;) {
+        while (*q && strchr(" \t\v\f", *q)) q++;
+        if (!*q) break;
         if (n == MAX_WORDS + 1) return fail(err, errlen, name, lineno, "too many words");
-        w[n++] = t;
+        w[n++] = q;
+        while (*q && !strchr(" \t\v\f", *q)) q++;
+        if (*q) *q++ = 0;
     }
     if (n == 0) return VW_OK; /* blank or comment */
     const cmd *c = NULL;

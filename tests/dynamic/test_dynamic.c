@@ -91,6 +91,22 @@ static void test_primitives(void)
     CHECK(vw_shape_collide(&s_in, NULL, &box, tol));
     CHECK(!vw_shape_collide(&s_out, NULL, &box, tol));
     CHECK(vw_shape_collide(&s_out, (double[3]){-5, 0, 0}, &box, tol));
+    /* The parser leaves the caller's strtok alone: a script cut into lines with strtok
+       is parsed to its end (it once stopped after the first line, its words cut by
+       strtok, whose state then pointed into the parser's own buffer). */
+    char script[] = "move 1 1 0 0\nmoveto 2 0 0 0\n\t remove   3 # gone\n";
+    const vw_edit_op want[] = {VW_EDIT_MOVE, VW_EDIT_MOVETO, VW_EDIT_REMOVE};
+    int lines = 0;
+    for (char *line = strtok(script, "\n"); line; line = strtok(NULL, "\n")) {
+        vw_edit e;
+        char err[128];
+        CHECK(lines < 3);
+        CHECK(vw_edit_parse(line, "s", lines + 1, &e, err, sizeof err) == VW_OK);
+        CHECK_EQ_INT(e.op, want[lines]);
+        CHECK_EQ_INT(e.id, lines + 1);
+        lines++;
+    }
+    CHECK_EQ_INT(lines, 3);
 }
 
 /* ---- random scenes and scripts --------------------------------------------------------- */

@@ -53,7 +53,8 @@ VW_API vw_status vw_outfile_commit(vw_outfile *f, char *err, size_t errlen);
    (a device or a FIFO keeps what was already sent to it). Frees f; NULL is a no-op. */
 VW_API void vw_outfile_abort(vw_outfile *f);
 
-/* The whole of buf[0..len) to path: open, write, commit. */
+/* The whole of buf[0..len) to path: open, write, commit. buf may be NULL only when len
+   is 0 (VW_E_INVAL otherwise, and path is left as it was). */
 VW_API vw_status vw_outfile_write(const char *path, const void *buf, size_t len, char *err,
                                   size_t errlen);
 

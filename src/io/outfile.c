@@ -402,6 +402,12 @@ VW_API void vw_outfile_abort(vw_outfile *f)
 VW_API vw_status vw_outfile_write(const char *path, const void *buf, size_t len, char *err,
                                   size_t errlen)
 {
+    /* No bytes to write len of: refused before the file is touched (fwrite would have
+       read from NULL, and the commit put a file of garbage or nothing in place). */
+    if (!buf && len) {
+        vw__errf(err, errlen, "%s: no data to write", path ? path : "(null)");
+        return VW_E_INVAL;
+    }
     vw_outfile *f;
     vw_status st = vw_outfile_open(path, &f, err, errlen);
     if (st != VW_OK)

@@ -136,6 +136,13 @@ static void regular_files(void)
     CHECK(strstr(err, "Is a directory") != NULL);
     CHECK(S_ISDIR(mode_of(at("d"))));
     CHECK_EQ_INT(temps_in(dir), 0);
+    /* No buffer for a length: refused, the file as it was (fwrite read from NULL). */
+    CHECK_EQ_INT(vw_outfile_write(at("a.txt"), NULL, 5, err, sizeof err), VW_E_INVAL);
+    CHECK(strstr(err, "a.txt: no data") != NULL);
+    CHECK(strcmp(text_of(at("a.txt")), "three\n") == 0);
+    CHECK_EQ_INT(vw_outfile_write(at("empty.txt"), NULL, 0, err, sizeof err), VW_OK);
+    CHECK(strcmp(text_of(at("empty.txt")), "") == 0);
+    CHECK_EQ_INT(temps_in(dir), 0);
 }
 
 static void symbolic_links(void)

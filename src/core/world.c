@@ -198,6 +198,15 @@ vw_status vw_world_create(const vw_module *m, void *user, const vw_decomp *d, co
         return create_failed(VW_E_INVAL, "module '%s': %d message kinds and %d counters (at most %d "
                              "and %d)", m->name ? m->name : "?", m->nkinds, m->ncounters, VW_MAX_KINDS,
                              VW_MAX_COUNTERS);
+    /* The tables the counts promise: read at every send and in the stats JSON. */
+    if ((m->nkinds > 0 && !m->kinds) || (m->ncounters > 0 && !m->counters))
+        return create_failed(VW_E_INVAL, "module '%s': %d message kinds and %d counters, but no "
+                             "table of %s", m->name ? m->name : "?", m->nkinds, m->ncounters,
+                             m->nkinds > 0 && !m->kinds ? "kinds" : "counter names");
+    for (int k = 0; k < m->ncounters; k++)
+        if (!m->counters[k])
+            return create_failed(VW_E_INVAL, "module '%s': counter %d has no name",
+                                 m->name ? m->name : "?", k);
     if (m->object_size && !m->object_bounds)
         return create_failed(VW_E_INVAL, "module '%s': objects without object_bounds",
                              m->name ? m->name : "?");

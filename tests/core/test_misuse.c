@@ -97,6 +97,20 @@ int main(int argc, char **argv)
         printf("workers: %s\n", vw_world_errmsg(NULL));
         CHECK(strstr(vw_world_errmsg(NULL), "5000 workers") != NULL);
         cfg.workers = 2;
+        /* Counts without their tables: the first send or the stats JSON read NULL. */
+        bad = m;
+        bad.kinds = NULL;
+        CHECK(vw_world_create(&bad, NULL, d, &cfg, &w) == VW_E_INVAL && !w);
+        printf("kinds: %s\n", vw_world_errmsg(NULL));
+        CHECK(strstr(vw_world_errmsg(NULL), "no table of kinds") != NULL);
+        bad = m;
+        bad.counters = NULL;
+        CHECK(vw_world_create(&bad, NULL, d, &cfg, &w) == VW_E_INVAL && !w);
+        CHECK(strstr(vw_world_errmsg(NULL), "no table of counter names") != NULL);
+        static const char *const unnamed[] = {NULL};
+        bad.counters = unnamed;
+        CHECK(vw_world_create(&bad, NULL, d, &cfg, &w) == VW_E_INVAL && !w);
+        CHECK(strstr(vw_world_errmsg(NULL), "counter 0 has no name") != NULL);
         CHECK(vw_world_create(&m, NULL, d, &cfg, &w) == VW_OK);
         CHECK(!strcmp(vw_world_errmsg(NULL), "no world")); /* a success clears it */
     } else {

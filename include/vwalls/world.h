@@ -39,7 +39,8 @@ typedef struct vw_config {
        MPI_Finalize); NULL = MPI_COMM_WORLD if MPI is initialised or the process was
        started by a launcher, else the threads engine alone. */
     const void *mpi_comm;
-    /* Per-worker slow-down factor for emulating unequal machines (NULL = none). */
+    /* Per-worker slow-down factor for emulating unequal machines: processes x workers
+       entries, copied at create (NULL = none). */
     const double *worker_slowdown;
     /* Farmed work (vw_ctx_next_batch): a copy of a cell whose turns are used up takes
        the turns the cell's other copies in its process have not taken. 1 = on, 0 = off

@@ -168,6 +168,20 @@ static void free_cells(vw_world *w)
     w->cell_worker = NULL;
 }
 
+/* cfg.worker_slowdown, one per global worker, into the world's own copy: the workers
+   read it at every switch of cell, long after the caller's array may have gone. */
+static vw_status copy_slowdown(vw_world *w)
+{
+    const double *s = w->cfg.worker_slowdown;
+    w->cfg.worker_slowdown = NULL;
+    if (!s) return VW_OK;
+    w->slowdown = malloc(sizeof(double) * (size_t)w->gworkers);
+    if (!w->slowdown) return VW_E_NOMEM;
+    memcpy(w->slowdown, s, sizeof(double) * (size_t)w->gworkers);
+    w->cfg.worker_slowdown = w->slowdown;
+    return VW_OK;
+}
+
 /* cfg.worker_speeds, one per global worker, into the world's own copy. */
 static vw_status copy_speeds(vw_world *w)
 {
@@ -273,6 +287,7 @@ vw_status vw_world_create(const vw_module *m, void *user, const vw_decomp *d, co
         if (!wk->out || !wk->tr_proc) st = VW_E_NOMEM;
     }
     if (st == VW_OK) st = copy_speeds(w);
+    if (st == VW_OK) st = copy_slowdown(w);
     if (st == VW_OK) st = map_cells(w, c ? c->cell_worker : NULL);
     if (st != VW_OK) {
         create_failed(st, "%s", w->err != VW_OK ? w->errmsg : vw_status_message(st));
@@ -290,6 +305,7 @@ void vw_world_free(vw_world *w)
     if (w->transport) w->transport->free(w);
     free(w->wstats);
     free(w->speeds);
+    free(w->slowdown);
     free_cells(w);
     if (w->workers) {
         for (int i = 0; i < w->nworkers; i++) {

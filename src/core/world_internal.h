@@ -172,6 +172,7 @@ struct vw_world {
     int gworkers;              /* all processes */
     int steal;                 /* cfg.steal decided (vw_ctx_next_batch) */
     double *speeds;            /* cfg.worker_speeds copied (gworkers), or NULL */
+    double *slowdown;          /* cfg.worker_slowdown copied (gworkers), or NULL */
     int ncells;
     vw__cell *cells;
     int *cell_worker;          /* cell -> global worker */

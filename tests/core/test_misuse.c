@@ -4,6 +4,7 @@
  *   redecompose   a bad mapping is refused and leaves the world as it was
  *   limits   counts whose bytes overflow a size_t are refused, not wrapped
  *   stats    phase names of any length and number, escaped in the stats JSON
+ *   slowdown vw_config.worker_slowdown is copied at create, like the speeds
  *   send | output | count   a module's bad send or count stops the process (abort)
  *            with a message on stderr: run in a child, whose end and stderr are checked
  * Usage: test_misuse MODE [EXPECTED-MESSAGE]
@@ -154,6 +155,24 @@ int main(int argc, char **argv)
             CHECK(vw_world_create(&m, NULL, d, &cfg, &w2) == VW_E_LIMIT && !w2);
             printf("packets: %s\n", vw_world_errmsg(NULL));
             CHECK(strstr(vw_world_errmsg(NULL), "packets of") != NULL);
+        } else if (!strcmp(mode, "slowdown")) {
+            /* The factors are the world's copy: what the caller's array holds after
+               create (here a slow-down that would spin for days) does not matter. */
+            vw_world *w2 = NULL;
+            double *slow = malloc(2 * sizeof *slow);
+            CHECK(slow != NULL);
+            slow[0] = slow[1] = 1.0;
+            cfg.worker_slowdown = slow;
+            CHECK(vw_world_create(&m, NULL, d, &cfg, &w2) == VW_OK);
+            slow[0] = slow[1] = 1e12;
+            CHECK(vw_world_add_objects(w2, o, 2) == VW_OK);
+            int x = 0;
+            CHECK(vw_world_post(w2, 0, 0, &x) == VW_OK);
+            CHECK(vw_world_run(w2) == VW_OK);
+            free(slow);
+            CHECK(vw_world_post(w2, 1, 0, &x) == VW_OK);
+            CHECK(vw_world_run(w2) == VW_OK);
+            vw_world_free(w2);
         } else if (!strcmp(mode, "stats")) {
             const char *lng = "a phase whose name is longer than sixteen bytes";
             vw_world_add_time(w, lng, 1.5);

@@ -384,6 +384,22 @@ static int prepare(vw_dynscene *ds, const vw_edit *e, int next_id, vw_result *r,
     r->outcome = VW_OUT_ACCEPTED;
     r->obstacle = -1;
     r->id = e->id;
+    /* vw_edit_parse's checks of the numbers, for edits a program made itself: a sphere
+       of radius <= 0 was added, and the scene written then failed to read back. */
+    int nv = e->op == VW_EDIT_ADD || e->op == VW_EDIT_ROTATE ? 4 : e->op == VW_EDIT_REMOVE ? 0 : 3;
+    for (int k = 0; k < nv; k++)
+        if (!isfinite(e->v[k])) {
+            invalid(r, "a number of the edit is not finite", 0);
+            return 0;
+        }
+    if (e->op == VW_EDIT_ADD && !(e->v[3] > 0)) {
+        invalid(r, "sphere radius must be > 0", 0);
+        return 0;
+    }
+    if (e->op == VW_EDIT_ROTATE && e->v[0] == 0 && e->v[1] == 0 && e->v[2] == 0) {
+        invalid(r, "rotation axis of object %d is zero", e->id);
+        return 0;
+    }
     if (e->op == VW_EDIT_ADD) {
         if (e->material >= 0 && (size_t)e->material >= ds->s->nmaterials) {
             invalid(r, "no material %d in the scene", e->material);

@@ -427,6 +427,32 @@ static void test_tunnel(int workers)
         free(ch);
         CHECK_EQ_INT(r.outcome, VW_OUT_COLLISION);
         CHECK_EQ_INT(r.obstacle, 1);
+        /* Edits a program made itself get the parser's checks: a sphere of radius <= 0
+           is not added (the scene written would not read back), a zero axis is named. */
+        const vw_edit hand[] = {{VW_EDIT_ADD, 0, {4, -4, 4, -1}, -1},
+                                {VW_EDIT_ADD, 0, {-4, -4, 4, 0}, -1},
+                                {VW_EDIT_MOVE, 2, {NAN, 0, 0}, -1},
+                                {VW_EDIT_ROTATE, 1, {0, 0, 0, 90}, -1}};
+        const char *why[] = {"radius", "radius", "not finite", "axis of object 1 is zero"};
+        for (int i = 0; i < 4; i++) {
+            CHECK(vw_dynscene_apply(ds, &hand[i], 1, 1, 1, &r, &ch, &nch) == VW_OK);
+            free(ch);
+            CHECK_EQ_INT(r.outcome, VW_OUT_INVALID);
+            CHECK(strstr(r.msg, why[i]) != NULL);
+        }
+        CHECK_EQ_INT(vw_dynscene_ids(ds), 3);
+        FILE *f = tmpfile();
+        CHECK(f && vw_dynscene_write_nff(ds, f) == VW_OK);
+        long len = ftell(f);
+        char *text = malloc((size_t)len);
+        rewind(f);
+        CHECK(text && fread(text, 1, (size_t)len, f) == (size_t)len);
+        fclose(f);
+        vw_scene *back;
+        CHECK(vw_scene_read_nff("written", text, (size_t)len, &back, err, sizeof err) == VW_OK);
+        CHECK_EQ_INT(vw_scene_count_objects(back), 3);
+        vw_scene_free(back);
+        free(text);
         vw_dynscene_free(ds);
     }
     vw_decomp_free(d);

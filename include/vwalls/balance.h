@@ -72,14 +72,17 @@ typedef struct vw_load_field vw_load_field;
 
 VW_API vw_status vw_load_field_create(vw_load_field **out);
 VW_API void vw_load_field_free(vw_load_field *f);
-/* A point mass of load w at world point p (modules may add their own samples). */
+/* A point mass of load w at world point p (modules may add their own samples).
+   VW_E_INVAL for a weight that is negative or not finite, or a point that is not. */
 VW_API vw_status vw_load_field_add_point(vw_load_field *f, const double p[3], double w);
 /* Adds each cell's load spread uniformly over its box (k^3 points per cell, k >= 1). */
 VW_API vw_status vw_load_field_add_cells(vw_load_field *f, const vw_decomp *d,
                                          const double *cell_load, int k);
 /* Re-calibration by a new measurement on decomposition d: inside every cell the
    field's points are scaled so that they sum to cell_load[c]; a cell with load but
-   no points gets k^3 uniform points. Keeps the old field's detail below the cells. */
+   no points gets k^3 uniform points. Keeps the old field's detail below the cells.
+   A load that is not positive counts as 0; an infinite one is VW_E_INVAL (the field
+   is then unchanged). */
 VW_API vw_status vw_load_field_calibrate(vw_load_field *f, const vw_decomp *d,
                                          const double *cell_load, int k);
 /* The field's load per cell of d (predicted loads), out[vw_decomp_cell_count(d)]. */

@@ -83,7 +83,10 @@ void vw_load_field_free(vw_load_field *f)
 
 vw_status vw_load_field_add_point(vw_load_field *f, const double p[3], double w)
 {
+    /* A point that is nowhere still counted in the balancers' totals: one NaN point of
+       weight 100 beside a uniform load of 4 squeezed every tensor wall to min_width. */
     if (!f || !p || !(w >= 0) || !isfinite(w)) return VW_E_INVAL;
+    if (!isfinite(p[0]) || !isfinite(p[1]) || !isfinite(p[2])) return VW_E_INVAL;
     if (f->n == f->cap) {
         size_t cap = f->cap ? 2 * f->cap : 1024;
         double(*np)[3] = realloc(f->p, cap * sizeof *np);
@@ -158,6 +161,10 @@ vw_status vw_load_field_calibrate(vw_load_field *f, const vw_decomp *d, const do
 {
     if (!f || !d || !cell_load || k < 1 || k > 64) return VW_E_INVAL;
     int nc = vw_decomp_cell_count(d);
+    /* An infinite load would scale its cell's points to infinite weights (which
+       add_point refuses); checked before the field is touched. */
+    for (int c = 0; c < nc; c++)
+        if (cell_load[c] == INFINITY) return VW_E_INVAL;
     double *pred = calloc((size_t)nc, sizeof *pred);
     int *cell = locate_all(f, d);
     if (!pred || !cell) {

@@ -674,10 +674,45 @@ static int t_duplicate(void)
     return vw_test_failures ? 1 : 0;
 }
 
+/* ---- the load field's inputs ------------------------------------------------------------ */
+
+/* Points and loads that are not finite are refused and leave the field as it was: one
+   NaN point once squeezed every tensor wall to min_width, an infinite load made
+   infinite weights. */
+static int t_field(void)
+{
+    vw_box world = {{0, 0, 0}, {1, 1, 1}};
+    int dims[3] = {4, 1, 1};
+    vw_decomp *d;
+    vw_decomp_create_grid(&world, dims, &d);
+    double loads[4] = {1, 1, 1, 1};
+    vw_load_field *f;
+    vw_load_field_create(&f);
+    vw_load_field_add_cells(f, d, loads, 2);
+    const double bad[][3] = {{NAN, 0.5, 0.5}, {0.5, INFINITY, 0.5}, {0.5, 0.5, -INFINITY}};
+    for (int i = 0; i < 3; i++)
+        EXPECT(vw_load_field_add_point(f, bad[i], 100) == VW_E_INVAL, "point %d", i);
+    const double inf_load[4] = {1, INFINITY, 1, 1};
+    EXPECT(vw_load_field_calibrate(f, d, inf_load, 2) == VW_E_INVAL, "infinite load");
+    EXPECT(vw_load_field_total(f) == 4.0, "total %g", vw_load_field_total(f));
+    vw_balance_params p;
+    vw_balance_params_init(&p);
+    p.strategy = VW_BALANCE_TENSOR;
+    vw_decomp *nd = NULL;
+    EXPECT(vw_balance_decompose(d, f, &p, &nd, NULL) == VW_OK, "tensor");
+    const double *walls = nd ? vw_decomp_grid_walls(nd, 0) : NULL;
+    for (int i = 0; walls && i < 3; i++)
+        EXPECT(fabs(walls[i] - 0.25 * (i + 1)) < 1e-12, "wall %d at %g", i, walls[i]);
+    vw_decomp_free(nd);
+    vw_load_field_free(f);
+    vw_decomp_free(d);
+    return vw_test_failures ? 1 : 0;
+}
+
 int main(int argc, char **argv)
 {
     if (argc < 2) {
-        fprintf(stderr, "usage: bal_test identical|conserve|staggered8|divide16|rotate|map|duplicate [...]\n");
+        fprintf(stderr, "usage: bal_test identical|conserve|staggered8|divide16|rotate|map|duplicate|field [...]\n");
         return 2;
     }
     const char *cmd = argv[1];
@@ -688,6 +723,7 @@ int main(int argc, char **argv)
     if (!strcmp(cmd, "divide16")) return t_divide16();
     if (!strcmp(cmd, "map")) return t_map();
     if (!strcmp(cmd, "duplicate")) return t_duplicate();
+    if (!strcmp(cmd, "field")) return t_field();
     fprintf(stderr, "bal_test: unknown test '%s'\n", cmd);
     return 2;
 }

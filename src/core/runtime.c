@@ -694,11 +694,17 @@ vw_status vw__runtime_run(vw_world *w)
         }
         c->farmed = c->nreps > 0 && local == w->nworkers;
     }
-    /* Posted messages: counted like any packet. */
+    /* Posted messages (every process holds them all): to the worker that hosts the
+       cell now, if it is one of this process's; counted like any packet. */
     while (w->posted) {
         vw__packet *p = w->posted;
         w->posted = p->next;
-        vw__deliver(w, NULL, p);
+        p->next = NULL;
+        p->dest = w->cell_worker[((const vw__msg_header *)p->data)->cell];
+        if (vw__worker_process(w, p->dest) == w->rank)
+            vw__deliver(w, NULL, p);
+        else
+            free(p);
     }
     vw_status st = VW_OK;
     int failed = pool_start(w);

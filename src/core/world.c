@@ -521,8 +521,11 @@ vw_status vw_world_post(vw_world *w, int cell, int kind, const void *msg)
     if (!w->m->kinds[kind].handle)
         return vw__world_error(w, VW_E_INVAL, "posted message kind %d to cell %d, but the kind "
                                "has no handle", kind, cell);
+    /* Every process keeps the message and the run gives it to the cell's worker then:
+       a remap or a new decomposition may still move the cell (to another worker, or
+       another process) before the run, and the worker chosen now received a message
+       for a cell it no longer hosted (an abort, or a read past the cells). */
     int dest = w->cell_worker[cell];
-    if (vw__worker_process(w, dest) != w->rank) return VW_OK; /* its own process posts it */
     size_t size = w->m->kinds[kind].size;
     size_t stride = sizeof(vw__msg_header) + ((size + 7) & ~(size_t)7);
     vw__packet *p = vw__packet_new(dest, -1, stride);
@@ -560,6 +563,15 @@ vw_status vw_world_redecompose(vw_world *w, const vw_decomp *d, const int *cell_
         if (cell_worker[c] < 0 || cell_worker[c] >= w->gworkers)
             return vw__world_error(w, VW_E_INVAL, "mapping sends cell %d to worker %d of %d", c,
                                    cell_worker[c], w->gworkers);
+    /* A message posted for the next run is delivered to its cell of the decomposition
+       then in force (vw_world_post): that cell must still exist. */
+    for (const vw__packet *p = w->posted; p; p = p->next) {
+        int cell = ((const vw__msg_header *)p->data)->cell;
+        if (cell >= vw_decomp_cell_count(d))
+            return vw__world_error(w, VW_E_STATE, "a message posted to cell %d waits for the "
+                                   "next run, and the new decomposition has %d cells", cell,
+                                   vw_decomp_cell_count(d));
+    }
     /* Which worker held each object before, to count migrations. */
     size_t n = w->nobjects;
     unsigned char *held = calloc(n ? n * (size_t)w->gworkers : 1, 1);

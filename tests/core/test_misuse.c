@@ -1,7 +1,8 @@
 /* test_misuse.c - a module's mistakes get a message, never silence:
  *   create   a world that cannot be created says why through vw_world_errmsg(NULL)
  *   post     posting a kind without handle is VW_E_INVAL with a message
- *   redecompose   a bad mapping is refused and leaves the world as it was
+ *   redecompose   a bad mapping is refused and leaves the world as it was; messages
+ *            posted before new walls or a new mapping reach their cell
  *   limits   counts whose bytes overflow a size_t are refused, not wrapped
  *   stats    phase names of any length and number, escaped in the stats JSON
  *   slowdown vw_config.worker_slowdown is copied at create, like the speeds
@@ -142,6 +143,23 @@ int main(int argc, char **argv)
             CHECK(vw_world_cell_stats(w, 1, &cs) == VW_OK && cs.messages_in == 1 && cs.objects == 1);
             map[3] = 1;
             CHECK(vw_world_redecompose(w, d2, map) == VW_OK);
+            CHECK(vw_world_run(w) == VW_OK);
+            /* A message posted before a remap goes to its cell's new worker (it went to
+               the old one, which aborted: "received a message for cell 1, which it does
+               not host"). */
+            int swap[4] = {1, 0, 1, 0};
+            CHECK(vw_world_post(w, 1, 0, &x) == VW_OK);
+            CHECK(vw_world_remap(w, swap) == VW_OK);
+            CHECK(vw_world_run(w) == VW_OK);
+            CHECK(vw_world_cell_stats(w, 1, &cs) == VW_OK && cs.messages_in == 1);
+            /* New walls without the cell a posted message waits for are refused (the
+               message was handed to cell 3 of a world of 2 cells: a read past them). */
+            CHECK(vw_world_post(w, 3, 0, &x) == VW_OK);
+            CHECK(vw_world_redecompose(w, d, NULL) == VW_E_STATE);
+            CHECK(vw_decomp_equal(vw_world_decomp(w), d2));
+            CHECK(vw_world_run(w) == VW_OK);
+            CHECK(vw_world_cell_stats(w, 3, &cs) == VW_OK && cs.messages_in == 1);
+            CHECK(vw_world_redecompose(w, d, NULL) == VW_OK);
             CHECK(vw_world_run(w) == VW_OK);
             vw_decomp_free(d2);
         } else if (!strcmp(mode, "limits")) {

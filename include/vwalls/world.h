@@ -155,7 +155,7 @@ VW_API void vw_world_set_balance_info(vw_world *w, const char *strategy, double 
 /* The stats JSON (docs/runtime.md, Statistics), written by the output process only,
    through vw_outfile (vwalls/outfile.h: complete or absent). extra_json: more
    top-level members ("\"rays\": {...}") or NULL. On failure vw_world_errmsg() says
-   "path: reason". */
+   "path: reason", unless the world already holds an earlier error (the first is kept). */
 VW_API vw_status vw_world_write_stats(vw_world *w, const char *path, const char *command,
                                       const char *extra_json);
 

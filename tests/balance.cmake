@@ -20,9 +20,10 @@ add_test(NAME balance_divide16 COMMAND vw_test_balance divide16)
 add_test(NAME balance_map COMMAND vw_test_balance map)
 add_test(NAME balance_duplicate COMMAND vw_test_balance duplicate)
 add_test(NAME balance_field COMMAND vw_test_balance field)
+add_test(NAME balance_concurrent COMMAND vw_test_balance concurrent)
 set_tests_properties(balance_identical_spheres balance_identical_mixed balance_conserve
   balance_staggered8 balance_divide16 balance_rotate balance_map balance_duplicate
-  balance_field PROPERTIES LABELS "balance;threads"
+  balance_field balance_concurrent PROPERTIES LABELS "balance;threads"
   ENVIRONMENT "${VW_BAL_TSAN}")
 
 # The command line: PNG bytes equal for every --balance and --map, under the threads

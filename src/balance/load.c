@@ -220,20 +220,25 @@ long vw__field_points(const vw_load_field *f, const double *F, vw__lpt **out)
 
 /* ---- the weighted-quantile cut -------------------------------------------------------- */
 
-static int cut_axis;
-static int cmp_axis(const void *a, const void *b)
-{
-    double x = ((const vw__lpt *)a)->x[cut_axis], y = ((const vw__lpt *)b)->x[cut_axis];
-    return x < y ? -1 : x > y;
-}
+/* One comparator per axis, not one reading the axis from a file-static variable:
+   vw_balance_decompose is public, and two threads balancing two worlds at once set
+   each other's axis in the middle of a sort (a tensor balance then came out wrong in
+   about one call of ten). */
+#define CMP_AXIS(name, a)                                                                 \
+    static int name(const void *p, const void *q)                                         \
+    {                                                                                     \
+        double x = ((const vw__lpt *)p)->x[a], y = ((const vw__lpt *)q)->x[a];            \
+        return x < y ? -1 : x > y;                                                        \
+    }
+CMP_AXIS(cmp_x, 0)
+CMP_AXIS(cmp_y, 1)
+CMP_AXIS(cmp_z, 2)
 
 void vw__cut(vw__lpt *pts, long n, int axis, double lo, double hi, int parts, double minw,
              double *walls)
 {
     if (parts < 2) return;
-    /* qsort with a file-static axis: the balancers run on one thread between runs. */
-    cut_axis = axis;
-    if (n > 1) qsort(pts, (size_t)n, sizeof *pts, cmp_axis);
+    if (n > 1) qsort(pts, (size_t)n, sizeof *pts, axis == 0 ? cmp_x : axis == 1 ? cmp_y : cmp_z);
     /* Points with equal coordinates form one group (a cell's k x k sub-grid points share
        their x): each group's mass is spread evenly between the midpoints to the groups
        beside it, so the cumulative load is piecewise linear, as for uniform cells. */

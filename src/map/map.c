@@ -135,12 +135,19 @@ vw_status vw_map_block(const vw_decomp *d, int nprocs, int wpp, int *cell_worker
 
 /* ---- greedy and weighted ----------------------------------------------------------------- */
 
-static const double *sort_load;
+/* A cell and its load, sorted together: the comparator reads no file-static array,
+   which two threads mapping at once overwrote in each other's sort (a wrong mapping in
+   about one call of ten). */
+typedef struct ranked_cell {
+    double load;
+    int cell;
+} ranked_cell;
+
 static int cmp_load_desc(const void *a, const void *b)
 {
-    int x = *(const int *)a, y = *(const int *)b;
-    if (sort_load[x] != sort_load[y]) return sort_load[x] > sort_load[y] ? -1 : 1;
-    return x - y; /* ties by id: every process computes the same mapping */
+    const ranked_cell *x = a, *y = b;
+    if (x->load != y->load) return x->load > y->load ? -1 : 1;
+    return x->cell - y->cell; /* ties by id: every process computes the same mapping */
 }
 
 vw_status vw_map_greedy(const vw_decomp *d, const double *cell_load, int gworkers,
@@ -152,7 +159,7 @@ vw_status vw_map_greedy(const vw_decomp *d, const double *cell_load, int gworker
     for (int g = 0; speeds && g < gworkers; g++)
         if (!(speeds[g] > 0) || !isfinite(speeds[g])) return VW_E_INVAL;
     int nc = vw_decomp_cell_count(d);
-    int *order = malloc(sizeof(int) * (size_t)nc);
+    ranked_cell *order = malloc(sizeof *order * (size_t)nc);
     double *ones = NULL, *t = calloc((size_t)gworkers, sizeof *t);
     if (!cell_load) {
         ones = malloc(sizeof(double) * (size_t)nc);
@@ -165,14 +172,13 @@ vw_status vw_map_greedy(const vw_decomp *d, const double *cell_load, int gworker
         return VW_E_NOMEM;
     }
     for (int c = 0; c < nc; c++) {
-        order[c] = c;
+        order[c] = (ranked_cell){cell_load[c], c};
         cell_worker[c] = -1;
     }
-    sort_load = cell_load;
     qsort(order, (size_t)nc, sizeof *order, cmp_load_desc);
     int nb[64];
     for (int i = 0; i < nc; i++) {
-        int c = order[i];
+        int c = order[i].cell;
         double l = cell_load[c] > 0 ? cell_load[c] : 0;
         /* Longest processing time first: the worker that would finish this cell first. */
         double best = INFINITY;

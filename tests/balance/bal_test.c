@@ -17,6 +17,7 @@
  *                         of a 50%-clustered scene down to <= 1.10 on 8 cells
  */
 #include <math.h>
+#include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -709,10 +710,82 @@ static int t_field(void)
     return vw_test_failures ? 1 : 0;
 }
 
+/* ---- two threads balancing at once ------------------------------------------------------ */
+
+/* The mappers and balancers are plain functions of their inputs: two threads running
+   them at once on different loads get what each gets alone. (Their sorts once read a
+   file-static array or axis that the other thread's call overwrote.) */
+typedef struct side {
+    vw_decomp *d;
+    double *load;
+    vw_load_field *f;
+    int *map;          /* vw_map_greedy alone */
+    vw_decomp *walls;  /* the tensor balance alone */
+    int wrong;
+} side;
+
+static void *side_run(void *arg)
+{
+    side *s = arg;
+    int nc = vw_decomp_cell_count(s->d);
+    int *cw = malloc(sizeof(int) * (size_t)nc);
+    vw_balance_params p;
+    vw_balance_params_init(&p);
+    p.strategy = VW_BALANCE_TENSOR;
+    for (int it = 0; it < 100; it++) {
+        vw_map_greedy(s->d, s->load, 7, NULL, 0.05, cw);
+        s->wrong += memcmp(cw, s->map, sizeof(int) * (size_t)nc) != 0;
+        vw_decomp *nd = NULL;
+        vw_balance_decompose(s->d, s->f, &p, &nd, NULL);
+        s->wrong += !vw_decomp_equal(nd, s->walls);
+        vw_decomp_free(nd);
+    }
+    free(cw);
+    return NULL;
+}
+
+static int t_concurrent(void)
+{
+    vw_box world = {{0, 0, 0}, {1, 1, 1}};
+    int dims[3] = {16, 16, 8};
+    vw_decomp *d;
+    vw_decomp_create_grid(&world, dims, &d);
+    int nc = vw_decomp_cell_count(d);
+    side sd[2];
+    vw_balance_params p;
+    vw_balance_params_init(&p);
+    p.strategy = VW_BALANCE_TENSOR;
+    for (int k = 0; k < 2; k++) {
+        sd[k].d = d;
+        sd[k].load = malloc(sizeof(double) * (size_t)nc);
+        sd[k].map = malloc(sizeof(int) * (size_t)nc);
+        for (int c = 0; c < nc; c++) sd[k].load[c] = k ? (double)((c * 37) % 101) : (double)(nc - c);
+        CHECK(vw_map_greedy(d, sd[k].load, 7, NULL, 0.05, sd[k].map) == VW_OK);
+        vw_load_field_create(&sd[k].f);
+        vw_load_field_add_cells(sd[k].f, d, sd[k].load, 1);
+        CHECK(vw_balance_decompose(d, sd[k].f, &p, &sd[k].walls, NULL) == VW_OK);
+        sd[k].wrong = 0;
+    }
+    pthread_t th[2];
+    for (int k = 0; k < 2; k++) CHECK(pthread_create(&th[k], NULL, side_run, &sd[k]) == 0);
+    for (int k = 0; k < 2; k++) pthread_join(th[k], NULL);
+    printf("concurrent: %d and %d of 200 results differ from the thread's alone\n", sd[0].wrong,
+           sd[1].wrong);
+    for (int k = 0; k < 2; k++) {
+        EXPECT(sd[k].wrong == 0, "thread %d: %d wrong results", k, sd[k].wrong);
+        free(sd[k].load);
+        free(sd[k].map);
+        vw_load_field_free(sd[k].f);
+        vw_decomp_free(sd[k].walls);
+    }
+    vw_decomp_free(d);
+    return vw_test_failures ? 1 : 0;
+}
+
 int main(int argc, char **argv)
 {
     if (argc < 2) {
-        fprintf(stderr, "usage: bal_test identical|conserve|staggered8|divide16|rotate|map|duplicate|field [...]\n");
+        fprintf(stderr, "usage: bal_test identical|conserve|staggered8|divide16|rotate|map|duplicate|field|concurrent [...]\n");
         return 2;
     }
     const char *cmd = argv[1];
@@ -724,6 +797,7 @@ int main(int argc, char **argv)
     if (!strcmp(cmd, "map")) return t_map();
     if (!strcmp(cmd, "duplicate")) return t_duplicate();
     if (!strcmp(cmd, "field")) return t_field();
+    if (!strcmp(cmd, "concurrent")) return t_concurrent();
     fprintf(stderr, "bal_test: unknown test '%s'\n", cmd);
     return 2;
 }

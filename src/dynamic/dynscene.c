@@ -741,11 +741,10 @@ vw_status vw_dynscene_apply(vw_dynscene *ds, const vw_edit *edits, size_t n, int
     *nchanged = 0;
     for (size_t i = 0; i < n; i++)
         if (!vw_edit_is_object(edits[i].op)) return VW_E_INVAL;
-    /* Every id the batch can name or create. */
+    /* Every id the batch can create, and so every id an accepted edit can name. A larger
+       id names no object (its edit is invalid, whatever else the run holds), so it needs
+       no byte: sized by the ids named, "remove 2000000000" cost 4 GB. */
     size_t maxid = (size_t)ds->nids + n + 1;
-    for (size_t i = 0; i < n; i++)
-        if (edits[i].op != VW_EDIT_ADD && edits[i].id >= 0 && (size_t)edits[i].id + 1 > maxid)
-            maxid = (size_t)edits[i].id + 1;
     unsigned char *bits = calloc(maxid, 1), *seen = calloc(maxid, 1);
     vw_status st = (bits && seen) ? VW_OK : VW_E_NOMEM;
     size_t nbits = 0, i = 0;

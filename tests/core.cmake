@@ -27,13 +27,15 @@ add_test(NAME core_misuse_create COMMAND test_misuse create)
 add_test(NAME core_misuse_post COMMAND test_misuse post)
 # Calls a careless or hostile program makes: a bad mapping for new walls leaves the world
 # as it was, counts too large for memory are refused, phases keep their names, the
-# slow-down factors are the world's own copy.
+# slow-down factors are the world's own copy, signals need no buffer.
 add_test(NAME core_misuse_redecompose COMMAND test_misuse redecompose)
 add_test(NAME core_misuse_limits COMMAND test_misuse limits)
 add_test(NAME core_misuse_stats COMMAND test_misuse stats)
 add_test(NAME core_misuse_slowdown COMMAND test_misuse slowdown)
+add_test(NAME core_misuse_signal COMMAND test_misuse signal)
 set_tests_properties(core_misuse_create core_misuse_post core_misuse_redecompose
-  core_misuse_limits core_misuse_stats core_misuse_slowdown PROPERTIES LABELS "core")
+  core_misuse_limits core_misuse_stats core_misuse_slowdown core_misuse_signal
+  PROPERTIES LABELS "core")
 # An overflowed size loops; a slow-down read from the caller's array spins: both hang.
 set_tests_properties(core_misuse_limits core_misuse_slowdown PROPERTIES TIMEOUT 30)
 foreach(case "send;sent message kind 1 to cell 0, but the kind has no handle"

@@ -78,9 +78,10 @@ VW_API const char *vw_world_errmsg(const vw_world *w);
 VW_API vw_status vw_world_add_objects(vw_world *w, const void *objects, size_t n);
 /* Build every cell (cell_build on the hosting worker). */
 VW_API vw_status vw_world_commit(vw_world *w);
-/* A message delivered to `cell` at the start of the next run (on the worker that hosts
-   the cell then, after any vw_world_remap or vw_world_redecompose in between; one that
-   leaves no cell `cell` is refused with VW_E_STATE while the message waits). */
+/* A message delivered to `cell` at the start of the next run, on the worker that hosts
+   the cell then (after any vw_world_remap or vw_world_redecompose in between; one that
+   leaves no cell `cell` is refused with VW_E_STATE while the message waits). msg may be
+   NULL for a kind of size 0. */
 VW_API vw_status vw_world_post(vw_world *w, int cell, int kind, const void *msg);
 /* Runs every cell to quiescence (no message in flight, every step() idle); commits
    first when objects or the decomposition changed since the last commit. */

@@ -211,7 +211,8 @@ static void enqueue(vw_ctx *ctx, int slot, int dest, int cell, int kind, const v
     h->cell = cell;
     h->kind = (uint16_t)kind;
     h->size = (uint16_t)size;
-    memcpy(p->data + p->used + sizeof *h, msg, size);
+    /* A kind of size 0 is a signal: its msg may be NULL, which memcpy may not get. */
+    if (size) memcpy(p->data + p->used + sizeof *h, msg, size);
     p->used += stride;
     p->nmsgs++;
     if (w->cfg.stress_split) {

@@ -516,7 +516,8 @@ vw_status vw_world_commit(vw_world *w)
 
 vw_status vw_world_post(vw_world *w, int cell, int kind, const void *msg)
 {
-    if (!w || !msg || cell < 0 || cell >= w->ncells || kind < 0 || kind >= w->m->nkinds)
+    if (!w || cell < 0 || cell >= w->ncells || kind < 0 || kind >= w->m->nkinds ||
+        (!msg && w->m->kinds[kind].size)) /* a kind of size 0 has nothing to point to */
         return VW_E_INVAL;
     if (!w->m->kinds[kind].handle)
         return vw__world_error(w, VW_E_INVAL, "posted message kind %d to cell %d, but the kind "
@@ -533,7 +534,7 @@ vw_status vw_world_post(vw_world *w, int cell, int kind, const void *msg)
     h->cell = cell;
     h->kind = (uint16_t)kind;
     h->size = (uint16_t)size;
-    memcpy(p->data + sizeof *h, msg, size);
+    if (size) memcpy(p->data + sizeof *h, msg, size); /* (msg may be NULL then) */
     p->used = stride;
     p->nmsgs = 1;
     p->next = w->posted;

@@ -6,6 +6,7 @@
  *   limits   counts whose bytes overflow a size_t are refused, not wrapped
  *   stats    phase names of any length and number, escaped in the stats JSON
  *   slowdown vw_config.worker_slowdown is copied at create, like the speeds
+ *   signal   kinds of size 0 are sent and posted with no buffer
  *   send | output | count   a module's bad send or count stops the process (abort)
  *            with a message on stderr: run in a child, whose end and stderr are checked
  * Usage: test_misuse MODE [EXPECTED-MESSAGE]
@@ -67,6 +68,33 @@ static const vw_msg_kind kinds[] = {
     {.name = "to_output", .size = sizeof(int), .output = output},
 };
 static const char *const counters[] = {"one"};
+
+/* Signals: kinds of size 0, sent and posted with no buffer (memcpy got NULL, and the
+   post was refused). */
+static int signals_in, signals_out;
+static void on_signal(vw_ctx *ctx, void *state, const void *msg)
+{
+    (void)ctx, (void)state, (void)msg;
+    __atomic_add_fetch(&signals_in, 1, __ATOMIC_RELAXED);
+}
+static void on_signal_out(void *user, const void *msg)
+{
+    (void)user, (void)msg;
+    signals_out++;
+}
+static int signal_step(vw_ctx *ctx, void *state)
+{
+    int *done = state;
+    if (*done) return 0;
+    *done = 1;
+    vw_send_neighbours(ctx, 0, NULL);
+    vw_send_output(ctx, 1, NULL);
+    return 1;
+}
+static const vw_msg_kind signal_kinds[] = {
+    {.name = "signal", .size = 0, .handle = on_signal},
+    {.name = "signal_out", .size = 0, .output = on_signal_out},
+};
 
 static vw_module module(void)
 {
@@ -190,6 +218,18 @@ int main(int argc, char **argv)
             free(slow);
             CHECK(vw_world_post(w2, 1, 0, &x) == VW_OK);
             CHECK(vw_world_run(w2) == VW_OK);
+            vw_world_free(w2);
+        } else if (!strcmp(mode, "signal")) {
+            vw_module sm = m;
+            sm.kinds = signal_kinds;
+            sm.step = signal_step;
+            vw_world *w2 = NULL;
+            CHECK(vw_world_create(&sm, NULL, d, &cfg, &w2) == VW_OK);
+            CHECK(vw_world_post(w2, 1, 0, NULL) == VW_OK);
+            CHECK(vw_world_post(w, 1, 0, NULL) == VW_E_INVAL); /* a kind of 4 bytes */
+            CHECK(vw_world_run(w2) == VW_OK);
+            CHECK_EQ_INT(signals_in, 3);  /* one posted, one from each of the 2 cells */
+            CHECK_EQ_INT(signals_out, 2);
             vw_world_free(w2);
         } else if (!strcmp(mode, "stats")) {
             const char *lng = "a phase whose name is longer than sixteen bytes";

@@ -94,7 +94,8 @@ VW_API void vw_scene_free(vw_scene *s);
    per-channel specular colours and emission are written as extension comments,
        #vw Ks r g b        #vw Ke r g b
    right after the 'f' they belong to. Other NFF readers skip them as comments;
-   ours applies them to the current material. Returns VW_E_IO if writing fails. */
+   ours applies them to the current material. Returns VW_E_IO if writing fails (f is
+   flushed, so this includes what would otherwise wait in its buffer). */
 VW_API vw_status vw_scene_write_nff(const vw_scene *s, FILE *f);
 /* The same into a file, atomically: a failure leaves no file (nor a partial one). */
 VW_API vw_status vw_scene_write_nff_file(const vw_scene *s, const char *path,

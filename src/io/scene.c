@@ -786,7 +786,9 @@ VW_API vw_status vw_scene_write_nff(const vw_scene *s, FILE *f)
             }
         }
     }
-    return ferror(f) ? VW_E_IO : VW_OK;
+    /* Flushed, so that a failure of the writes is known here: a small scene stayed in
+       the stream's buffer and VW_OK came back for a stream that could not take it. */
+    return fflush(f) != 0 || ferror(f) ? VW_E_IO : VW_OK;
 }
 
 VW_API vw_status vw_scene_write_nff_file(const vw_scene *s, const char *path, char *err,

@@ -249,6 +249,17 @@ int main(int argc, char **argv)
     vw_scene *p = NULL;
     CHECK(vw_scene_read_nff("x", "q", 1, &p, NULL, 0) == VW_E_INPUT && p == NULL);
 
+    /* A stream that cannot take the scene is VW_E_IO, also when the scene is small
+       enough to stay in the stream's buffer (a file limited to 100 bytes). */
+    FILE *f = tmpfile();
+    CHECK(f != NULL);
+    struct rlimit rl;
+    CHECK(file_size_limit(100, &rl) == 0);
+    vw_status wst = vw_scene_write_nff(s, f);
+    CHECK(file_size_restore(&rl) == 0);
+    fclose(f);
+    CHECK_EQ_INT(wst, VW_E_IO);
+
     vw_scene_free(s);
     free(text);
     TEST_DONE();

@@ -112,8 +112,8 @@ VW_API uint64_t vw_ctx_next_batch(vw_ctx *ctx, uint64_t nbatches);
 
 /* Sending. A message is copied when sent; the caller keeps its buffer (which may be NULL
    for a kind of size 0, a signal that carries nothing). A send that cannot be meant is
-   a bug in the module and stops the process with a message on stderr: an unknown cell
-   or kind, a kind without handle sent to a cell, a kind without
+   a bug in the module and stops the process with a message on stderr: an unknown cell,
+   face or kind, a kind without handle sent to a cell, a kind without
    output handler sent to the output; so is an unknown counter given to vw_count.
    Messages are batched per destination into packets, flushed when full or when the
    worker has nothing else to do. To a duplicated cell, a message of an independent kind

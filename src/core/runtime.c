@@ -435,6 +435,9 @@ int vw_send_point(vw_ctx *ctx, const double p[3], const double dir[3], int kind,
 
 int vw_send_face(vw_ctx *ctx, int face, int kind, const void *msg)
 {
+    /* A face that does not exist is a bug like an unknown cell: it used to send to no
+       one and return 0, as a face on the world's wall does. */
+    if (face < 0 || face > 5) misuse(ctx, "sent message kind %d to face %d (faces are 0..5)", kind, face);
     int nb[64];
     int n = vw_decomp_neighbours(ctx->w->decomp, ctx->cell, face, nb, 64);
     if (n > 64) {

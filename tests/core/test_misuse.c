@@ -52,6 +52,7 @@ static int step(vw_ctx *ctx, void *state)
     if (!strcmp(mode, "send")) vw_send_cell(ctx, 0, 1, &x);   /* kind 1: output only */
     if (!strcmp(mode, "output")) vw_send_output(ctx, 0, &x);  /* kind 0: no output */
     if (!strcmp(mode, "count")) vw_count(ctx, 5, 1);          /* one counter */
+    if (!strcmp(mode, "face")) vw_send_face(ctx, 6, 0, &x);   /* faces 0..5 */
     return 1;
 }
 

@@ -42,7 +42,8 @@ typedef struct vw_kd_node {
     int cell;
 } vw_kd_node;
 
-/* "4", "2x4", "2x2x2" -> dims (missing dimensions are 1). err gets a one-line message. */
+/* "4", "2x4", "2x2x2" -> dims (missing dimensions are 1). On VW_E_INPUT dims are 1x1x1
+   and err gets a one-line message. */
 VW_API vw_status vw_layout_parse(const char *s, int dims[3], char *err, size_t errlen);
 
 /* A grid with uniform walls. Cell id of grid index (i,j,k) is i + nx*(j + ny*k). */

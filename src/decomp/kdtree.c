@@ -759,13 +759,13 @@ vw_status vw_layout_parse(const char *s, int dims[3], char *err, size_t errlen)
         }
         if (v < 1) {
             if (err) snprintf(err, errlen, "layout '%s': every dimension must be at least 1", s);
-            return VW_E_INPUT;
+            goto refused;
         }
         total *= v;
         if (v > VW_MAX_CELLS || total > VW_MAX_CELLS) {
             if (err)
                 snprintf(err, errlen, "layout '%s': more than %d cells", s, VW_MAX_CELLS);
-            return VW_E_INPUT;
+            goto refused;
         }
         dims[n++] = (int)v;
         if (*p == 'x' || *p == 'X') {
@@ -780,6 +780,7 @@ bad:
     if (err)
         snprintf(err, errlen, "layout '%s': expected 1 to 3 positive numbers joined by 'x', like 2x2x2",
                  s ? s : "");
+refused: /* every refusal leaves dims at 1x1x1, not half parsed ("4x0x2" left 4x1x1) */
     dims[0] = dims[1] = dims[2] = 1;
     return VW_E_INPUT;
 }

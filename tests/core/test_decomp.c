@@ -378,11 +378,12 @@ int main(void)
     {
         int dims[3];
         char err[128];
-        const char *bad[] = {"", "x", "2x", "x2", "0", "2x0", "-1", "2x2x2x2", "a", "2y3", "99999999",
-                             "100x100x100"};
+        const char *bad[] = {"", "x", "2x", "x2", "0", "2x0", "4x0x2", "-1", "2x2x2x2", "a", "2y3",
+                             "99999999", "100x100x100", "4x100000"};
         for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
             CHECK_EQ_INT(vw_layout_parse(bad[i], dims, err, sizeof err), VW_E_INPUT);
             CHECK(strstr(err, "layout") != NULL);
+            CHECK(dims[0] == 1 && dims[1] == 1 && dims[2] == 1); /* not half parsed */
         }
         CHECK_EQ_INT(vw_layout_parse("2X3", dims, err, sizeof err), VW_OK);
         CHECK_EQ_INT(dims[0] * 10 + dims[1] * 100 + dims[2], 2 * 10 + 3 * 100 + 1);

@@ -9,6 +9,9 @@ set(VW_RT_MIXED ${PROJECT_SOURCE_DIR}/tests/raytrace/mixed.nff)
 
 add_test(NAME raytrace_cone COMMAND vw_test_raytrace cone)
 add_test(NAME raytrace_analytic COMMAND vw_test_raytrace analytic)
+# The same scene 1e4 times its size from the origin: a shadow ray must start clear of its
+# own surface by more than Embree's float error there (eps, rt_job_create).
+add_test(NAME raytrace_analytic_far COMMAND vw_test_raytrace analytic 1e4)
 # Rays aimed at the edges and vertices a mesh's triangles share do not slip through.
 add_test(NAME raytrace_watertight COMMAND vw_test_raytrace watertight)
 # Layouts 1, 2, 2x4, 2x2x2, 4x4x4 x workers 1, 2, 4 against 1 cell on 1 worker; also
@@ -22,11 +25,11 @@ add_test(NAME raytrace_identical_wall_hit COMMAND vw_test_raytrace identical
 add_test(NAME raytrace_stress_balls COMMAND vw_test_raytrace identical gen:balls:2 64x64)
 add_test(NAME raytrace_stress_mixed COMMAND vw_test_raytrace identical ${VW_RT_MIXED} 64x64)
 set(VW_RT_TSAN "TSAN_OPTIONS=suppressions=${PROJECT_SOURCE_DIR}/tests/raytrace/tsan.supp")
-set_tests_properties(raytrace_cone raytrace_analytic raytrace_identical_balls
+set_tests_properties(raytrace_cone raytrace_analytic raytrace_analytic_far raytrace_identical_balls
   raytrace_identical_mixed raytrace_identical_wall_hit PROPERTIES ENVIRONMENT "${VW_RT_TSAN}")
 # Threads-engine tests: ./run test-sanitizers runs them under TSan (rays handed from
 # cell to cell inline and by message, under the stress switch too).
-set_tests_properties(raytrace_cone raytrace_analytic raytrace_identical_balls
+set_tests_properties(raytrace_cone raytrace_analytic raytrace_analytic_far raytrace_identical_balls
   raytrace_identical_mixed raytrace_identical_wall_hit raytrace_stress_balls raytrace_stress_mixed
   PROPERTIES LABELS "threads")
 set_tests_properties(raytrace_stress_balls PROPERTIES ENVIRONMENT "VW_STRESS=7;${VW_RT_TSAN}")

@@ -168,9 +168,6 @@ vw_status rt_job_create(const vw_scene *s, const rt_params *p, rt_job **out, cha
     }
     rt_view_init(&sh->view, &cam, w, h);
     sh->max_depth = p->depth > 0 ? p->depth : 5;
-    /* Secondary rays start this far from their surface: far above Embree's float error
-       (~1e-7 of the scene size), far below any feature a scene file means. */
-    sh->eps = 1e-4 * diag;
     for (int k = 0; k < 3; k++) sh->background[k] = s->background[k];
 
     size_t nl = s->nlights ? s->nlights : 1;
@@ -228,6 +225,11 @@ vw_status rt_job_create(const vw_scene *s, const rt_params *p, rt_job **out, cha
         if (n > m) m = n;
     }
     sh->overlap = 1e-6 * 3 * m;
+    /* Secondary rays start this far from their surface: 1e-4 of the scene's size, far
+       below any feature a scene file means, and at least ten times Embree's float error
+       (1e-7 of the coordinates' magnitude, not of the scene's size: a scene far from the
+       origin, 1e4 times its size, otherwise shades its own shadow rays as occluded). */
+    sh->eps = fmax(1e-4 * diag, 1e-6 * m);
     sh->bpad = fmax(1e-6 * diag, 2 * sh->overlap);
     int dims[3];
     for (int a = 0; a < 3; a++) dims[a] = p->dims[a] > 0 ? p->dims[a] : 1;

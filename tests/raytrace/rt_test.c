@@ -2,7 +2,8 @@
  * subcommand (registered in tests/raytrace.cmake):
  *   identical SCENE WxH   the same fixed-point sums for every layout and worker count,
  *                         and every ray created is ended (SCENE: a file or gen:NAME:SIZE)
- *   analytic              one diffuse sphere and one light against the formula, 1/255
+ *   analytic [OFFSET]     one diffuse sphere and one light against the formula, 1/255
+ *                         (the scene moved by OFFSET on every axis: float error)
  *   cone                  the cone/cylinder intersection against sampled points
  *   watertight            rays aimed at a mesh's shared edges and vertices hit it
  *   write SCENE WxH LAYOUT WORKERS OUT.png   (a helper for looking at pictures)
@@ -163,18 +164,25 @@ static int test_identical(const char *spec, const char *size)
 }
 
 /* One diffuse sphere lit by one light, no specular, no ambient: every pixel is either
-   the background or Kd * colour * max(0, N.L) * light, by the formula alone. */
-static int test_analytic(void)
+   the background or Kd * colour * max(0, N.L) * light, by the formula alone. The whole
+   scene (eye, light, sphere) can be moved by `off` on every axis: far from the origin
+   Embree's float error grows with the coordinates, and a shadow ray must still start
+   clear of its own surface (the acne of a too small eps shows as dark pixels). */
+static int test_analytic(double off)
 {
-    static const char nff[] =
-        "v\nfrom 0.3 0.2 5\nat 0 0 0\nup 0 1 0\nangle 30\nhither 1\nresolution 64 48\n"
-        "b 0.1 0.2 0.3\n"
-        "l 3 4 5\n"
-        "f 1 0.5 0.25 0.8 0 0 0 1\n"
-        "s 0 0 0 1\n";
+    char nff[512];
+    int len = snprintf(nff, sizeof nff,
+                       "v\nfrom %.17g %.17g %.17g\nat %.17g %.17g %.17g\nup 0 1 0\nangle 30\n"
+                       "hither 1\nresolution 64 48\n"
+                       "b 0.1 0.2 0.3\n"
+                       "l %.17g %.17g %.17g\n"
+                       "f 1 0.5 0.25 0.8 0 0 0 1\n"
+                       "s %.17g %.17g %.17g 1\n",
+                       0.3 + off, 0.2 + off, 5 + off, off, off, off, 3 + off, 4 + off, 5 + off,
+                       off, off, off);
     char err[256];
     vw_scene *s;
-    if (vw_scene_read_nff("analytic.nff", nff, sizeof nff - 1, &s, err, sizeof err) != VW_OK) {
+    if (vw_scene_read_nff("analytic.nff", nff, (size_t)len, &s, err, sizeof err) != VW_OK) {
         fprintf(stderr, "%s\n", err);
         return 1;
     }
@@ -434,7 +442,7 @@ int main(int argc, char **argv)
 {
     if (argc >= 3 && !strcmp(argv[1], "nff")) return write_nff(argv[2]);
     if (argc >= 3 && !strcmp(argv[1], "identical")) return test_identical(argv[2], argc > 3 ? argv[3] : NULL);
-    if (argc >= 2 && !strcmp(argv[1], "analytic")) return test_analytic();
+    if (argc >= 2 && !strcmp(argv[1], "analytic")) return test_analytic(argc > 2 ? atof(argv[2]) : 0);
     if (argc >= 2 && !strcmp(argv[1], "cone")) return test_cone();
     if (argc >= 2 && !strcmp(argv[1], "watertight")) return test_watertight();
     if (argc >= 2 && !strcmp(argv[1], "write")) return write_png(argc, argv);

@@ -64,7 +64,8 @@ static void help(void)
            "  --speeds LIST    relative speed of every worker, like 1,1,2,4: --map weighted\n"
            "                   maps by them, and copies of cells take shares of the work\n"
            "                   in proportion (--slow W:K gives worker W the speed 1/K)\n"
-           "  --slow W:K[,..]  worker W does its work K times slower (emulates a slow machine)\n"
+           "  --slow W:K[,..]  worker W does its work K times slower, K from 1 to 1000\n"
+           "                   (emulates a slow machine)\n"
            "  --overlay-by B   load (default): each cell by its measured load; worker: each\n"
            "                   pixel by the worker that made its eye ray (farmed cells show\n"
            "                   their copies' turns)\n"
@@ -350,8 +351,8 @@ int vw_cmd_render(int argc, char **argv)
             double k = 0;
             if (end != q && *end == ':') k = strtod(end + 1, &end);
             if (wk < 0 || wk >= gw || !(k >= 1) || k > 1000 || (*end && *end != ',')) {
-                vw_cli_error(CMD, "--slow: bad value '%s' (expected W:K with worker W < %d and K >= 1)",
-                             slow_s, gw);
+                vw_cli_error(CMD, "--slow: bad value '%s' (expected W:K with worker W < %d and K "
+                                  "from 1 to 1000)", slow_s, gw);
                 free(speeds);
                 free(slowdown);
                 return VW_EXIT_USAGE;

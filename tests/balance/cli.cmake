@@ -68,4 +68,10 @@ foreach(bad "--balance;sideways" "--map;random" "--speeds;1,x" "--speeds;1" "--s
     message(FATAL_ERROR "${bad}: exit ${rc} (expected 2): ${err}")
   endif()
 endforeach()
+# A K beyond the limit: the message says what the limit is (it said "K >= 1" alone).
+execute_process(COMMAND ${VWALLS} render ${SCENE} -o ${WORK}/bad.png --workers 2 --slow 1:2000
+                RESULT_VARIABLE rc OUTPUT_QUIET ERROR_VARIABLE err)
+if(NOT rc EQUAL 2 OR EXISTS ${WORK}/bad.png OR NOT err MATCHES "K from 1 to 1000")
+  message(FATAL_ERROR "--slow 1:2000: exit ${rc} (expected 2, naming the limit): ${err}")
+endif()
 message(STATUS "balance_cli: every strategy and mapping gives the same PNG")

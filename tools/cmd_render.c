@@ -342,7 +342,10 @@ int vw_cmd_render(int argc, char **argv)
     }
     if (slow_s) {
         slowdown = malloc(sizeof(double) * (size_t)gw);
-        if (!slowdown) return VW_EXIT_FAIL;
+        if (!slowdown) {
+            free(speeds);
+            return VW_EXIT_FAIL;
+        }
         for (int g = 0; g < gw; g++) slowdown[g] = 1.0;
         const char *q = slow_s;
         while (*q) {
@@ -363,7 +366,10 @@ int vw_cmd_render(int argc, char **argv)
         /* A known slow-down is the calibration: its speed is 1/K. */
         if (!speeds) {
             speeds = malloc(sizeof(double) * (size_t)gw);
-            if (!speeds) return VW_EXIT_FAIL;
+            if (!speeds) {
+                free(slowdown);
+                return VW_EXIT_FAIL;
+            }
             for (int g = 0; g < gw; g++) speeds[g] = 1.0 / slowdown[g];
         }
     }
@@ -374,12 +380,14 @@ int vw_cmd_render(int argc, char **argv)
     if (vw_scene_read_file(scene_path, &scene, err, sizeof err) != VW_OK) {
         /* The parser's "file:line: message", as it is. */
         if (vw_cli_is_output()) fprintf(stderr, "%s\n", err);
+        free(speeds), free(slowdown);
         return VW_EXIT_USAGE;
     }
     if (nlights) { /* --light: these lights instead of the scene's */
         vw_light *L = malloc(sizeof *L * (size_t)nlights);
         if (!L) {
             vw_scene_free(scene);
+            free(speeds), free(slowdown);
             return VW_EXIT_FAIL;
         }
         /* The NFF reader's rule (nff.c) for lights without a colour. */
@@ -428,6 +436,7 @@ int vw_cmd_render(int argc, char **argv)
     vw_scene_free(scene);
     if (st != VW_OK) {
         vw_cli_error(CMD, "%s", err);
+        free(speeds), free(slowdown);
         return st == VW_E_INVAL ? VW_EXIT_USAGE : VW_EXIT_FAIL;
     }
     vw_world *w = rt_job_world(job);

@@ -146,6 +146,13 @@ vw_status rt_job_create(const vw_scene *s, const rt_params *p, rt_job **out, cha
     double diag = 0;
     for (int a = 0; a < 3; a++) diag += (hi[a] - lo[a]) * (hi[a] - lo[a]);
     diag = sqrt(diag);
+    if (diag > 0 && diag < RT_MIN_SIZE) {
+        snprintf(err, errlen, "the scene is %g across: the ray tracer needs at least %g (Embree "
+                              "computes in float, whose squares of smaller lengths vanish)",
+                 diag, RT_MIN_SIZE);
+        rt_job_free(j);
+        return VW_E_INVAL;
+    }
     if (p->scale > 0) diag = p->scale;
     if (!(diag > 0)) diag = 1;
 
@@ -223,6 +230,22 @@ vw_status rt_job_create(const vw_scene *s, const rt_params *p, rt_job **out, cha
         double n = fabs((i & 1) ? world.hi[0] : world.lo[0]) +
                    fabs((i & 2) ? world.hi[1] : world.lo[1]) + fabs((i & 4) ? world.hi[2] : world.lo[2]);
         if (n > m) m = n;
+    }
+    /* Every ray starts at the eye or inside the world box: Embree refuses (asserts on) an
+       origin beyond its float limit, 1.8e18 on any axis, and squares of such lengths
+       overflow its floats. */
+    double far = 0;
+    for (int a = 0; a < 3; a++)
+        far = fmax(far, fmax(fabs(cam.from[a]), fmax(fabs(world.lo[a]), fabs(world.hi[a]))));
+    if (!(far <= RT_MAX_COORD)) {
+        snprintf(err, errlen, "the %s lies %g from the origin on an axis: the ray tracer takes "
+                              "coordinates up to %g (Embree computes in float)",
+                 fmax(fabs(cam.from[0]), fmax(fabs(cam.from[1]), fabs(cam.from[2]))) == far ? "eye"
+                                                                                          : "scene",
+                 far, RT_MAX_COORD);
+        free(objs);
+        rt_job_free(j);
+        return VW_E_INVAL;
     }
     sh->overlap = 1e-6 * 3 * m;
     /* Secondary rays start this far from their surface: 1e-4 of the scene's size, far

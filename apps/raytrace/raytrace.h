@@ -167,6 +167,14 @@ void rt_object_empty(rt_object *o);
 
 typedef struct rt_job rt_job;
 
+/* What Embree's float arithmetic can trace, refused by rt_job_create (VW_E_INVAL) rather
+   than rendered wrong: the eye and the world box within RT_MAX_COORD of the origin on
+   every axis (Embree asserts that a ray's origin is within 1.8e18), and a scene at least
+   RT_MIN_SIZE across (below, the squares of its lengths vanish in float; a scene that
+   is a single point is allowed: it shows nothing). */
+#define RT_MAX_COORD 1e18
+#define RT_MIN_SIZE 1e-15
+
 /* Phases, each timed by the caller if it wishes: create (objects, decomposition, world,
    objects added), commit (cells built), run (rays traced). err gets a message. */
 vw_status rt_job_create(const vw_scene *s, const rt_params *p, rt_job **out, char *err,

@@ -126,6 +126,41 @@ foreach(case "--from;1,2,nan;--from: bad value '1,2,nan'"
     message(FATAL_ERROR "${opt} ${val}: exit ${rc}, expected 2, '${want}' and no file (${err})")
   endif()
 endforeach()
+# Scales: one sphere, its eye and its light multiplied by S. Up to 1e17 and down to 1e-14
+# the same rays as at S = 1; at 1e18 the eye is beyond Embree's limit (1.8e18, where it
+# used to assert and abort the process), at 1e-16 the scene too small for its floats
+# (the image used to come out as noise): exit 2, a message, no file.
+function(scaled_scene path s)
+  file(WRITE ${path} "v\nfrom 3${s} 3${s} 3${s}\nat 0 0 0\nup 0 0 1\nangle 45\nhither 0\n"
+                     "resolution 16 16\nb 0.1 0.2 0.3\nl 4${s} 3${s} 2${s}\n"
+                     "f 0.8 0.6 0.3 1 0.5 10 0 1\ns 0 0 0 1${s}\n")
+endfunction()
+foreach(case "e17;0" "e-14;0" "e18;the eye lies 3e+18 from the origin" "e-16;the scene is 3.4641e-16 across")
+  list(GET case 0 s)
+  list(GET case 1 want)
+  scaled_scene(${WORK}/scale${s}.nff ${s})
+  file(REMOVE ${WORK}/scale.png)
+  execute_process(COMMAND ${VWALLS} render ${WORK}/scale${s}.nff -o ${WORK}/scale.png --quiet
+                          --cells 2x2x2 --stats ${WORK}/scale${s}.json
+                  RESULT_VARIABLE rc ERROR_VARIABLE err)
+  if(want STREQUAL "0")
+    scaled_scene(${WORK}/scale1.nff "")
+    execute_process(COMMAND ${VWALLS} render ${WORK}/scale1.nff -o ${WORK}/scale1.png --quiet
+                            --cells 2x2x2 --stats ${WORK}/scale1.json RESULT_VARIABLE rc1)
+    file(READ ${WORK}/scale1.json j1)
+    file(READ ${WORK}/scale${s}.json js)
+    string(REGEX MATCH "\"rays\": {[^}]*}" r1 "${j1}")
+    string(REGEX MATCH "\"rays\": {[^}]*}" rs "${js}")
+    if(NOT rc EQUAL 0 OR NOT rc1 EQUAL 0 OR NOT r1 STREQUAL rs OR r1 STREQUAL "")
+      message(FATAL_ERROR "scale 1${s}: exit ${rc}, ${rs} against ${r1} at scale 1 (${err})")
+    endif()
+  else()
+    string(FIND "${err}" "${want}" at)
+    if(NOT rc EQUAL 2 OR at LESS 0 OR EXISTS ${WORK}/scale.png)
+      message(FATAL_ERROR "scale 1${s}: exit ${rc}, expected 2, '${want}' and no file (${err})")
+    endif()
+  endif()
+endforeach()
 # A pre-pass option without a pre-pass is said to do nothing (and renders); with one, not.
 foreach(case "--balance-iters;3;warn" "--prepass;2;warn" "--balance-load;segments;warn"
              "--prepass;2;--balance;tensor;quiet")

@@ -455,7 +455,7 @@ int vw_anim_main(const char *cmd, int argc, char **argv)
     if (st != VW_OK) {
         vw_cli_error(cmd, "%s", err);
         if (in != stdin) fclose(in);
-        rc = VW_EXIT_FAIL;
+        rc = st == VW_E_INVAL ? VW_EXIT_USAGE : VW_EXIT_FAIL; /* as render's */
         goto done;
     }
     if (log_path && vw_cli_is_output()) {

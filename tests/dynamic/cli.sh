@@ -64,6 +64,16 @@ grep -q "trigger: bad value 'most'" yerr.txt || fail "--trigger most message: $(
 [ $rc -eq 2 ] || fail "--farm most: status $rc, expected 2"
 grep -q "farm: bad value 'most'" xerr.txt || fail "--farm most message: $(cat xerr.txt)"
 [ -e x00.png ] && fail "a frame was rendered with a bad --farm"
+# Input the ray tracer refuses (a size beyond 16384, an eye beyond Embree's 1e18) is bad
+# input as in render: status 2 (it was 1), the message, no frame.
+"$V" animate scene.nff ok.txt -o 'z%02d.png' --size 20000x10 2> zerr.txt; rc=$?
+[ $rc -eq 2 ] || fail "--size 20000x10: status $rc, expected 2"
+grep -q "image size 20000x10 too large" zerr.txt || fail "--size 20000x10 message: $(cat zerr.txt)"
+sed 's/^from .*/from 3e18 3e18 3e18/' scene.nff > far.nff
+echo frame | "$V" edit far.nff -o 'z%02d.png' 2> zerr.txt > /dev/null; rc=$?
+[ $rc -eq 2 ] || fail "edit with an eye at 3e18: status $rc, expected 2"
+grep -q "the eye lies 3e+18" zerr.txt || fail "eye at 3e18 message: $(cat zerr.txt)"
+[ -e z00.png ] && fail "a frame was rendered from input the ray tracer refuses"
 # Cells rebuilt per frame: every cell on the first frame and with --full-rebuild, else
 # each cell the frame's edits touched, once however many batches touched it (vwalls edit
 # makes a batch of every line: five moves of one sphere used to count its cells five

@@ -14,6 +14,9 @@ add_test(NAME raytrace_analytic COMMAND vw_test_raytrace analytic)
 add_test(NAME raytrace_analytic_far COMMAND vw_test_raytrace analytic 1e4)
 # Rays aimed at the edges and vertices a mesh's triangles share do not slip through.
 add_test(NAME raytrace_watertight COMMAND vw_test_raytrace watertight)
+# Concave polygons (the SPD gears' faces) become triangles inside them, not a fan.
+add_test(NAME raytrace_concave COMMAND vw_test_raytrace concave
+         ${PROJECT_SOURCE_DIR}/tests/data/good/concave.nff)
 # Layouts 1, 2, 2x4, 2x2x2, 4x4x4 x workers 1, 2, 4 against 1 cell on 1 worker; also
 # checks that every ray created is ended and that every layout creates the same rays.
 add_test(NAME raytrace_identical_balls COMMAND vw_test_raytrace identical gen:balls:2 96x96)

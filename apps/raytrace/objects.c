@@ -1,6 +1,7 @@
 /* objects.c - the ray tracer's object records: a scene's spheres, cones and polygons as
  * plain records with their material copied in, so any cell can shade any hit alone.
- * Polygons are fan-triangulated; every triangle keeps its polygon's global id.
+ * Polygons are split by vw_polygon_triangulate (a fan when convex, ear clipping when
+ * concave); every triangle keeps its polygon's global id.
  */
 #include <math.h>
 #include <stdlib.h>
@@ -32,6 +33,60 @@ static double tri_area2(const double a[3], const double b[3], const double c[3])
     return x * x + y * y + z * z;
 }
 
+/* Scratch space for one polygon's corners and triangles, grown as polygons need. */
+typedef struct poly_work {
+    double (*v)[3];
+    int (*tri)[3];
+    int cap;
+} poly_work;
+
+/* The count - 2 triangle records of polygon i into out. A triangle of zero area can
+   never be hit; it is dropped (leaving it out keeps NaN normals out of the shading)
+   or, with keep_empty, becomes an empty record. *made gets the number written. */
+static vw_status polygon_records(const vw_scene *s, size_t i, poly_work *w, int keep_empty,
+                                 rt_object *out, size_t *made)
+{
+    const vw_polygon *p = &s->polygons[i];
+    *made = 0;
+    if (p->count < 3) return VW_OK;
+    if (p->count > w->cap) {
+        double (*v)[3] = realloc(w->v, (size_t)p->count * sizeof *v);
+        if (!v) return VW_E_NOMEM;
+        w->v = v;
+        int (*t)[3] = realloc(w->tri, (size_t)p->count * sizeof *t);
+        if (!t) return VW_E_NOMEM;
+        w->tri = t;
+        w->cap = p->count;
+    }
+    const int *idx = &s->indices[p->first];
+    for (int j = 0; j < p->count; j++) memcpy(w->v[j], s->vertices[idx[j]], sizeof w->v[j]);
+    vw_status st = vw_polygon_triangulate((const double (*)[3])w->v, p->count, w->tri);
+    if (st != VW_OK) return st;
+    int smooth = p->has_normals && s->normals;
+    size_t k = 0;
+    for (int j = 0; j + 2 < p->count; j++) {
+        rt_object *r = &out[k];
+        memset(r, 0, sizeof *r);
+        for (int c = 0; c < 3; c++) {
+            memcpy(r->g.tri.v[c], w->v[w->tri[j][c]], sizeof r->g.tri.v[c]);
+            if (smooth)
+                memcpy(r->g.tri.n[c], s->normals[(size_t)p->first + (size_t)w->tri[j][c]],
+                       sizeof r->g.tri.n[c]);
+        }
+        if (!(tri_area2(r->g.tri.v[0], r->g.tri.v[1], r->g.tri.v[2]) > 0)) {
+            if (keep_empty) rt_object_empty(&out[k++]);
+            continue;
+        }
+        r->kind = RT_TRIANGLE;
+        r->id = p->id;
+        if (smooth) r->flags |= RT_SMOOTH;
+        material_of(s, p->material, &r->mat);
+        k++;
+    }
+    *made = k;
+    return VW_OK;
+}
+
 vw_status rt_objects_from_scene(const vw_scene *s, rt_object **out, size_t *n)
 {
     size_t cap = s->nspheres + s->ncones;
@@ -48,6 +103,9 @@ vw_status rt_objects_from_scene(const vw_scene *s, rt_object **out, size_t *n)
         material_of(s, sp->material, &r->mat);
         memcpy(r->g.sphere.c, sp->center, sizeof r->g.sphere.c);
         r->g.sphere.r = fabs(sp->radius);
+        /* NFF: a negative radius means only the inside is visible; as for cones, both
+           sides are shaded and the sign turns the normal inward. */
+        if (sp->radius < 0) r->flags |= RT_INSIDE;
     }
     for (size_t i = 0; i < s->ncones; i++) {
         const vw_cone *c = &s->cones[i];
@@ -63,30 +121,18 @@ vw_status rt_objects_from_scene(const vw_scene *s, rt_object **out, size_t *n)
            so the sign only turns the normal (it matters for refraction). */
         if (c->base_radius < 0 || c->apex_radius < 0) r->flags |= RT_INSIDE;
     }
-    for (size_t i = 0; i < s->npolygons; i++) {
-        const vw_polygon *p = &s->polygons[i];
-        if (p->count < 3) continue;
-        const int *idx = &s->indices[p->first];
-        for (int j = 1; j + 1 < p->count; j++) {
-            const int c3[3] = {0, j, j + 1};
-            rt_object *r = &o[k];
-            for (int v = 0; v < 3; v++) {
-                memcpy(r->g.tri.v[v], s->vertices[idx[c3[v]]], sizeof r->g.tri.v[v]);
-                if (p->has_normals && s->normals)
-                    memcpy(r->g.tri.n[v], s->normals[p->first + c3[v]], sizeof r->g.tri.n[v]);
-            }
-            /* A triangle of zero area can never be hit; leaving it out keeps NaN
-               normals out of the shading. */
-            if (!(tri_area2(r->g.tri.v[0], r->g.tri.v[1], r->g.tri.v[2]) > 0)) {
-                memset(r, 0, sizeof *r);
-                continue;
-            }
-            r->kind = RT_TRIANGLE;
-            r->id = p->id;
-            if (p->has_normals && s->normals) r->flags |= RT_SMOOTH;
-            material_of(s, p->material, &r->mat);
-            k++;
-        }
+    poly_work w = {NULL, NULL, 0};
+    vw_status st = VW_OK;
+    for (size_t i = 0; i < s->npolygons && st == VW_OK; i++) {
+        size_t made;
+        st = polygon_records(s, i, &w, 0, &o[k], &made);
+        k += made;
+    }
+    free(w.v);
+    free(w.tri);
+    if (st != VW_OK) {
+        free(o);
+        return st;
     }
     *out = o;
     *n = k;
@@ -163,24 +209,11 @@ size_t rt_object_records(const vw_scene *s, vw_prim_kind kind, size_t index, rt_
         return 1;
     }
     const vw_polygon *p = &s->polygons[index];
-    size_t n = p->count >= 3 ? (size_t)p->count - 2 : 0;
-    vw_scene one = *s;
-    one.nspheres = one.ncones = 0;
-    one.polygons = (vw_polygon *)p;
-    one.npolygons = 1;
-    rt_object *o;
-    size_t got;
-    for (size_t k = 0; k < n; k++) rt_object_empty(&out[k]);
-    if (rt_objects_from_scene(&one, &o, &got) != VW_OK) return n;
-    /* Match the surviving triangles to their fan positions (same vertices). */
-    const int *idx = &s->indices[p->first];
-    size_t g = 0;
-    for (size_t k = 0; k < n && g < got; k++) {
-        const double *v1 = s->vertices[idx[k + 1]], *v2 = s->vertices[idx[k + 2]];
-        if (!memcmp(o[g].g.tri.v[1], v1, sizeof o[g].g.tri.v[1]) &&
-            !memcmp(o[g].g.tri.v[2], v2, sizeof o[g].g.tri.v[2]))
-            out[k] = o[g++];
-    }
-    free(o);
+    size_t n = p->count >= 3 ? (size_t)p->count - 2 : 0, made = 0;
+    poly_work w = {NULL, NULL, 0};
+    if (polygon_records(s, index, &w, 1, out, &made) != VW_OK || made != n)
+        for (size_t k = 0; k < n; k++) rt_object_empty(&out[k]);
+    free(w.v);
+    free(w.tri);
     return n;
 }

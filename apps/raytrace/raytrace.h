@@ -44,7 +44,7 @@ typedef struct rt_object {
     } g;
 } rt_object;
 
-/* The scene's primitives as records (polygons fan-triangulated, degenerate triangles
+/* The scene's primitives as records (polygons by vw_polygon_triangulate, degenerate triangles
    dropped). *out is malloc'ed; returns VW_E_NOMEM on failure. */
 vw_status rt_objects_from_scene(const vw_scene *s, rt_object **out, size_t *n);
 /* Bounds of one record, widened by pad on every side. */

@@ -118,6 +118,14 @@ VW_API void vw_scene_object_bounds(const vw_scene *s, vw_prim_kind kind, size_t 
    finite number, 'from' and 'at' the same point, or 'up' zero or parallel to the view
    direction. The NFF parser asks it of a 'v' block, the commands of their overrides. */
 VW_API const char *vw_camera_problem(const vw_camera *cam);
+/* The n - 2 triangles of a polygon with corners v[0..n), n >= 3, as corner numbers
+   (0..n-1) into tri[0..n-2), each in the polygon's own winding. A convex polygon gets
+   the fan (0, j, j+1); a concave one is ear-clipped in the plane of its Newell normal,
+   so its triangles cover the polygon and nothing else. A polygon with no interior to
+   keep (self-intersecting, or with no area) is fanned where clipping cannot go on.
+   VW_E_INVAL for bad arguments, VW_E_NOMEM when its scratch memory (concave only)
+   cannot be had. */
+VW_API vw_status vw_polygon_triangulate(const double (*v)[3], int n, int (*tri)[3]);
 /* A camera that sees the whole scene: for scenes without one (OBJ). It looks at the
    centre of the bounds from the +z side, slightly above (+y up, the OBJ convention),
    with a 45 degree field of view; width and height are kept from *cam when positive,

@@ -96,8 +96,9 @@ static vw_status geom_get(const vw_dynscene *ds, int id, geom *g)
 static size_t geom_nslots(const geom *g) { return g->kind == VW_PRIM_POLYGON ? (size_t)g->nv - 2 : 1; }
 
 /* The collision shapes of an object: a sphere; a cone's bounding box (the ray tracer's
-   tight bounds of its two end discs); a polygon's fan of triangles. */
-static void geom_shapes(const geom *g, int id, vw_shape *out)
+   tight bounds of its two end discs); a polygon's triangles, the ray tracer's
+   (vw_polygon_triangulate). VW_E_NOMEM when a concave polygon's scratch cannot be had. */
+static vw_status geom_shapes(const geom *g, int id, vw_shape *out)
 {
     size_t n = geom_nslots(g);
     memset(out, 0, n * sizeof *out);
@@ -118,14 +119,18 @@ static void geom_shapes(const geom *g, int id, vw_shape *out)
             out->p[1][a] = fmax(g->base[a] + r0, g->apex[a] + r1);
         }
     } else {
-        for (int j = 1; j + 1 < g->nv; j++) {
-            vw_shape *t = &out[j - 1];
+        int (*tri)[3] = malloc((size_t)g->nv * sizeof *tri);
+        if (!tri) return VW_E_NOMEM;
+        vw_status st = vw_polygon_triangulate((const double (*)[3])g->v, g->nv, tri);
+        for (int j = 0; st == VW_OK && j + 2 < g->nv; j++) {
+            vw_shape *t = &out[j];
             t->kind = VW_SHAPE_TRIANGLE;
-            memcpy(t->p[0], g->v[0], sizeof t->p[0]);
-            memcpy(t->p[1], g->v[j], sizeof t->p[1]);
-            memcpy(t->p[2], g->v[j + 1], sizeof t->p[2]);
+            for (int c = 0; c < 3; c++) memcpy(t->p[c], g->v[tri[j][c]], sizeof t->p[c]);
         }
+        free(tri);
+        return st;
     }
+    return VW_OK;
 }
 
 static void geom_bounds(const geom *g, double lo[3], double hi[3])
@@ -306,10 +311,8 @@ vw_status vw_dynscene_create(vw_scene *s, const vw_dynscene_params *p, vw_dynsce
             o->nslots = geom_nslots(&g);
             st = grow_slots(ds, ds->nslots + o->nslots);
         }
-        if (st == VW_OK) {
-            geom_shapes(&g, id, ds->shapes + ds->nslots);
-            ds->nslots += o->nslots;
-        }
+        if (st == VW_OK) st = geom_shapes(&g, id, ds->shapes + ds->nslots);
+        if (st == VW_OK) ds->nslots += o->nslots;
         geom_free(&g);
     }
     ds->nids = n;
@@ -611,7 +614,7 @@ static vw_status run_batch(vw_dynscene *ds, const vw_edit *edits, size_t n, int 
         }
         pd[i].probe0 = nends;
         pd[i].nshapes = (int)ns;
-        geom_shapes(&pd[i].g, pd[i].id, ends + nends);
+        if ((st = geom_shapes(&pd[i].g, pd[i].id, ends + nends)) != VW_OK) break;
         for (int a = 0; a < 3; a++) {
             pd[i].endb.lo[a] = pd[i].reach.lo[a] = INFINITY;
             pd[i].endb.hi[a] = pd[i].reach.hi[a] = -INFINITY;

@@ -6,6 +6,7 @@
  *                         (the scene moved by OFFSET on every axis: float error)
  *   cone                  the cone/cylinder intersection against sampled points
  *   watertight            rays aimed at a mesh's shared edges and vertices hit it
+ *   concave SCENE         each polygon's triangle records cover it and nothing else
  *   write SCENE WxH LAYOUT WORKERS OUT.png   (a helper for looking at pictures)
  *   nff SCENE             the scene as NFF on stdout (gen:balls:4 for the benchmark)
  */
@@ -46,6 +47,93 @@ static vw_scene *load(const char *spec)
         exit(1);
     }
     return s;
+}
+
+/* Is (x, y) inside polygon p (corners q[0..n) projected on axes ax, ay)? Even-odd. */
+static int inside2(const double (*q)[3], int n, int ax, int ay, double x, double y)
+{
+    int in = 0;
+    for (int i = 0, j = n - 1; i < n; j = i++) {
+        double xi = q[i][ax], yi = q[i][ay], xj = q[j][ax], yj = q[j][ay];
+        if ((yi > y) != (yj > y) && x < xj + (y - yj) * (xi - xj) / (yi - yj)) in = !in;
+    }
+    return in;
+}
+
+/* Every polygon of SCENE (planar, simple, concave or not) against its triangle records
+   (rt_objects_from_scene, and rt_object_records one polygon at a time): the triangles'
+   areas add up to the polygon's, each lies inside the polygon (its centroid and points
+   near each corner), and each faces the way the polygon does. A fan from the first
+   corner of a concave polygon fails all three. */
+static int test_concave(const char *spec)
+{
+    vw_scene *s = load(spec);
+    rt_object *o;
+    size_t no;
+    CHECK(rt_objects_from_scene(s, &o, &no) == VW_OK);
+    size_t at = 0;
+    for (size_t i = 0; i < s->npolygons; i++) {
+        const vw_polygon *p = &s->polygons[i];
+        double (*q)[3] = malloc((size_t)p->count * sizeof *q), nw[3] = {0, 0, 0};
+        CHECK(q != NULL);
+        for (int k = 0; k < p->count; k++)
+            memcpy(q[k], s->vertices[s->indices[p->first + k]], sizeof q[k]);
+        for (int k = 0; k < p->count; k++) {
+            const double *a = q[k], *b = q[(k + 1) % p->count];
+            nw[0] += (a[1] - b[1]) * (a[2] + b[2]);
+            nw[1] += (a[2] - b[2]) * (a[0] + b[0]);
+            nw[2] += (a[0] - b[0]) * (a[1] + b[1]);
+        }
+        double area = 0.5 * sqrt(nw[0] * nw[0] + nw[1] * nw[1] + nw[2] * nw[2]), sum = 0;
+        int drop = fabs(nw[0]) > fabs(nw[1]) ? 0 : 1;
+        if (fabs(nw[2]) > fabs(nw[drop])) drop = 2;
+        int ax = (drop + 1) % 3, ay = (drop + 2) % 3;
+        rt_object *rec = calloc((size_t)p->count, sizeof *rec);
+        CHECK(rec != NULL);
+        size_t nrec = rt_object_records(s, VW_PRIM_POLYGON, i, rec), got = 0;
+        CHECK_EQ_INT(nrec, p->count - 2);
+        for (size_t r = 0; r < nrec; r++) {
+            if (rec[r].id < 0) continue; /* a triangle of no area */
+            const rt_object *t = &rec[r];
+            CHECK(at < no);
+            CHECK(!memcmp(&o[at++], t, sizeof *t)); /* the same records, in the same order */
+            got++;
+            CHECK_EQ_INT(t->id, p->id);
+            double e1[3], e2[3], x[3];
+            for (int a = 0; a < 3; a++) {
+                e1[a] = t->g.tri.v[1][a] - t->g.tri.v[0][a];
+                e2[a] = t->g.tri.v[2][a] - t->g.tri.v[0][a];
+            }
+            x[0] = e1[1] * e2[2] - e1[2] * e2[1];
+            x[1] = e1[2] * e2[0] - e1[0] * e2[2];
+            x[2] = e1[0] * e2[1] - e1[1] * e2[0];
+            sum += 0.5 * sqrt(x[0] * x[0] + x[1] * x[1] + x[2] * x[2]);
+            EXPECT(x[0] * nw[0] + x[1] * nw[1] + x[2] * nw[2] > 0, "polygon %d: triangle %zu faces away",
+                   p->id, r);
+            /* The centroid, and points a tenth of the way from each corner to it. */
+            double c[3];
+            for (int a = 0; a < 3; a++)
+                c[a] = (t->g.tri.v[0][a] + t->g.tri.v[1][a] + t->g.tri.v[2][a]) / 3;
+            EXPECT(inside2((const double (*)[3])q, p->count, ax, ay, c[ax], c[ay]),
+                   "polygon %d: triangle %zu lies outside it", p->id, r);
+            for (int k = 0; k < 3; k++) {
+                double px = 0.9 * t->g.tri.v[k][ax] + 0.1 * c[ax];
+                double py = 0.9 * t->g.tri.v[k][ay] + 0.1 * c[ay];
+                EXPECT(inside2((const double (*)[3])q, p->count, ax, ay, px, py),
+                       "polygon %d: triangle %zu reaches outside it near corner %d", p->id, r, k);
+            }
+        }
+        EXPECT(fabs(sum - area) <= 1e-9 * area, "polygon %d: triangles cover %.17g, polygon %.17g",
+               p->id, sum, area);
+        CHECK(got > 0);
+        free(rec);
+        free(q);
+    }
+    CHECK(s->npolygons > 0);
+    free(o);
+    vw_scene_free(s);
+    printf("%d checks, %d failed\n", vw_test_checks, vw_test_failures);
+    return vw_test_failures ? 1 : 0;
 }
 
 /* Renders; returns the malloc'ed fixed-point sums (w*h*3) and the ray counters. */
@@ -445,6 +533,7 @@ int main(int argc, char **argv)
     if (argc >= 2 && !strcmp(argv[1], "analytic")) return test_analytic(argc > 2 ? atof(argv[2]) : 0);
     if (argc >= 2 && !strcmp(argv[1], "cone")) return test_cone();
     if (argc >= 2 && !strcmp(argv[1], "watertight")) return test_watertight();
+    if (argc >= 3 && !strcmp(argv[1], "concave")) return test_concave(argv[2]);
     if (argc >= 2 && !strcmp(argv[1], "write")) return write_png(argc, argv);
     fprintf(stderr, "usage: rt_test identical SCENE [WxH] | analytic | cone | write ...\n");
     return 2;

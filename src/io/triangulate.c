@@ -1,0 +1,128 @@
+/* src/io/triangulate.c - a scene polygon as triangles (vw_polygon_triangulate).
+ *
+ * NFF and OBJ polygons may be concave: the SPD "gears" faces are, and so is any OBJ
+ * n-gon a modeller exports. A fan from the first corner covers area outside such a
+ * polygon, so concave polygons are ear-clipped in the plane of their Newell normal.
+ * Convex ones keep the fan, corner for corner, so their triangles (and every image of
+ * a convex scene) are what they were before concave polygons were told apart.
+ */
+#include <math.h>
+#include <stdlib.h>
+
+#include "io/io_internal.h"
+
+/* Twice the signed area of (a, b, c) in the projection plane. */
+static double orient(const double (*p)[2], int a, int b, int c)
+{
+    return (p[b][0] - p[a][0]) * (p[c][1] - p[a][1]) - (p[b][1] - p[a][1]) * (p[c][0] - p[a][0]);
+}
+
+static int same_point(const double (*p)[2], int a, int b)
+{
+    return p[a][0] == p[b][0] && p[a][1] == p[b][1];
+}
+
+/* Is (a, b, c), counterclockwise, an ear of the ring: strictly convex at b, and no other
+   corner of the ring inside it or on its edges? Corners at the same place as a, b or c
+   (repeated vertices) do not count against it. */
+static int is_ear(const double (*p)[2], const int *next, int a, int b, int c)
+{
+    if (!(orient(p, a, b, c) > 0))
+        return 0;
+    for (int r = next[c]; r != a; r = next[r]) {
+        if (same_point(p, r, a) || same_point(p, r, b) || same_point(p, r, c))
+            continue;
+        if (orient(p, a, b, r) >= 0 && orient(p, b, c, r) >= 0 && orient(p, c, a, r) >= 0)
+            return 0;
+    }
+    return 1;
+}
+
+VW_API vw_status vw_polygon_triangulate(const double (*v)[3], int n, int (*tri)[3])
+{
+    if (!v || !tri || n < 3)
+        return VW_E_INVAL;
+    /* The Newell normal: its largest component names the axis to project along. */
+    double nw[3] = {0, 0, 0};
+    for (int i = 0; i < n; i++) {
+        const double *a = v[i], *b = v[(i + 1) % n];
+        nw[0] += (a[1] - b[1]) * (a[2] + b[2]);
+        nw[1] += (a[2] - b[2]) * (a[0] + b[0]);
+        nw[2] += (a[0] - b[0]) * (a[1] + b[1]);
+    }
+    int drop = fabs(nw[0]) > fabs(nw[1]) ? 0 : 1;
+    if (fabs(nw[2]) > fabs(nw[drop]))
+        drop = 2;
+    int ax = (drop + 1) % 3, ay = (drop + 2) % 3;
+    /* Seen from the side the normal points to, (ax, ay) is counterclockwise when the
+       normal's component along drop is positive; otherwise swap them. */
+    if (nw[drop] < 0) {
+        int t = ax;
+        ax = ay;
+        ay = t;
+    }
+    double (*p)[2] = NULL;
+    int convex = !(nw[drop] != 0) || n == 3;   /* no normal (or NaN): nothing to clip */
+    if (!convex) {
+        p = malloc((size_t)n * sizeof *p);
+        if (!p)
+            return VW_E_NOMEM;
+        for (int i = 0; i < n; i++) {
+            p[i][0] = v[i][ax];
+            p[i][1] = v[i][ay];
+        }
+        convex = 1;
+        for (int i = 0; i < n && convex; i++)
+            convex = orient(p, i, (i + 1) % n, (i + 2) % n) >= 0;
+    }
+    if (convex) {
+        free(p);
+        for (int j = 1; j + 1 < n; j++) {
+            tri[j - 1][0] = 0;
+            tri[j - 1][1] = j;
+            tri[j - 1][2] = j + 1;
+        }
+        return VW_OK;
+    }
+    int *next = malloc(2 * (size_t)n * sizeof *next);
+    if (!next) {
+        free(p);
+        return VW_E_NOMEM;
+    }
+    int *prev = next + n;
+    for (int i = 0; i < n; i++) {
+        next[i] = (i + 1) % n;
+        prev[i] = (i + n - 1) % n;
+    }
+    /* Ear clipping. A ring in which a whole turn finds no ear (a self-intersecting or
+       degenerate polygon: no interior to keep) is fanned from where the turn ended,
+       so there are always n - 2 triangles and the work stays O(n^3) at worst. */
+    int k = 0, left = n, b = 0, tried = 0;
+    while (left > 3) {
+        int a = prev[b], c = next[b];
+        if (is_ear((const double (*)[2])p, next, a, b, c)) {
+            tri[k][0] = a;
+            tri[k][1] = b;
+            tri[k][2] = c;
+            k++;
+            next[a] = c;
+            prev[c] = a;
+            left--;
+            b = c;
+            tried = 0;
+        } else if (++tried > left) {
+            break;
+        } else {
+            b = c;
+        }
+    }
+    for (int c = next[b]; next[c] != b; c = next[c]) {
+        tri[k][0] = b;
+        tri[k][1] = c;
+        tri[k][2] = next[c];
+        k++;
+    }
+    free(next);
+    free(p);
+    return VW_OK;
+}

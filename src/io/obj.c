@@ -1,6 +1,8 @@
 /* src/io/obj.c - reader for Wavefront OBJ meshes and their MTL material libraries.
  *
- * OBJ is line-oriented. Faces stay polygons (consumers triangulate) over the shared
+ * OBJ is line-oriented; a backslash that ends a line joins the next one to it (the
+ * OBJ and MTL specifications' continuation), and messages name the physical line of
+ * the token they are about. Faces stay polygons (consumers triangulate) over the shared
  * vertex array; texture coordinates, groups, objects and smoothing are accepted and
  * ignored. OBJ has no camera and no lights: camera.valid is 0.
  */
@@ -25,7 +27,8 @@ typedef struct span {
 
 typedef struct obj {
     const char *name;     /* file name for messages (the OBJ or the current MTL) */
-    int line;
+    int line;             /* the physical line being read, for messages */
+    int next_no;          /* the number of the line after the current statement */
     char *err;
     size_t errlen;
     vw__sb b;
@@ -44,17 +47,38 @@ static int is_space(char c)
     return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f';
 }
 
-/* Next whitespace-separated token of a line; a '#' starting a token ends the line. */
-static int next_tok(span *line, span *t)
+/* The length of the line continuation at s[0..n): a backslash that ends its line (a
+   CR before the newline allowed) or the text; 0 when s does not start with one. */
+static size_t continuation(const char *s, size_t n)
 {
-    while (line->n && is_space(*line->s)) {
-        line->s++;
-        line->n--;
+    if (!n || s[0] != '\\')
+        return 0;
+    if (n == 1 || s[1] == '\n')
+        return n == 1 ? 1 : 2;
+    return n >= 3 && s[1] == '\r' && s[2] == '\n' ? 3 : 0;
+}
+
+/* Next whitespace-separated token of a statement; a '#' starting a token ends it.
+   Continuations are blanks between tokens; passing one counts its line in O->line. */
+static int next_tok(obj *O, span *line, span *t)
+{
+    for (;;) {
+        size_t c = continuation(line->s, line->n);
+        if (c) {
+            O->line += c > 1;
+            line->s += c;
+            line->n -= c;
+        } else if (line->n && is_space(*line->s)) {
+            line->s++;
+            line->n--;
+        } else {
+            break;
+        }
     }
     if (!line->n || *line->s == '#')
         return 0;
     t->s = line->s;
-    while (line->n && !is_space(*line->s)) {
+    while (line->n && !is_space(*line->s) && !continuation(line->s, line->n)) {
         line->s++;
         line->n--;
     }
@@ -142,7 +166,7 @@ static vw_status read_numbers(obj *O, span *line, const char *key, double *out, 
 {
     span t;
     int k = 0;
-    while (k < max && next_tok(line, &t)) {
+    while (k < max && next_tok(O, line, &t)) {
         vw_status st = parse_double(O, t, &out[k]);
         if (st != VW_OK)
             return st;
@@ -217,16 +241,31 @@ static vw_status add_named_material(obj *O, span name)
     return VW_OK;
 }
 
-/* The next line of [*p, end) (without its newline) into *line, counting it in O->line;
-   0 at the end of the text. */
+/* The next statement of [*p, end) (without its final newline) into *line: one line,
+   and the lines that continuations join to it. A comment line is never continued: a
+   comment ending in a backslash (a Windows directory) must not swallow the statement
+   after it. O->line becomes the first line's number; 0 at the end of the text. */
 static int next_line(obj *O, const char **p, const char *end, span *line)
 {
     if (*p >= end)
         return 0;
-    const char *eol = memchr(*p, '\n', (size_t)(end - *p));
+    O->line = O->next_no++;
+    const char *eol = memchr(*p, '\n', (size_t)(end - *p)), *first = *p;
     if (!eol)
         eol = end;
-    O->line++;
+    while (first < eol && is_space(*first))
+        first++;
+    for (int comment = first < eol && *first == '#'; !comment;) {
+        const char *q = eol;
+        if (q > *p && q[-1] == '\r')
+            q--;
+        if (eol == end || q == *p || q[-1] != '\\')
+            break;
+        O->next_no++;
+        eol = memchr(eol + 1, '\n', (size_t)(end - (eol + 1)));
+        if (!eol)
+            eol = end;
+    }
     line->s = *p;
     line->n = (size_t)(eol - *p);
     *p = eol + (eol < end);
@@ -238,9 +277,10 @@ static vw_status parse_mtl(obj *O, const char *text, size_t len)
     const char *p = text, *end = text + len;
     vw_material *m = NULL;
     O->line = 0;
+    O->next_no = 1;
     span line, key;
     while (next_line(O, &p, end, &line)) {
-        if (!next_tok(&line, &key))
+        if (!next_tok(O, &line, &key))
             continue;
         if (span_is(key, "newmtl")) {
             span name = rest_of_line(line);
@@ -309,11 +349,12 @@ static vw_status load_mtllib(obj *O, const char *dir, span fname)
         return st == VW_E_NOMEM ? st : VW_E_INPUT;
     }
     const char *obj_name = O->name;
-    int obj_line = O->line;
+    int obj_line = O->line, obj_next = O->next_no;
     O->name = path;
     st = parse_mtl(O, text, len);
     O->name = obj_name;
     O->line = obj_line;
+    O->next_no = obj_next;
     free(text);
     free(path);
     return st;
@@ -343,7 +384,7 @@ static vw_status parse_face(obj *O, span *line)
     span t;
     int n = 0, all_normals = 1;
     vw__sb_polygon_begin(&O->b);
-    while (next_tok(line, &t)) {
+    while (next_tok(O, line, &t)) {
         /* v, v/vt, v//vn or v/vt/vn */
         span part[3] = {{t.s, 0}, {NULL, 0}, {NULL, 0}};
         int np = 1;
@@ -401,7 +442,7 @@ static vw_status parse_obj(obj *O, const char *text, size_t len, const char *dir
     const char *p = text, *end = text + len;
     span line, key;
     while (next_line(O, &p, end, &line)) {
-        if (!next_tok(&line, &key))
+        if (!next_tok(O, &line, &key))
             continue;
         vw_status st = VW_OK;
         double v[3];
@@ -447,7 +488,7 @@ static vw_status parse_obj(obj *O, const char *text, size_t len, const char *dir
             span fname;
             if (!dir)
                 continue;   /* no directory given: libraries are not loaded */
-            while (next_tok(&line, &fname))
+            while (next_tok(O, &line, &fname))
                 if ((st = load_mtllib(O, dir, fname)) != VW_OK)
                     return st;
         }
@@ -469,6 +510,7 @@ VW_API vw_status vw_scene_read_obj(const char *name, const char *text, size_t le
     obj O;
     memset(&O, 0, sizeof O);
     O.name = name ? name : "<obj>";
+    O.next_no = 1;
     O.err = err;
     O.errlen = errlen;
     O.cur_mat = -1;

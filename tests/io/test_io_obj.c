@@ -1,5 +1,6 @@
 /* test_io_obj.c - the OBJ/MTL reader: face-vertex forms, negative indices, normals,
- * materials from the library, no camera, and OBJ -> NFF -> scene conversion.
+ * materials from the library, no camera, line continuations, and OBJ -> NFF -> scene
+ * conversion.
  * Usage: test_io_obj DATA_DIR
  */
 #define _GNU_SOURCE
@@ -92,6 +93,22 @@ int main(int argc, char **argv)
     t = "v 0 0 0\nv 1 0 0\nv 0 1 0\n# comment\nf 1 2 4\n";
     CHECK_EQ_INT(vw_scene_read_obj("r.obj", t, strlen(t), NULL, &n, err, sizeof err), VW_E_INPUT);
     CHECK(!strcmp(err, "r.obj:5: vertex index 4 out of range (3 vertices)"));
+    /* A backslash ending a line joins the next one (CRLF too, and at the end of the
+       text); a comment ending in one does not; messages name the token's own line. */
+    t = "# from C:\\models\\\nv 0 0 \\\n 0\nv 1 0 0\r\nv 1 1 0\nv 0 1 0\n"
+        "f 1 2\\\r\n 3 \\\n\\\n 4 \\";
+    CHECK_EQ_INT(vw_scene_read_obj("c.obj", t, strlen(t), NULL, &n, err, sizeof err), VW_OK);
+    CHECK_EQ_INT(n->nvertices, 4);
+    CHECK_EQ_INT(n->npolygons, 1);
+    CHECK_EQ_INT(n->polygons[0].count, 4);
+    CHECK(corner(n, 0, 0) == 0 && corner(n, 0, 2) == 2 && corner(n, 0, 3) == 3);
+    vw_scene_free(n);
+    t = "v 0 0 0\nv 1 0 0\nf 1 \\\n 2 \\\n\\\n 3\n";
+    CHECK_EQ_INT(vw_scene_read_obj("c.obj", t, strlen(t), NULL, &n, err, sizeof err), VW_E_INPUT);
+    CHECK(!strcmp(err, "c.obj:6: vertex index 3 out of range (2 vertices)"));
+    t = "v 0 0 \\\n0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nv 1 1\n";
+    CHECK_EQ_INT(vw_scene_read_obj("c.obj", t, strlen(t), NULL, &n, err, sizeof err), VW_E_INPUT);
+    CHECK(!strcmp(err, "c.obj:6: wrong number of values for 'v'"));
     /* Meshes far from the origin, huge or degenerate, still get a usable default
        camera when written as NFF (the reader rejects 'from' equal to 'at'). */
     const char *far[] = {"v 1e20 1e20 1e20\nv 1e20 1e20 1e20\nv 1e20 1e20 1e20\nf 1 2 3\n",

@@ -190,6 +190,8 @@ static void normals(const rt_hit *h, const double p[3], double ng[3], double ns[
     case RT_SPHERE:
         for (int a = 0; a < 3; a++) ng[a] = (p[a] - o->g.sphere.c[a]) / o->g.sphere.r;
         unit3(ng);
+        if (o->flags & RT_INSIDE)
+            for (int a = 0; a < 3; a++) ng[a] = -ng[a];
         memcpy(ns, ng, 3 * sizeof *ns);
         break;
     case RT_CONE:

@@ -27,7 +27,7 @@
 typedef enum rt_kind { RT_SPHERE = 0, RT_TRIANGLE = 1, RT_CONE = 2 } rt_kind;
 
 #define RT_SMOOTH 1 /* triangle with vertex normals (NFF pp, OBJ vn) */
-#define RT_INSIDE 2 /* cone given with negative radii: normals point inward */
+#define RT_INSIDE 2 /* sphere or cone given with negative radii: normals point inward */
 
 /* One primitive as copied into every cell it overlaps: plain data, material included,
    so a cell needs nothing but its records to shade a hit. */

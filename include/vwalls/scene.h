@@ -46,7 +46,7 @@ typedef enum vw_prim_kind {
 
 typedef struct vw_sphere {
     int id, material;
-    double center[3], radius;
+    double center[3], radius;      /* never 0; negative means "inside visible" (NFF) */
 } vw_sphere;
 
 typedef struct vw_cone {

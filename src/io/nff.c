@@ -398,8 +398,10 @@ static vw_status parse_sphere(nff *P)
     vw_status st = read_nums(P, v, 4);
     if (st != VW_OK)
         return st;
-    if (!(v[3] > 0.0))
-        return fail(P, P->entity_line, "sphere radius must be positive (got %g)", v[3]);
+    /* A negative radius is NFF's sphere whose inside is visible (as a cone's negative
+       radii are): kept as given, the sign is the applications' to read. */
+    if (v[3] == 0.0)
+        return fail(P, P->entity_line, "sphere radius must not be zero");
     if ((st = use_material(P, &mat)) != VW_OK)
         return st;
     st = vw__sb_add_sphere(&P->b, mat, v, v[3]);

@@ -212,6 +212,24 @@ int main(int argc, char **argv)
         vw_scene_free(a);
     }
 
+    /* A negative sphere radius is NFF's "only the inside is visible": kept, bounded by
+       its size, and written back as it was read. */
+    {
+        vw_scene *a = read_text("inside.nff", VIEW "s 1 0 0 -2\n");
+        CHECK(a->nspheres == 1 && a->spheres[0].radius == -2.0);
+        double lo[3], hi[3];
+        vw_scene_bounds(a, lo, hi);
+        CHECK(lo[0] == -1 && hi[0] == 3 && lo[2] == -2 && hi[2] == 2);
+        char *w = nff_string(a, NULL);
+        CHECK(w != NULL);
+        vw_scene *b = read_text("inside2.nff", w);
+        CHECK(b->nspheres == 1 && b->spheres[0].radius == -2.0);
+        vw_scene_free(b);
+        free(w);
+        vw_scene_free(a);
+        expect_error(VIEW "s 0 0 0\n-0\n", "t.nff:2: sphere radius must not be zero");
+    }
+
     /* The light rule and the default material (nocolor.nff). */
     snprintf(path, sizeof path, "%s/good/nocolor.nff", argv[1]);
     vw_scene *nc;

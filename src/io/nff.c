@@ -2,10 +2,11 @@
  *
  * NFF is read as a stream of whitespace-separated tokens, not lines, so an entity
  * split across lines parses exactly like one on a single line; the lexer counts
- * lines only to name them in messages. '#' at the start of a token comments out
- * the rest of its line. One extension rides in comments: "#vw Ks r g b" and
- * "#vw Ke r g b" set the specular colour and emission of the current material
- * (see vw_scene_write_nff), which other NFF readers ignore.
+ * lines only to name them in messages. '#' comments out the rest of its line, also
+ * right after a number ("1# radius"): as soon as one is seen, says the format. One
+ * extension rides in comments: "#vw Ks r g b" and "#vw Ke r g b" set the specular
+ * colour and emission of the current material (see vw_scene_write_nff), which other
+ * NFF readers ignore.
  */
 #include <float.h>
 #include <limits.h>
@@ -79,7 +80,7 @@ static int lex_next(lexer *lx, token *t, int want_ext)
             continue;
         }
         const char *start = lx->p;
-        while (lx->p < lx->end && !is_space(*lx->p))
+        while (lx->p < lx->end && !is_space(*lx->p) && *lx->p != '#')
             lx->p++;
         t->s = start;
         t->n = (size_t)(lx->p - start);

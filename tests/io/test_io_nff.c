@@ -230,6 +230,15 @@ int main(int argc, char **argv)
         expect_error(VIEW "s 0 0 0\n-0\n", "t.nff:2: sphere radius must not be zero");
     }
 
+    /* '#' starts a comment wherever it is seen, also right after a number, as the
+       format says; the entity's numbers are read up to it. */
+    {
+        vw_scene *a = read_text("hash.nff", VIEW "s 0 0 0\n1# the radius\ns 0 0#x\n 0 2\n");
+        CHECK(a->nspheres == 2 && a->spheres[0].radius == 1.0 && a->spheres[1].radius == 2.0);
+        vw_scene_free(a);
+        expect_error(VIEW "s 0 0 0#\n1x\n", "t.nff:3: bad number '1x' in 's'");
+    }
+
     /* The light rule and the default material (nocolor.nff). */
     snprintf(path, sizeof path, "%s/good/nocolor.nff", argv[1]);
     vw_scene *nc;

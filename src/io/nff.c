@@ -243,8 +243,12 @@ static vw_status parse_view(nff *P)
 {
     vw_camera *cam = &P->b.s->camera;
     int view_line = P->entity_line;
-    int have_from = 0, have_at = 0, have_up = 0, have_angle = 0, have_res = 0;
-    cam->hither = 1.0;  /* not every NFF writer gives hither */
+    int have_from = 0, have_at = 0, have_up = 0, have_angle = 0;
+    /* Not every NFF writer gives hither and resolution, and SPD's own reader (ReadNFF)
+       takes a 'v' block without them: they default to 1 and to vwalls render's
+       512x512. from, at, up and angle it requires, and so do we. */
+    cam->hither = 1.0;
+    cam->width = cam->height = 512;
     for (;;) {
         lexer save = P->lx;
         token t;
@@ -281,7 +285,6 @@ static vw_status parse_view(nff *P)
                 st = read_int(P, "resolution", 0, 1L << 20, &cam->height);
             if (st == VW_OK && (cam->width == 0 || cam->height == 0))
                 st = fail(P, t.line, "resolution must not be zero");
-            have_res = 1;
         } else {
             P->lx = save;   /* the next entity */
             break;
@@ -290,7 +293,7 @@ static vw_status parse_view(nff *P)
             return st;
     }
     const char *missing = !have_from ? "from" : !have_at ? "at" : !have_up ? "up"
-                        : !have_angle ? "angle" : !have_res ? "resolution" : NULL;
+                        : !have_angle ? "angle" : NULL;
     if (missing)
         return fail(P, view_line, "'v' block without '%s'", missing);
     const char *problem = vw_camera_problem(cam);

@@ -239,6 +239,23 @@ int main(int argc, char **argv)
         expect_error(VIEW "s 0 0 0#\n1x\n", "t.nff:3: bad number '1x' in 's'");
     }
 
+    /* hither and resolution may be left out of 'v', as SPD's reader allows; the
+       defaults are written back, so the scene reads again. */
+    {
+        vw_scene *a = read_text("bare.nff", "v from 0 -5 0 at 0 0 0 up 0 0 1 angle 45\n"
+                                            "s 0 0 0 1\n");
+        CHECK(a->camera.valid && a->camera.hither == 1.0 && a->camera.width == 512 &&
+              a->camera.height == 512);
+        char *w = nff_string(a, NULL);
+        CHECK(w != NULL);
+        vw_scene *b = read_text("bare2.nff", w);
+        CHECK(memcmp(&a->camera, &b->camera, sizeof a->camera) == 0);
+        vw_scene_free(b);
+        free(w);
+        vw_scene_free(a);
+        expect_error("v from 0 -5 0 at 0 0 0 up 0 0 1 hither 1\n", "t.nff:1: 'v' block without 'angle'");
+    }
+
     /* The light rule and the default material (nocolor.nff). */
     snprintf(path, sizeof path, "%s/good/nocolor.nff", argv[1]);
     vw_scene *nc;

@@ -59,6 +59,10 @@ static int vw_test_failures __attribute__((unused));
 
 #define TEST_DONE()                                                                     \
     do {                                                                                \
+        if (vw_test_failures) {                                                         \
+            printf("%d checks, %d failed\n", vw_test_checks, vw_test_failures);         \
+            return 1;                                                                   \
+        }                                                                               \
         printf("%d checks passed\n", vw_test_checks);                                   \
         return 0;                                                                       \
     } while (0)

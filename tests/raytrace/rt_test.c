@@ -132,8 +132,7 @@ static int test_concave(const char *spec)
     CHECK(s->npolygons > 0);
     free(o);
     vw_scene_free(s);
-    printf("%d checks, %d failed\n", vw_test_checks, vw_test_failures);
-    return vw_test_failures ? 1 : 0;
+    TEST_DONE();
 }
 
 /* Renders; returns the malloc'ed fixed-point sums (w*h*3) and the ray counters. */

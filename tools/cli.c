@@ -96,14 +96,16 @@ int vw_cli_size(const char *cmd, const char *opt, const char *s, int *w, int *h)
     if (s && *s && (*end == 'x' || *end == 'X') && !errno) {
         const char *q = end + 1;
         b = strtol(q, &end, 10);
-        if (*q && !*end && !errno && a >= 1 && b >= 1 && a <= 65536 && b <= 65536 && a * b <= (1L << 28)) {
+        /* The ray tracer's limit (rt_job_create), for every command: a size it accepts
+           here and refuses later told the user two different maxima. */
+        if (*q && !*end && !errno && a >= 1 && b >= 1 && a <= 16384 && b <= 16384) {
             *w = (int)a;
             *h = (int)b;
             return 0;
         }
     }
     vw_cli_error(cmd, "%s: bad value '%s' (expected WIDTHxHEIGHT, like 512x512: sides of 1 to "
-                      "65536, at most 2^28 pixels)", opt, s ? s : "");
+                      "16384)", opt, s ? s : "");
     return -1;
 }
 

@@ -68,7 +68,8 @@ grep -q "farm: bad value 'most'" xerr.txt || fail "--farm most message: $(cat xe
 # input as in render: status 2 (it was 1), the message, no frame.
 "$V" animate scene.nff ok.txt -o 'z%02d.png' --size 20000x10 2> zerr.txt; rc=$?
 [ $rc -eq 2 ] || fail "--size 20000x10: status $rc, expected 2"
-grep -q "image size 20000x10 too large" zerr.txt || fail "--size 20000x10 message: $(cat zerr.txt)"
+grep -q "size: bad value '20000x10' (expected WIDTHxHEIGHT, like 512x512: sides of 1 to 16384)" zerr.txt ||
+  fail "--size 20000x10 message: $(cat zerr.txt)"
 sed 's/^from .*/from 3e18 3e18 3e18/' scene.nff > far.nff
 echo frame | "$V" edit far.nff -o 'z%02d.png' 2> zerr.txt > /dev/null; rc=$?
 [ $rc -eq 2 ] || fail "edit with an eye at 3e18: status $rc, expected 2"

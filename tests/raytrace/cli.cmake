@@ -90,6 +90,25 @@ endif()
 if(EXISTS ${WORK}/bad.png)
   message(FATAL_ERROR "bad scene: an output file was left behind")
 endif()
+# Image sizes: the command line and the ray tracer have one maximum, 16384 on a side
+# (the command line said 65536, and the ray tracer then refused 20000).
+execute_process(COMMAND ${VWALLS} render ${SCENE} -o ${WORK}/big.png --size 16385x1 --quiet
+                RESULT_VARIABLE rc ERROR_VARIABLE err)
+if(NOT rc EQUAL 2 OR NOT err MATCHES "sides of 1 to 16384" OR EXISTS ${WORK}/big.png)
+  message(FATAL_ERROR "--size 16385x1: exit ${rc} (expected 2 and the limit): ${err}")
+endif()
+execute_process(COMMAND ${VWALLS} render ${SCENE} -o ${WORK}/big.png --size 16384x1 --quiet
+                RESULT_VARIABLE rc ERROR_VARIABLE err)
+if(NOT rc EQUAL 0 OR NOT EXISTS ${WORK}/big.png)
+  message(FATAL_ERROR "--size 16384x1: exit ${rc}: ${err}")
+endif()
+# A scene file's own resolution beyond it: the same status, the ray tracer's message.
+file(WRITE ${WORK}/wide.nff "v\nfrom 0 0 5\nat 0 0 0\nup 0 1 0\nangle 30\nhither 1\nresolution 20000 10\ns 0 0 0 1\n")
+execute_process(COMMAND ${VWALLS} render ${WORK}/wide.nff -o ${WORK}/wide.png --quiet
+                RESULT_VARIABLE rc ERROR_VARIABLE err)
+if(NOT rc EQUAL 2 OR NOT err MATCHES "image size 20000x10 too large" OR EXISTS ${WORK}/wide.png)
+  message(FATAL_ERROR "resolution 20000 10: exit ${rc} (expected 2 and the limit): ${err}")
+endif()
 # A scene refused after --speeds or --slow was read: exit 2 (under ASan, a leak of their
 # arrays on that path made it 1), and no output.
 foreach(bad "--speeds;1,2" "--slow;1:3")

@@ -111,7 +111,8 @@ double rad_poly_area(const rad_poly *p, double normal[3], double centroid[3])
         rad_normalize(normal);
     }
     if (centroid) {
-        /* Area-weighted fan: exact for convex polygons. */
+        /* Area-weighted fan: exact for convex polygons, which every piece and element
+           is (concave polygons are meshed in convex parts, mesh_concave). */
         for (int i = 1; i + 1 < p->n; i++) {
             double e1[3], e2[3], x[3];
             rad_sub(p->v[i], p->v[0], e1);
@@ -296,6 +297,96 @@ static vw_status mesh_polygon(rad_mesh *m, size_t *cap, const vw_decomp *d, cons
     return VW_OK;
 }
 
+/* The most corners of a polygon handed to mesh_polygon: clipping to a patch square and
+   a cell box adds at most 10 (see RAD_MAXV). */
+#define CHUNK (RAD_MAXV - 10)
+
+/* Does the polygon (on its plane, normal n) turn left, or go straight on, at every
+   corner? A turn to the right by more than rounding makes it concave. */
+static int is_convex(const double (*v)[3], int nv, const double n[3])
+{
+    for (int i = 0; i < nv; i++) {
+        double e1[3], e2[3], x[3];
+        rad_sub(v[(i + 1) % nv], v[i], e1);
+        rad_sub(v[(i + 2) % nv], v[(i + 1) % nv], e2);
+        rad_cross(e1, e2, x);
+        if (rad_dot(x, n) < -1e-12 * rad_norm(e1) * rad_norm(e2)) return 0;
+    }
+    return 1;
+}
+
+/* A convex part of a concave polygon, as corner numbers in the polygon's winding. */
+typedef struct part {
+    int n;
+    int c[CHUNK];
+} part;
+
+/* Adds triangle t (corner numbers, polygon winding) to part p when they share an edge
+   and the union is still convex with at most CHUNK corners. */
+static int part_merge(part *p, const int t[3], const double (*v)[3], const double n[3])
+{
+    if (p->n >= CHUNK) return 0;
+    for (int i = 0; i < p->n; i++) {
+        int a = p->c[i], b = p->c[(i + 1) % p->n];
+        for (int k = 0; k < 3; k++) {
+            if (t[k] != b || t[(k + 1) % 3] != a) continue;
+            /* t runs b -> a -> w: w goes between a and b. */
+            part q;
+            q.n = 0;
+            for (int j = 0; j <= i; j++) q.c[q.n++] = p->c[j];
+            q.c[q.n++] = t[(k + 2) % 3];
+            for (int j = i + 1; j < p->n; j++) q.c[q.n++] = p->c[j];
+            double (*w)[3] = malloc(sizeof *w * (size_t)q.n);
+            if (!w) return 0;
+            for (int j = 0; j < q.n; j++) memcpy(w[j], v[q.c[j]], sizeof w[j]);
+            int ok = is_convex((const double (*)[3])w, q.n, n);
+            free(w);
+            if (ok) *p = q;
+            return ok;
+        }
+    }
+    return 0;
+}
+
+/* Meshes a concave polygon (corners v on its plane) as convex parts: its ear-clipped
+   triangles (vw_polygon_triangulate), each merged into one of the last few parts when
+   the union stays convex. Every piece must be convex: the hemicube rasteriser and the
+   picture fill a polygon by its edge functions (the intersection of the half planes),
+   rad_poly_area's centroid fans it, and fanning a concave polygon from one corner
+   covers area outside it (a gear's faces were filled in between the teeth). The parts
+   tile the polygon, so its area and its patch grid are the polygon's; a patch square
+   the parts divide is several pieces, as one a wall cuts is. */
+static vw_status mesh_concave(rad_mesh *m, size_t *cap, const vw_decomp *d, const double (*v)[3], int nv,
+                              const double normal[3], const double origin[3], const double ua[3],
+                              const double va[3], double S, double elem, int id,
+                              const vw_material *mat, int *cells, int ncap, double tiny,
+                              double *squares)
+{
+    int (*tri)[3] = malloc(sizeof *tri * (size_t)(nv - 2));
+    part *parts = malloc(sizeof *parts * (size_t)(nv - 2));
+    vw_status st = tri && parts ? vw_polygon_triangulate(v, nv, tri) : VW_E_NOMEM;
+    int np = 0;
+    for (int t = 0; t < nv - 2 && st == VW_OK; t++) {
+        rad_poly tp = {.n = 3};
+        for (int k = 0; k < 3; k++) memcpy(tp.v[k], v[tri[t][k]], sizeof tp.v[k]);
+        if (rad_poly_area(&tp, NULL, NULL) <= tiny) continue;
+        /* Ear clipping walks along the boundary: a triangle shares an edge with one of
+           the parts just made, so looking back a few keeps this linear. */
+        int merged = 0;
+        for (int p = np - 1; p >= 0 && p >= np - 8 && !merged; p--) merged = part_merge(&parts[p], tri[t], v, normal);
+        if (!merged) parts[np++] = (part){.n = 3, .c = {tri[t][0], tri[t][1], tri[t][2]}};
+    }
+    for (int p = 0; p < np && st == VW_OK; p++) {
+        rad_poly all;
+        all.n = parts[p].n;
+        for (int k = 0; k < all.n; k++) memcpy(all.v[k], v[parts[p].c[k]], sizeof all.v[k]);
+        st = mesh_polygon(m, cap, d, &all, normal, origin, ua, va, S, elem, id, mat, cells, ncap, tiny, squares);
+    }
+    free(tri);
+    free(parts);
+    return st;
+}
+
 vw_status rad_mesh_build(const vw_scene *s, const char *path, const vw_decomp *d,
                          const rad_options *o, rad_mesh *m, char *err, size_t errlen)
 {
@@ -388,24 +479,35 @@ vw_status rad_mesh_build(const vw_scene *s, const char *path, const vw_decomp *d
             pg->material >= 0 && (size_t)pg->material < s->nmaterials ? &s->materials[pg->material] : NULL;
         double rho_used[3], emit_used[3];
         if (rad_material(mat, rho_used, emit_used) && nclamped++ == 0) first_clamped = k;
-        /* Large polygons are fanned into chunks that fit RAD_MAXV after clipping. */
-        const int chunk = RAD_MAXV - 10;
-        for (int first = 1; first + 1 < nv && st == VW_OK; first += chunk - 2) {
-            all.n = 0;
-            memcpy(all.v[all.n++], s->vertices[s->indices[pg->first]], sizeof(double) * 3);
-            for (int i = first; i < nv && all.n < chunk; i++)
-                memcpy(all.v[all.n++], s->vertices[s->indices[pg->first + i]], sizeof(double) * 3);
-            for (int i = 0; i < all.n; i++) {
-                double q[3];
-                rad_sub(all.v[i], cen, q);
-                double dd = rad_dot(q, normal);
-                for (int c = 0; c < 3; c++) all.v[i][c] -= dd * normal[c];
-            }
-            if (all.n < 3 || rad_poly_area(&all, NULL, NULL) <= tiny) continue;
-            st = mesh_polygon(m, &cap, d, &all, normal, origin, ua, va, S, elem, pg->id, mat, cells,
-                              ncells, tiny, &squares);
-            if (all.n < chunk) break;
+        /* The corners on the Newell plane. */
+        double (*flat)[3] = malloc(sizeof *flat * (size_t)nv);
+        if (!flat) {
+            st = VW_E_NOMEM;
+            break;
         }
+        for (int i = 0; i < nv; i++) {
+            double q[3];
+            memcpy(flat[i], s->vertices[s->indices[pg->first + i]], sizeof flat[i]);
+            rad_sub(flat[i], cen, q);
+            double dd = rad_dot(q, normal);
+            for (int c = 0; c < 3; c++) flat[i][c] -= dd * normal[c];
+        }
+        if (is_convex(flat, nv, normal)) {
+            /* Large polygons are fanned into chunks that fit RAD_MAXV after clipping. */
+            for (int first = 1; first + 1 < nv && st == VW_OK; first += CHUNK - 2) {
+                all.n = 0;
+                memcpy(all.v[all.n++], flat[0], sizeof(double) * 3);
+                for (int i = first; i < nv && all.n < CHUNK; i++) memcpy(all.v[all.n++], flat[i], sizeof(double) * 3);
+                if (all.n < 3 || rad_poly_area(&all, NULL, NULL) <= tiny) continue;
+                st = mesh_polygon(m, &cap, d, &all, normal, origin, ua, va, S, elem, pg->id, mat, cells,
+                                  ncells, tiny, &squares);
+                if (all.n < CHUNK) break;
+            }
+        } else {
+            st = mesh_concave(m, &cap, d, flat, nv, normal, origin, ua, va, S, elem, pg->id, mat, cells,
+                              ncells, tiny, &squares);
+        }
+        free(flat);
     }
     free(cells);
     m->npolys = (size_t)(max_id + 1);

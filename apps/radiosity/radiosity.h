@@ -7,6 +7,9 @@
  *  - a piece (a patch clipped at the walls) lies in exactly one cell, its owner, the cell
  *    vw_decomp_locate() gives for its centroid with its normal as direction; every other
  *    cell the runtime hands it to drops it;
+ *  - every piece and element is convex (the rasterisers fill a polygon by its edge
+ *    functions, rad_poly_area's centroid is a fan): rad_mesh_build splits concave
+ *    polygons into convex parts;
  *  - no geometry leaves its cell: a shot travels as a header plus a hemicube coverage
  *    bitmap, results travel to the output process as numbers;
  *  - energy ledger (per RGB channel, double): emitted = absorbed + unshot + escaped.
@@ -20,7 +23,8 @@
 
 /* Largest number of vertices of a piece or element after clipping. A convex input
    polygon of up to RAD_MAXV-10 vertices always fits (a rectangle adds at most 4, a
-   box at most 6). */
+   box at most 6); the mesher hands over no other (larger polygons in convex chunks,
+   concave ones in convex parts). */
 #define RAD_MAXV 24
 /* Hemicube resolution limit: a shot message (header + 3 res^2 bits) must fit into
    VW_MAX_MSG_BYTES. */

@@ -148,6 +148,15 @@ int rad_elem_polygon(const rad_piece *pc, int level, int gi, int gj, rad_poly *o
     memcpy(p.v, pc->v, sizeof(double) * 3 * (size_t)pc->nv);
     double h = pc->elem / (double)(1 << level);
     clip_rect(&p, pc->origin, pc->uax, pc->vax, gi * h, (gi + 1) * h, gj * h, (gj + 1) * h, out);
+    /* A piece edge on a grid line (every patch edge is one) is computed a few ulps of
+       the coordinates off it, so the square beyond it clips to a sliver some 1e-13 of an
+       element wide, or to nothing, as the rounding of the world's position falls: the
+       Cornell box had 2889 elements and 7 to 115 such slivers (2900 to 3004 elements)
+       as it was scaled or moved. A sliver wins no pixel, so its radiosity stays 0, and
+       subdivision split its neighbours for differing from it. Squares covering no more
+       than 1e-9 of themselves are no elements: rounding stays below that while the
+       coordinates are under about 1e6 element sides. */
+    if (out->n >= 3 && !(rad_poly_area(out, NULL, NULL) > 1e-9 * h * h)) out->n = 0;
     return out->n;
 }
 

@@ -101,7 +101,8 @@ typedef struct rad_poly {
     double v[RAD_MAXV][3];
 } rad_poly;
 /* Element (level, gi, gj) of piece pc: the piece clipped to the grid square. Returns the
-   number of vertices (0 when empty). */
+   number of vertices (0 when empty, or when it covers no more than 1e-9 of the square:
+   a sliver left by rounding where a piece edge lies on a grid line). */
 int rad_elem_polygon(const rad_piece *pc, int level, int gi, int gj, rad_poly *out);
 /* The range of level-0 element grid indices a piece covers. */
 void rad_piece_grid(const rad_piece *pc, int lo[2], int hi[2]);

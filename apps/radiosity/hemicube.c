@@ -192,6 +192,7 @@ void rad_hemicube_raster(const rad_hemicube *h, const double (*hv)[3], int nv, c
                 double depth = c / md;
                 if (!(depth > 0)) continue;
                 if (z->stamp[p] != z->cur || depth < z->depth[p]) {
+                    if (z->written && z->stamp[p] != z->cur) z->written[p >> 6] |= (uint64_t)1 << (p & 63);
                     z->stamp[p] = z->cur;
                     z->depth[p] = depth;
                     z->owner[p] = id;

@@ -71,8 +71,7 @@ typedef struct rad_cell {
     int htcap, htused;
     rad_pend *pend;
     int npend, cappend;
-    rad_zbuf z;
-    uint8_t *mask;
+    uint8_t *mask;       /* the bitmap of this cell's own shot */
     int *touched;
     char *pvis;          /* per patch: some vertex in front of the current shooter */
     double (*hv)[3];
@@ -89,7 +88,8 @@ typedef struct rad_cell {
     int ngrp, *gfirst, *gpatch, *rgrp, *glist, nglist;
     int32_t *gpoly;      /* each group's polygon */
     vw_box box;          /* this cell's box (decomposition frame) */
-    int *pcls;           /* per pixel in the current shot: group, RAD_PX_UPSTREAM or _CLEAR */
+    int *pcls;           /* per pixel in the current shot: group, RAD_PX_UPSTREAM or _CLEAR
+                            (the worker's scratch, lent for the shot) */
     char *gtouched;
     double (*gpow)[3];
     int round, budget;
@@ -417,7 +417,6 @@ static vw_status cell_build(vw_ctx *ctx, const void *objects, size_t n, void **s
         c->gpatch[c->ngrp] = c->npatches;
         c->gpoly = xrealloc(NULL, sizeof(int32_t) * (size_t)(c->ngrp ? c->ngrp : 1));
         for (int g = 0; g < c->ngrp; g++) c->gpoly[g] = c->patches[c->gpatch[g]].pc.poly;
-        c->pcls = xrealloc(NULL, sizeof(int) * (size_t)S->hc.npix);
         for (int g = 0; g < c->ngrp; g++)
             if ((size_t)(c->gfirst[g + 1] - c->gfirst[g]) > maxg) maxg = (size_t)(c->gfirst[g + 1] - c->gfirst[g]);
         c->scw = xrealloc(NULL, sizeof *c->scw * 2 * maxg * (size_t)c->nsub);
@@ -463,10 +462,10 @@ static void cell_free(void *state, void *user)
     for (int i = 0; i < c->cappend; i++) free(c->pend[i].bits); /* spare buffers too */
     free(c->pend);
     free(c->patches), free(c->el), free(c->vp), free(c->ht);
-    free(c->z.depth), free(c->z.owner), free(c->z.stamp), free(c->mask), free(c->touched);
+    free(c->mask), free(c->touched);
     free(c->pvis), free(c->hv);
     free(c->scc), free(c->sca), free(c->sci), free(c->scl), free(c->scw);
-    free(c->gfirst), free(c->gpatch), free(c->gpoly), free(c->pcls), free(c->rgrp), free(c->glist), free(c->gtouched), free(c->gpow);
+    free(c->gfirst), free(c->gpatch), free(c->gpoly), free(c->rgrp), free(c->glist), free(c->gtouched), free(c->gpow);
     free(c);
 }
 
@@ -509,16 +508,42 @@ static void enter_round(vw_ctx *ctx, rad_cell *c, int round)
 
 /* ---- shots ---- */
 
-static void ensure_raster(rad_cell *c)
+/* Keeps the cell's flag in S->stepwork: whether step() may find work (a shot ready, or
+   budget left and a patch to shoot). Called wherever nready or budget changes. A cell
+   without patches keeps its budget all round long while its worker has shots ready (so
+   step() does not clear it), and most cells of a fine layout have none. */
+static void note_work(rad_cell *c)
 {
-    if (c->z.depth) return;
+    c->S->stepwork[c->cell] = c->nready > 0 || (c->budget > 0 && c->npatches > 0);
+}
+
+/* The number of the lowest set bit of x (x != 0). */
+static int ctz64(uint64_t x)
+{
+#if defined(__GNUC__)
+    return __builtin_ctzll(x);
+#else
+    int n = 0;
+    for (; !(x & 1); x >>= 1) n++;
+    return n;
+#endif
+}
+
+/* The calling worker's scratch for rasterising a shot (see rad_worker_slot). */
+static rad_worker_slot *scratch(vw_ctx *ctx, const rad_cell *c)
+{
+    rad_worker_slot *sl = &c->S->slots[vw_ctx_worker(ctx)];
     size_t np = (size_t)c->S->hc.npix;
-    c->z.depth = xrealloc(NULL, sizeof(double) * np);
-    c->z.owner = xrealloc(NULL, sizeof(int32_t) * np);
-    c->z.stamp = calloc(np, sizeof(uint32_t));
-    if (!c->z.stamp) abort();
-    c->z.cur = 0;
-    c->mask = xrealloc(NULL, c->S->bitmap_bytes);
+    if (!sl->z.depth) {
+        sl->z.depth = xrealloc(NULL, sizeof(double) * np);
+        sl->z.owner = xrealloc(NULL, sizeof(int32_t) * np);
+        sl->z.stamp = calloc(np, sizeof(uint32_t));
+        sl->z.written = calloc((np + 63) / 64, sizeof(uint64_t));
+        if (!sl->z.stamp || !sl->z.written) abort();
+        sl->z.cur = 0;
+    }
+    if (c->fine && !sl->pcls) sl->pcls = xrealloc(NULL, sizeof(int) * np);
+    return sl;
 }
 
 /* Forwards the shot across every face whose neighbours are downstream and take part. */
@@ -755,10 +780,12 @@ static void process_shot(vw_ctx *ctx, rad_cell *c, const rad_shot_hdr *h, uint8_
     vw_decomp_to_frame(d, h->n, v);
     const rad_hemicube *hc = &S->hc;
     if (!full && c->nel > 0) {
-        ensure_raster(c);
-        if (++c->z.cur == 0) {
-            memset(c->z.stamp, 0, sizeof(uint32_t) * (size_t)hc->npix);
-            c->z.cur = 1;
+        rad_worker_slot *sl = scratch(ctx, c);
+        rad_zbuf *z = &sl->z;
+        c->pcls = sl->pcls;
+        if (++z->cur == 0) {
+            memset(z->stamp, 0, sizeof(uint32_t) * (size_t)hc->npix);
+            z->cur = 1;
         }
         double ax[3][3], vv[3];
         memcpy(ax[0], h->u, sizeof vv);
@@ -793,25 +820,31 @@ static void process_shot(vw_ctx *ctx, rad_cell *c, const rad_shot_hdr *h, uint8_
                 front |= c->hv[i][2] > eps;
             }
             if (!front) continue;
-            rad_hemicube_raster(hc, (const double(*)[3])c->hv, x->nv, mask, &c->z, e, eps);
+            rad_hemicube_raster(hc, (const double(*)[3])c->hv, x->nv, mask, z, e, eps);
             nr++;
         }
         vw_count(ctx, RAD_C_RASTER, nr);
-        /* Deposit: every pixel won goes to its nearest element. */
+        /* Deposit: every pixel won goes to its nearest element. The pixels written are
+           visited in increasing order, as a scan of all npix would (the same sums), but
+           a cell that sees a few elements no longer pays for the whole hemicube: with
+           many cells that scan was a third of the solve. */
         if (!c->touched) c->touched = NULL;
         int ntouched = 0, captouched = 0;
-        for (int px = 0; px < hc->npix; px++) {
-            if (c->z.stamp[px] != c->z.cur) continue;
-            rad_elem *x = &c->el[c->z.owner[px]];
-            if (x->won == 0) {
-                if (ntouched == captouched) {
-                    captouched = captouched ? 2 * captouched : 256;
-                    c->touched = xrealloc(c->touched, sizeof(int) * (size_t)captouched);
+        for (int wd = 0; wd < (hc->npix + 63) / 64; wd++) {
+            for (uint64_t bits = z->written[wd]; bits; bits &= bits - 1) {
+                int px = wd * 64 + ctz64(bits);
+                rad_elem *x = &c->el[z->owner[px]];
+                if (x->won == 0) {
+                    if (ntouched == captouched) {
+                        captouched = captouched ? 2 * captouched : 256;
+                        c->touched = xrealloc(c->touched, sizeof(int) * (size_t)captouched);
+                    }
+                    c->touched[ntouched++] = z->owner[px];
                 }
-                c->touched[ntouched++] = c->z.owner[px];
+                x->won += hc->dff[px];
+                mask[px >> 3] |= (uint8_t)(1u << (px & 7));
             }
-            x->won += hc->dff[px];
-            mask[px >> 3] |= (uint8_t)(1u << (px & 7));
+            z->written[wd] = 0;
         }
         int64_t back = 0;
         for (int t = 0; t < ntouched; t++) {
@@ -844,7 +877,7 @@ static void process_shot(vw_ctx *ctx, rad_cell *c, const rad_shot_hdr *h, uint8_
         if (c->nglist) {
             /* Who holds each pixel, for visible(): a group of this cell, upstream, clear. */
             for (int px = 0; px < hc->npix; px++)
-                c->pcls[px] = c->z.stamp[px] == c->z.cur ? c->rgrp[c->el[c->z.owner[px]].root]
+                c->pcls[px] = z->stamp[px] == z->cur ? c->rgrp[c->el[z->owner[px]].root]
                               : mask[px >> 3] >> (px & 7) & 1 ? RAD_PX_UPSTREAM : RAD_PX_CLEAR;
         }
         for (int i = 0; i < c->nglist; i++) {
@@ -902,14 +935,28 @@ static void on_shot_common(vw_ctx *ctx, rad_cell *c, const rad_shot_hdr *h, cons
         pd->expected = expected > 0 ? expected : 1;
     }
     rad_pend *pd = &c->pend[k];
-    if (bits)
-        for (size_t b = 0; b < S->bitmap_bytes; b++) pd->bits[b] |= bits[b];
-    else
+    if (bits) {
+        /* By 64-bit words: byte by byte (the compiler cannot tell the two buffers apart)
+           this merge was 15 % of a solve on 16x16x16 cells. */
+        uint8_t *dst = pd->bits;
+        const size_t nb = S->bitmap_bytes;
+        size_t b = 0;
+        for (; b + 8 <= nb; b += 8) {
+            uint64_t x, y;
+            memcpy(&x, dst + b, 8);
+            memcpy(&y, bits + b, 8);
+            x |= y;
+            memcpy(dst + b, &x, 8);
+        }
+        for (; b < nb; b++) dst[b] |= bits[b];
+    } else {
         pd->full = 1;
+    }
     if (++pd->received < pd->expected) return;
     /* Ready: rasterised by step(), not here (see run_ready). */
     pd->ready = ++c->readyseq;
     c->nready++;
+    note_work(c);
     S->slots[vw_ctx_worker(ctx)].ready++;
 }
 
@@ -928,6 +975,7 @@ static void run_ready(vw_ctx *ctx, rad_cell *c)
         if (c->pend[i].ready && (k < 0 || c->pend[i].ready < c->pend[k].ready)) k = i;
     rad_pend *pd = &c->pend[k];
     c->nready--;
+    note_work(c);
     c->S->slots[vw_ctx_worker(ctx)].ready--;
     process_shot(ctx, c, &pd->h, pd->bits, pd->full);
     /* Swap-remove, keeping the bitmap buffers for reuse. */
@@ -953,6 +1001,10 @@ static void on_full(vw_ctx *ctx, void *state, const void *msg)
    the worker in turn, so that cell is asked before the worker could go idle). */
 static int step(vw_ctx *ctx, void *state)
 {
+    /* The flag first, not the cell: the runtime asks every cell of the worker whenever
+       its inbox runs dry, and most have nothing to do. */
+    const rad_solver *S = vw_ctx_user(ctx);
+    if (!S->stepwork[vw_ctx_cell(ctx)]) return 0;
     rad_cell *c = state;
     if (c->nready > 0) {
         run_ready(ctx, c);
@@ -967,6 +1019,7 @@ static int step(vw_ctx *ctx, void *state)
     }
     if (best < 0) {
         c->budget = 0;
+        note_work(c);
         return 0;
     }
     rad_patch *pt = &c->patches[best];
@@ -987,8 +1040,9 @@ static int step(vw_ctx *ctx, void *state)
     pt->nshots++;
     c->nshots++;
     c->budget--;
+    note_work(c);
     vw_count(ctx, RAD_C_SHOTS, 1);
-    ensure_raster(c);
+    if (!c->mask) c->mask = xrealloc(NULL, c->S->bitmap_bytes);
     memset(c->mask, 0, c->S->bitmap_bytes);
     process_shot(ctx, c, &h, c->mask, 0);
     return 1;
@@ -1004,6 +1058,7 @@ static void on_go(vw_ctx *ctx, void *state, const void *msg)
     if (g->sub_rel > 0) subdivide(ctx, c, g->sub_rel, g->sub_floor, g->max_level);
     c->budget = g->budget;
     c->thr = g->thr;
+    note_work(c);
 }
 
 static void on_collect(vw_ctx *ctx, void *state, const void *msg)

@@ -145,12 +145,15 @@ void rad_hemicube_pixel_dir(const rad_hemicube *h, int px, double d[3]);
 /* Rasterises a polygon given in hemicube coordinates (x, y along the orientation, z
    along the shooter normal; origin at the shooter) into a z-buffer: pixels whose bit in
    mask is clear and whose stored depth is larger take depth and id. stamp/cur mark the
-   pixels written in this shot (depth is valid only where stamp == cur). */
+   pixels written in this shot (depth is valid only where stamp == cur); when written is
+   not NULL, the first write of pixel p in a shot also sets bit p of it (npix bits in
+   64-bit words), so that the pixels written are found without visiting all npix. */
 typedef struct rad_zbuf {
     double *depth;
     int32_t *owner;
     uint32_t *stamp;
     uint32_t cur;
+    uint64_t *written;
 } rad_zbuf;
 void rad_hemicube_raster(const rad_hemicube *h, const double (*hv)[3], int nv, const uint8_t *mask,
                          rad_zbuf *z, int32_t id, double near_eps);

@@ -475,9 +475,11 @@ vw_status rad_solver_create(const rad_mesh *m, const vw_decomp *d, const rad_opt
     if (st == VW_OK) st = map_by_elements(s, m, d);
     if (st == VW_OK) {
         size_t gw = (size_t)vw_world_processes(s->w) * (size_t)vw_world_workers(s->w);
-        s->slots = aligned_alloc(sizeof *s->slots, gw * sizeof *s->slots);
+        s->slots = aligned_alloc(_Alignof(rad_worker_slot), gw * sizeof *s->slots);
+        s->nslots = s->slots ? gw : 0;
         if (s->slots) memset(s->slots, 0, gw * sizeof *s->slots);
-        else st = VW_E_NOMEM;
+        s->stepwork = calloc((size_t)vw_decomp_cell_count(d), 1);
+        if (!s->slots || !s->stepwork) st = VW_E_NOMEM;
     }
     if (st == VW_OK) st = vw_world_add_objects(s->w, m->pieces, m->npieces);
     if (st == VW_OK) st = vw_world_commit(s->w);
@@ -520,7 +522,12 @@ void rad_solver_free(rad_solver *s)
     rad_hemicube_free(&s->hc);
     free(s->elems);
     free(s->patches);
+    for (size_t i = 0; s->slots && i < s->nslots; i++) {
+        rad_worker_slot *sl = &s->slots[i];
+        free(sl->z.depth), free(sl->z.owner), free(sl->z.stamp), free(sl->z.written), free(sl->pcls);
+    }
     free(s->slots);
+    free(s->stepwork);
     free(s);
 }
 

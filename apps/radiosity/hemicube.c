@@ -79,13 +79,8 @@ void rad_hemicube_raster(const rad_hemicube *h, const double (*hv)[3], int nv, c
     const int R = h->res;
     const double n = R / 2.0;
     /* The polygon's plane in hemicube coordinates gives the exact depth along any ray. */
-    double m[3] = {0, 0, 0};
-    for (int i = 0; i < nv; i++) {
-        const double *a = hv[i], *b = hv[(i + 1) % nv];
-        m[0] += (a[1] - b[1]) * (a[2] + b[2]);
-        m[1] += (a[2] - b[2]) * (a[0] + b[0]);
-        m[2] += (a[0] - b[0]) * (a[1] + b[1]);
-    }
+    double m[3];
+    vw_polygon_normal(hv, nv, m);
     double c = rad_dot(m, hv[0]);
     if (fabs(c) <= 1e-300) return; /* the plane passes through the shooter: seen edge-on */
     for (int f = 0; f < 5; f++) {

@@ -98,13 +98,8 @@ static void clip_box(const rad_poly *p, const vw_box *b, const double *frame, ra
 
 double rad_poly_area(const rad_poly *p, double normal[3], double centroid[3])
 {
-    double nw[3] = {0, 0, 0}, c[3] = {0, 0, 0}, total = 0;
-    for (int i = 0; i < p->n; i++) {
-        const double *a = p->v[i], *b = p->v[(i + 1) % p->n];
-        nw[0] += (a[1] - b[1]) * (a[2] + b[2]);
-        nw[1] += (a[2] - b[2]) * (a[0] + b[0]);
-        nw[2] += (a[0] - b[0]) * (a[1] + b[1]);
-    }
+    double nw[3], c[3] = {0, 0, 0}, total = 0;
+    vw_polygon_normal((const double (*)[3])p->v, p->n, nw);
     double area = 0.5 * rad_norm(nw);
     if (normal) {
         memcpy(normal, nw, sizeof nw);
@@ -420,16 +415,18 @@ vw_status rad_mesh_build(const vw_scene *s, const char *path, const vw_decomp *d
         if (pg->id > max_id) max_id = pg->id;
         rad_poly all;
         int nv = pg->count;
-        /* The polygon's plane from Newell's method over all its vertices. */
-        double nw[3] = {0, 0, 0}, cen[3] = {0, 0, 0}, size = 0;
-        for (int i = 0; i < nv; i++) {
-            const double *a = s->vertices[s->indices[pg->first + i]];
-            const double *b = s->vertices[s->indices[pg->first + (i + 1) % nv]];
-            nw[0] += (a[1] - b[1]) * (a[2] + b[2]);
-            nw[1] += (a[2] - b[2]) * (a[0] + b[0]);
-            nw[2] += (a[0] - b[0]) * (a[1] + b[1]);
-            for (int c = 0; c < 3; c++) cen[c] += a[c] / nv;
+        /* The corners (flattened onto the polygon's plane further down), and the plane
+           from Newell's method over all of them. */
+        double (*flat)[3] = malloc(sizeof *flat * (size_t)(nv > 0 ? nv : 1));
+        if (!flat) {
+            st = VW_E_NOMEM;
+            break;
         }
+        for (int i = 0; i < nv; i++) memcpy(flat[i], s->vertices[s->indices[pg->first + i]], sizeof flat[i]);
+        double nw[3], cen[3] = {0, 0, 0}, size = 0;
+        vw_polygon_normal((const double (*)[3])flat, nv, nw);
+        for (int i = 0; i < nv; i++)
+            for (int c = 0; c < 3; c++) cen[c] += flat[i][c] / nv;
         for (int i = 0; i < nv; i++) {
             double q[3];
             rad_sub(s->vertices[s->indices[pg->first + i]], cen, q);
@@ -442,6 +439,7 @@ vw_status rad_mesh_build(const vw_scene *s, const char *path, const vw_decomp *d
                 where(at, sizeof at, path, k);
                 fprintf(stderr, "%s: warning: zero-area polygon (id %d) skipped\n", at, pg->id);
             }
+            free(flat);
             continue;
         }
         /* Measured data (the Cornell box) is a little off planar: up to 5% of the
@@ -463,7 +461,10 @@ vw_status rad_mesh_build(const vw_scene *s, const char *path, const vw_decomp *d
             where(at, sizeof at, path, k);
             fprintf(stderr, "%s: warning: polygon (id %d) is not planar (%.3g off), flattened\n", at, pg->id, off);
         }
-        if (st != VW_OK) break;
+        if (st != VW_OK) {
+            free(flat);
+            break;
+        }
         /* The polygon frame: u along its longest edge, origin at that edge's start, so
            patches of rectangles are rectangles. */
         double origin[3], ua[3] = {0, 0, 0}, va[3];
@@ -488,15 +489,9 @@ vw_status rad_mesh_build(const vw_scene *s, const char *path, const vw_decomp *d
             pg->material >= 0 && (size_t)pg->material < s->nmaterials ? &s->materials[pg->material] : NULL;
         double rho_used[3], emit_used[3];
         if (rad_material(mat, rho_used, emit_used) && nclamped++ == 0) first_clamped = k;
-        /* The corners on the Newell plane. */
-        double (*flat)[3] = malloc(sizeof *flat * (size_t)nv);
-        if (!flat) {
-            st = VW_E_NOMEM;
-            break;
-        }
+        /* The corners onto the Newell plane. */
         for (int i = 0; i < nv; i++) {
             double q[3];
-            memcpy(flat[i], s->vertices[s->indices[pg->first + i]], sizeof flat[i]);
             rad_sub(flat[i], cen, q);
             double dd = rad_dot(q, normal);
             for (int c = 0; c < 3; c++) flat[i][c] -= dd * normal[c];

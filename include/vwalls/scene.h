@@ -126,6 +126,10 @@ VW_API const char *vw_camera_problem(const vw_camera *cam);
    VW_E_INVAL for bad arguments, VW_E_NOMEM when its scratch memory (concave only)
    cannot be had. */
 VW_API vw_status vw_polygon_triangulate(const double (*v)[3], int n, int (*tri)[3]);
+/* Newell's normal of the polygon v[0..n) into out: its length is twice the polygon's
+   area (of its projection, for one that is not planar), and it points to the side from
+   which the corners run counterclockwise. Zero for n < 3 or no area. */
+VW_API void vw_polygon_normal(const double (*v)[3], int n, double out[3]);
 /* A camera that sees the whole scene: for scenes without one (OBJ). It looks at the
    centre of the bounds from the +z side, slightly above (+y up, the OBJ convention),
    with a 45 degree field of view; width and height are kept from *cam when positive,

@@ -38,18 +38,24 @@ static int is_ear(const double (*p)[2], const int *next, int a, int b, int c)
     return 1;
 }
 
+VW_API void vw_polygon_normal(const double (*v)[3], int n, double out[3])
+{
+    out[0] = out[1] = out[2] = 0;
+    for (int i = 0; i < n; i++) {
+        const double *a = v[i], *b = v[(i + 1) % n];
+        out[0] += (a[1] - b[1]) * (a[2] + b[2]);
+        out[1] += (a[2] - b[2]) * (a[0] + b[0]);
+        out[2] += (a[0] - b[0]) * (a[1] + b[1]);
+    }
+}
+
 VW_API vw_status vw_polygon_triangulate(const double (*v)[3], int n, int (*tri)[3])
 {
     if (!v || !tri || n < 3)
         return VW_E_INVAL;
     /* The Newell normal: its largest component names the axis to project along. */
-    double nw[3] = {0, 0, 0};
-    for (int i = 0; i < n; i++) {
-        const double *a = v[i], *b = v[(i + 1) % n];
-        nw[0] += (a[1] - b[1]) * (a[2] + b[2]);
-        nw[1] += (a[2] - b[2]) * (a[0] + b[0]);
-        nw[2] += (a[0] - b[0]) * (a[1] + b[1]);
-    }
+    double nw[3];
+    vw_polygon_normal(v, n, nw);
     int drop = fabs(nw[0]) > fabs(nw[1]) ? 0 : 1;
     if (fabs(nw[2]) > fabs(nw[drop]))
         drop = 2;

@@ -59,6 +59,14 @@ foreach(np 2 4)
                        ENVIRONMENT "${VW_MPI_ENV}" PROCESSORS 2)
 endforeach()
 
+# Only the first process prints: stdout under mpirun equals the single process's.
+add_test(NAME mpi_print_once
+         COMMAND sh ${PROJECT_SOURCE_DIR}/tests/mpi/print_once.sh $<TARGET_FILE:vwalls_tool>
+                 ${PROJECT_SOURCE_DIR}/tests/data/good/mixed.nff
+                 "${MPIEXEC_EXECUTABLE} ${MPIEXEC_NUMPROC_FLAG} 3 ${VW_MPI_PREFLAGS}")
+set_tests_properties(mpi_print_once PROPERTIES LABELS "mpi" TIMEOUT 120
+                     ENVIRONMENT "${VW_MPI_ENV}" PROCESSORS 2)
+
 # Faults: the job ends within 10 s, non-zero, naming the rank.
 foreach(mode kill exit)
   add_test(NAME mpi_fault_${mode}

@@ -75,14 +75,20 @@ static const vw_command *find_command(const char *name)
 {
     for (size_t i = 0; i < sizeof commands / sizeof commands[0]; i++)
         if (!strcmp(name, commands[i].name)) return &commands[i];
-    fprintf(stderr, "vwalls: unknown command '%s' (try vwalls --help)\n", name);
+    if (vw_cli_is_output()) fprintf(stderr, "vwalls: unknown command '%s' (try vwalls --help)\n", name);
     return NULL;
 }
 
-int main(int argc, char **argv)
+/* Under MPI every process runs main, but only the output process (rank 0) prints: the
+   others' standard output goes to /dev/null, so help, version, info and a scene written
+   by gen to stdout appear once. Their standard error stays open (a rank that must tell
+   why it stopped the job still can); main's own messages are printed by rank 0 only. */
+static int run(int argc, char **argv)
 {
+    int out = vw_cli_is_output();
+    if (!out && !freopen("/dev/null", "w", stdout)) return VW_EXIT_FAIL;
     if (argc < 2) {
-        usage(stderr);
+        if (out) usage(stderr);
         return VW_EXIT_USAGE;
     }
     if (!strcmp(argv[1], "--help") || !strcmp(argv[1], "-h") ||
@@ -97,7 +103,7 @@ int main(int argc, char **argv)
     if (!strcmp(argv[1], "help")) { /* vwalls help CMD: vwalls CMD --help */
         const vw_command *c = argc == 3 ? find_command(argv[2]) : NULL;
         if (!c) {
-            if (argc != 3) fprintf(stderr, "vwalls help: one command name (try vwalls --help)\n");
+            if (argc != 3 && out) fprintf(stderr, "vwalls help: one command name (try vwalls --help)\n");
             return VW_EXIT_USAGE;
         }
         char *help_argv[] = {argv[2], "--help", NULL};
@@ -105,9 +111,14 @@ int main(int argc, char **argv)
     }
     const vw_command *c = find_command(argv[1]);
     if (!c) return VW_EXIT_USAGE;
-    vw_cli_engine_init(&argc, &argv);
     install_signal_handlers();
-    int rc = c->run(argc - 1, argv + 1);
+    return c->run(argc - 1, argv + 1);
+}
+
+int main(int argc, char **argv)
+{
+    vw_cli_engine_init(&argc, &argv);
+    int rc = run(argc, argv);
     vw_cli_engine_finish();
     return rc;
 }

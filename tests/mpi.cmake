@@ -67,6 +67,14 @@ add_test(NAME mpi_print_once
 set_tests_properties(mpi_print_once PROPERTIES LABELS "mpi" TIMEOUT 120
                      ENVIRONMENT "${VW_MPI_ENV}" PROCESSORS 2)
 
+# Input only some ranks have (stdin of vwalls edit): no rank is left waiting.
+add_test(NAME mpi_rank_input
+         COMMAND sh ${PROJECT_SOURCE_DIR}/tests/mpi/rank_input.sh $<TARGET_FILE:vwalls_tool>
+                 ${PROJECT_SOURCE_DIR}/tests/data/good/mixed.nff
+                 "${MPIEXEC_EXECUTABLE} ${MPIEXEC_NUMPROC_FLAG} 2 ${VW_MPI_PREFLAGS}")
+set_tests_properties(mpi_rank_input PROPERTIES LABELS "mpi" TIMEOUT 240
+                     ENVIRONMENT "${VW_MPI_ENV}" PROCESSORS 2)
+
 # Faults: the job ends within 10 s, non-zero, naming the rank.
 foreach(mode kill exit)
   add_test(NAME mpi_fault_${mode}

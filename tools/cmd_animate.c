@@ -346,6 +346,34 @@ static char *frames_json(const vw_anim_session *s)
     return j;
 }
 
+/* The next line of the edits (getline's length, <= 0 at the end; *read_error gets errno
+   when reading failed). A file is read by every process. Standard input is read by the
+   output process alone, which hands each line to the others: MPI launchers forward
+   stdin to rank 0 only, and every process must apply the same edits in the same order. */
+static ssize_t next_line(FILE *in, int from_output, char **line, size_t *cap, int *read_error)
+{
+    ssize_t len = 0;
+    if (!from_output || vw_cli_is_output()) {
+        len = getline(line, cap, in);
+        *read_error = len < 0 && ferror(in) ? errno : 0;
+    }
+    if (!from_output) return len;
+    int64_t head[2] = {len, *read_error};
+    vw_engine_broadcast(head, sizeof head);
+    len = (ssize_t)head[0];
+    *read_error = (int)head[1];
+    if (len <= 0) return len;
+    if (!vw_cli_is_output() && *cap < (size_t)len + 1) {
+        char *p = realloc(*line, (size_t)len + 1);
+        if (!p) vw_engine_abort(VW_EXIT_FAIL, "vwalls edit: out of memory for a line of stdin");
+        *line = p;
+        *cap = (size_t)len + 1;
+    }
+    vw_engine_broadcast(*line, (size_t)len);
+    (*line)[len] = 0;
+    return len;
+}
+
 /* The whole command, for both animate (edits from a file) and edit (from stdin). */
 int vw_anim_main(const char *cmd, int argc, char **argv)
 {
@@ -478,12 +506,12 @@ int vw_anim_main(const char *cmd, int argc, char **argv)
             vw_dynscene_ids(rt_anim_dynscene(s->anim)));
         fflush(stdout); /* a program driving edit waits for it */
     }
-    while ((len = getline(&line, &cap, in)) > 0) {
+    int read_error = 0;
+    while ((len = next_line(in, in == stdin, &line, &cap, &read_error)) > 0) {
         lineno++;
         if (session_line(s, line, (size_t)len, lineno)) break;
         if (s->interactive) fflush(stdout);
     }
-    int read_error = len < 0 && ferror(in) ? errno : 0;
     free(line);
     if (!s->failed) flush(s);
     if (in != stdin) fclose(in);

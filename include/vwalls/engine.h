@@ -44,6 +44,12 @@ VW_API int vw_engine_size(void);
 VW_API vw_status vw_engine_agree(vw_status local, char *msg, size_t len);
 VW_API vw_status vw_world_agree(vw_world *w, vw_status local, char *msg, size_t len);
 
+/* Broadcast (collective on MPI_COMM_WORLD: every rank must call it with the same n): the
+   n bytes at buf on rank 0 replace those at buf on every other rank. For input only rank
+   0 can read, such as standard input, which MPI launchers forward to rank 0 alone. Does
+   nothing without MPI or with one process. */
+VW_API void vw_engine_broadcast(void *buf, size_t n);
+
 #ifdef __cplusplus
 }
 #endif

@@ -5,6 +5,7 @@
 #include "transport/mpi_internal.h"
 #include "vwalls/engine.h"
 
+#include <limits.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -146,6 +147,17 @@ vw_status vw_engine_agree(vw_status local, char *msg, size_t len)
     MPI_Comm_size(MPI_COMM_WORLD, &size);
     if (size == 1) return local;
     return vw__mpi_agree(MPI_COMM_WORLD, local, msg, len);
+}
+
+void vw_engine_broadcast(void *buf, size_t n)
+{
+    if (!mpi_up() || vw_engine_size() == 1) return;
+    /* In pieces, as MPI counts in int. */
+    for (size_t off = 0; off < n;) {
+        size_t k = n - off < (size_t)INT_MAX ? n - off : (size_t)INT_MAX;
+        MPI_Bcast((char *)buf + off, (int)k, MPI_BYTE, 0, MPI_COMM_WORLD);
+        off += k;
+    }
 }
 
 vw_status vw_world_agree(vw_world *w, vw_status local, char *msg, size_t len)

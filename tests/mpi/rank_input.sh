@@ -1,0 +1,51 @@
+#!/bin/sh
+# rank_input.sh - input that only some ranks have never leaves a rank waiting:
+#   * vwalls edit reads stdin, which the launcher gives rank 0 alone: every rank must
+#     apply the same edits (same log and frames as the single process's).
+# Every job must end within 30 s.
+# usage: rank_input.sh VWALLS SCENE "MPIEXEC -n 2 [flags]"
+vwalls=$1 scene=$2 launch=$3
+dir=$(mktemp -d)
+trap 'rm -rf "$dir"' EXIT
+fail=0
+common="--size 48x48 --cells 2x2x2 --workers 1"
+printf 'move 0 0.01 0 0\nframe\nbogus\nmove 1 0 0.01 0\nframe\n' >"$dir/edits"
+
+# run NAME WANT_STATUS GREP_PATTERN args... : under the launcher, within 30 s
+run() {
+    name=$1 want=$2 pattern=$3
+    shift 3
+    # shellcheck disable=SC2086
+    timeout 30 $launch "$@" <"$dir/edits" >"$dir/out" 2>&1
+    rc=$?
+    if [ "$rc" -eq 124 ]; then
+        echo "FAIL: $name: the job hung (killed after 30 s)"
+        fail=1
+    elif [ "$rc" -ne "$want" ]; then
+        echo "FAIL: $name: status $rc, expected $want"
+        fail=1
+    elif [ -n "$pattern" ] && ! grep -Eq "$pattern" "$dir/out"; then
+        echo "FAIL: $name: no message matching '$pattern'"
+        fail=1
+    else
+        echo "ok: $name (status $rc)"
+        return 0
+    fi
+    sed 's/^/    /' "$dir/out"
+    return 1
+}
+
+# edit: stdin reaches every rank through rank 0.
+mkdir "$dir/f1" "$dir/fm"
+# shellcheck disable=SC2086
+"$vwalls" edit "$scene" -o "$dir/f1/%d.png" --log "$dir/log1" $common <"$dir/edits" >/dev/null 2>&1
+want=$?
+# shellcheck disable=SC2086
+if run "edit from stdin" "$want" "" "$vwalls" edit "$scene" -o "$dir/fm/%d.png" --log "$dir/logm" $common; then
+    cmp "$dir/log1" "$dir/logm" || { echo "FAIL: edit: the logs differ"; fail=1; }
+    for f in 0 1; do
+        cmp "$dir/f1/$f.png" "$dir/fm/$f.png" || { echo "FAIL: edit: frame $f differs"; fail=1; }
+    done
+fi
+
+exit $fail

@@ -67,7 +67,8 @@ add_test(NAME mpi_print_once
 set_tests_properties(mpi_print_once PROPERTIES LABELS "mpi" TIMEOUT 120
                      ENVIRONMENT "${VW_MPI_ENV}" PROCESSORS 2)
 
-# Input only some ranks have (stdin of vwalls edit): no rank is left waiting.
+# Input only some ranks have (stdin of vwalls edit, a file missing on one host) and
+# outputs only rank 0 writes: no rank is left waiting.
 add_test(NAME mpi_rank_input
          COMMAND sh ${PROJECT_SOURCE_DIR}/tests/mpi/rank_input.sh $<TARGET_FILE:vwalls_tool>
                  ${PROJECT_SOURCE_DIR}/tests/data/good/mixed.nff

@@ -146,25 +146,32 @@ static int do_frame(vw_anim_session *s)
     const rt_shared *sh = rt_job_shared(job);
     int w = sh->view.width, h = sh->view.height;
     /* Without -o (vwalls edit) a frame still renders; its times are reported. */
+    vw_status wst = VW_OK;
+    err[0] = 0;
     if (vw_cli_is_output() && s->pattern) {
         char path[4096];
+        uint8_t *rgb = NULL;
         /* The pattern has exactly one integer conversion (vw_cli_frame_pattern). */
         if (snprintf(path, sizeof path, s->pattern, s->frame) >= (int)sizeof path) {
-            vw_cli_error(s->cmd, "frame %d: the file name is longer than %zu bytes", s->frame,
-                         sizeof path - 1);
-            return s->failed = 1;
+            snprintf(err, sizeof err, "frame %d: the file name is longer than %zu bytes", s->frame,
+                     sizeof path - 1);
+            wst = VW_E_INVAL;
+        } else if (!(rgb = malloc((size_t)w * h * 3))) {
+            snprintf(err, sizeof err, "frame %d: %s", s->frame, vw_status_message(VW_E_NOMEM));
+            wst = VW_E_NOMEM;
+        } else {
+            rt_job_rgb8(job, rgb);
+            /* Compressed on as many threads as the process has workers (idle now). */
+            wst = vw_image_write_png_threads(path, w, h, rgb, vw_world_workers(rt_job_world(job)),
+                                             err, sizeof err);
+            free(rgb);
         }
-        uint8_t *rgb = malloc((size_t)w * h * 3);
-        if (!rgb) return s->failed = 1;
-        rt_job_rgb8(job, rgb);
-        /* Compressed on as many threads as the process has workers (idle now). */
-        rc = vw_image_write_png_threads(path, w, h, rgb, vw_world_workers(rt_job_world(job)), err,
-                                        sizeof err);
-        free(rgb);
-        if (rc != VW_OK) {
-            vw_cli_error(s->cmd, "%s", err);
-            return s->failed = 1;
-        }
+    }
+    /* Only the output process writes; all stop when it cannot (a missing directory), or
+       the others would wait for it in the next edit's collective calls forever. */
+    if (vw_engine_agree(wst, err, sizeof err) != VW_OK) {
+        vw_cli_error(s->cmd, "%s", err);
+        return s->failed = 1;
     }
     if (s->nframes == s->capframes) {
         size_t cap = s->capframes ? 2 * s->capframes : 16;
@@ -460,22 +467,33 @@ int vw_anim_main(const char *cmd, int argc, char **argv)
     p.farm = (rt_farm)vw_cli_farm_resolve(farm, s->strategy != NULL); /* as render's */
     s->farm = p.farm;
     double t_start = vw_cli_now();
+    /* Under MPI every process opens the edits and reads the scene; all stop if one
+       cannot (a file missing on one host), and the output process says which and why. */
     FILE *in = stdin;
     s->name = "stdin";
+    char err[1024] = "";
+    vw_status ost = VW_OK;
     if (edits_path) {
         in = fopen(edits_path, "r");
         struct stat sb;
         if (!in || (fstat(fileno(in), &sb) == 0 && S_ISDIR(sb.st_mode))) {
-            vw_cli_error(cmd, "cannot open '%s': %s", edits_path, in ? strerror(EISDIR) : strerror(errno));
+            snprintf(err, sizeof err, "cannot open '%s': %s", edits_path,
+                     in ? strerror(EISDIR) : strerror(errno));
             if (in) fclose(in);
-            goto done;
+            in = NULL;
+            ost = VW_E_IO;
         }
         s->name = edits_path;
     }
-    char err[1024];
+    if (vw_engine_agree(ost, err, sizeof err) != VW_OK) {
+        vw_cli_error(cmd, "%s", err);
+        if (in && in != stdin) fclose(in);
+        goto done;
+    }
     vw_scene *scene = NULL;
-    if (vw_scene_read_file(scene_path, &scene, err, sizeof err) != VW_OK) {
+    if (vw_engine_agree(vw_scene_read_file(scene_path, &scene, err, sizeof err), err, sizeof err) != VW_OK) {
         if (vw_cli_is_output()) fprintf(stderr, "%s\n", err);
+        vw_scene_free(scene);
         if (in != stdin) fclose(in);
         goto done;
     }
@@ -486,14 +504,15 @@ int vw_anim_main(const char *cmd, int argc, char **argv)
         rc = st == VW_E_INVAL ? VW_EXIT_USAGE : VW_EXIT_FAIL; /* as render's */
         goto done;
     }
-    if (log_path && vw_cli_is_output()) {
-        if (vw_outfile_open(log_path, &s->logf, err, sizeof err) != VW_OK) {
+    if (log_path) { /* written by the output process; all stop when it cannot */
+        vw_status lst = vw_cli_is_output() ? vw_outfile_open(log_path, &s->logf, err, sizeof err) : VW_OK;
+        if (vw_engine_agree(lst, err, sizeof err) != VW_OK) {
             vw_cli_error(cmd, "%s", err);
             if (in != stdin) fclose(in);
             rc = VW_EXIT_FAIL;
             goto done;
         }
-        s->log = vw_outfile_stream(s->logf);
+        if (s->logf) s->log = vw_outfile_stream(s->logf);
     }
     /* Whole lines, however long (the parser refuses a long command; a long comment is
        fine), so no tail of a line is ever read as a line of its own. */

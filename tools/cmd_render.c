@@ -377,9 +377,12 @@ int vw_cmd_render(int argc, char **argv)
     double t_load0 = vw_cli_now();
     char err[1024];
     vw_scene *scene = NULL;
-    if (vw_scene_read_file(scene_path, &scene, err, sizeof err) != VW_OK) {
-        /* The parser's "file:line: message", as it is. */
+    /* Under MPI every process reads the scene; all stop if one cannot (a file missing on
+       one host), and the output process says which and why (the parser's
+       "file:line: message", as it is, after "rank R: " under MPI). */
+    if (vw_engine_agree(vw_scene_read_file(scene_path, &scene, err, sizeof err), err, sizeof err) != VW_OK) {
         if (vw_cli_is_output()) fprintf(stderr, "%s\n", err);
+        vw_scene_free(scene);
         free(speeds), free(slowdown);
         return VW_EXIT_USAGE;
     }

@@ -1,7 +1,10 @@
 #!/bin/sh
-# rank_input.sh - input that only some ranks have never leaves a rank waiting:
+# rank_input.sh - input and output that only some ranks have never leave a rank waiting:
 #   * vwalls edit reads stdin, which the launcher gives rank 0 alone: every rank must
-#     apply the same edits (same log and frames as the single process's).
+#     apply the same edits (same log and frames as the single process's);
+#   * a scene or an edit script missing on one rank stops every rank, naming it;
+#   * an output only rank 0 writes (animate's frames, --log) into a missing directory
+#     stops every rank with the single process's status.
 # Every job must end within 30 s.
 # usage: rank_input.sh VWALLS SCENE "MPIEXEC -n 2 [flags]"
 vwalls=$1 scene=$2 launch=$3
@@ -10,6 +13,8 @@ trap 'rm -rf "$dir"' EXIT
 fail=0
 common="--size 48x48 --cells 2x2x2 --workers 1"
 printf 'move 0 0.01 0 0\nframe\nbogus\nmove 1 0 0.01 0\nframe\n' >"$dir/edits"
+cp "$scene" "$dir/s0.nff"
+cp "$dir/edits" "$dir/e0.txt"
 
 # run NAME WANT_STATUS GREP_PATTERN args... : under the launcher, within 30 s
 run() {
@@ -48,4 +53,23 @@ if run "edit from stdin" "$want" "" "$vwalls" edit "$scene" -o "$dir/fm/%d.png" 
     done
 fi
 
+# A file only rank 0 has (the others look for s1.nff, e1.txt, ...).
+rank='${OMPI_COMM_WORLD_RANK:-$PMI_RANK}'
+# shellcheck disable=SC2086
+run "render, scene missing on rank 1" 2 "rank 1: .*s1.nff" \
+    sh -c "exec \"$vwalls\" render \"$dir/s$rank.nff\" -o \"$dir/r.png\" $common"
+# shellcheck disable=SC2086
+run "animate, scene missing on rank 1" 2 "rank 1: .*s1.nff" \
+    sh -c "exec \"$vwalls\" animate \"$dir/s$rank.nff\" \"$dir/edits\" -o \"$dir/a%d.png\" $common"
+# shellcheck disable=SC2086
+run "animate, edits missing on rank 1" 2 "rank 1: .*e1.txt" \
+    sh -c "exec \"$vwalls\" animate \"$scene\" \"$dir/e$rank.txt\" -o \"$dir/a%d.png\" $common"
+
+# Outputs into a missing directory: status 1, as the single process's.
+# shellcheck disable=SC2086
+run "animate -o into a missing directory" 1 "nodir/0.png" \
+    "$vwalls" animate "$scene" "$dir/edits" -o "$dir/nodir/%d.png" $common
+# shellcheck disable=SC2086
+run "animate --log into a missing directory" 1 "nodir/log" \
+    "$vwalls" animate "$scene" "$dir/edits" -o "$dir/a%d.png" --log "$dir/nodir/log" $common
 exit $fail

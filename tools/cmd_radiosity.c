@@ -136,7 +136,11 @@ static void on_round(void *user, rad_solver *s, int round)
         r->failed = 1;
         return;
     }
-    if (vw_world_is_output(rad_solver_world(s)) && write_outputs(r, s)) r->failed = 1;
+    /* Only the output process writes; every process learns whether it could, and all
+       stop snapshotting together, or the others would wait for it in the next collect. */
+    vw_world *w = rad_solver_world(s);
+    vw_status wst = vw_world_is_output(w) && write_outputs(r, s) ? VW_E_IO : VW_OK;
+    if (vw_world_agree(w, wst, err, sizeof err) != VW_OK) r->failed = 1;
 }
 
 /* Can a file be made at path: its directory exists and may be written into, and path

@@ -3,8 +3,9 @@
 #   * vwalls edit reads stdin, which the launcher gives rank 0 alone: every rank must
 #     apply the same edits (same log and frames as the single process's);
 #   * a scene or an edit script missing on one rank stops every rank, naming it;
-#   * an output only rank 0 writes (animate's frames, --log) into a missing directory
-#     stops every rank with the single process's status.
+#   * an output only rank 0 writes (animate's frames, --log) into a missing directory,
+#     or a radiosity snapshot on a full disk, stops every rank with the single
+#     process's status.
 # Every job must end within 30 s.
 # usage: rank_input.sh VWALLS SCENE "MPIEXEC -n 2 [flags]"
 vwalls=$1 scene=$2 launch=$3
@@ -72,4 +73,8 @@ run "animate -o into a missing directory" 1 "nodir/0.png" \
 # shellcheck disable=SC2086
 run "animate --log into a missing directory" 1 "nodir/log" \
     "$vwalls" animate "$scene" "$dir/edits" -o "$dir/a%d.png" --log "$dir/nodir/log" $common
+# A radiosity snapshot rank 0 cannot write (a full disk) stops every rank.
+"$vwalls" gen cornell -o "$dir/cornell.nff"
+run "radiosity, a snapshot that cannot be written" 1 "No space left" \
+    "$vwalls" radiosity "$dir/cornell.nff" -o /dev/full --snapshot-every 20 --cells 2x2x2 --workers 1
 exit $fail

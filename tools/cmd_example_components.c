@@ -82,7 +82,8 @@ int vw_cmd_example_components(int argc, char **argv)
     double t2 = vw_cli_now();
     int rc = VW_EXIT_OK;
     if (st != VW_OK) {
-        vw_cli_error(CMD, "run failed: %s", w ? vw_world_errmsg(w) : vw_status_message(st));
+        /* With w NULL, vw_world_errmsg says why the world was not made. */
+        vw_cli_error(CMD, "run failed: %s", vw_world_errmsg(w));
         rc = VW_EXIT_FAIL;
     }
     if (rc == VW_EXIT_OK && vw_world_is_output(w)) {

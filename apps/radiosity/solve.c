@@ -485,7 +485,7 @@ vw_status rad_solver_create(const rad_mesh *m, const vw_decomp *d, const rad_opt
     if (st == VW_OK) st = vw_world_commit(s->w);
     if (st != VW_OK) {
         snprintf(err, errlen, "cannot set up the radiosity world: %s",
-                 s->w ? vw_world_errmsg(s->w) : vw_status_message(st));
+                 vw_world_errmsg(s->w)); /* s->w NULL: why it was not made */
         rad_solver_free(s);
         return st;
     }

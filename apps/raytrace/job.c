@@ -276,7 +276,7 @@ vw_status rt_job_create(const vw_scene *s, const rt_params *p, rt_job **out, cha
     vw_config cfg = rt_job_config(p);
     st = vw_world_create(&rt_module, sh, j->decomp, &cfg, &j->world);
     if (st != VW_OK) {
-        snprintf(err, errlen, "cannot create the world: %s", vw_status_message(st));
+        snprintf(err, errlen, "cannot create the world: %s", vw_world_errmsg(NULL)); /* why not */
         free(objs);
         rt_job_free(j);
         return st;

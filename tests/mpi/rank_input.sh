@@ -2,7 +2,8 @@
 # rank_input.sh - input and output that only some ranks have never leave a rank waiting:
 #   * vwalls edit reads stdin, which the launcher gives rank 0 alone: every rank must
 #     apply the same edits (same log and frames as the single process's);
-#   * a scene or an edit script missing on one rank stops every rank, naming it;
+#   * a scene or an edit script missing on one rank stops every rank, naming it, and
+#     another --workers on one rank is named as such;
 #   * an output only rank 0 writes (animate's frames, --log) into a missing directory,
 #     or a radiosity snapshot on a full disk, stops every rank with the single
 #     process's status.
@@ -65,6 +66,13 @@ run "animate, scene missing on rank 1" 2 "rank 1: .*s1.nff" \
 # shellcheck disable=SC2086
 run "animate, edits missing on rank 1" 2 "rank 1: .*e1.txt" \
     sh -c "exec \"$vwalls\" animate \"$scene\" \"$dir/e$rank.txt\" -o \"$dir/a%d.png\" $common"
+
+# Ranks given different worker counts: the message says so (not "invalid argument").
+wrank='$(('"$rank"' + 1))'
+run "render, another worker count on rank 1" 2 "different worker counts" \
+    sh -c "exec \"$vwalls\" render \"$scene\" -o \"$dir/r.png\" --size 48x48 --cells 2x2x2 --workers $wrank"
+run "example-pairs, another worker count on rank 1" 1 "different worker counts" \
+    sh -c "exec \"$vwalls\" example-pairs --spheres 500 --workers $wrank"
 
 # Outputs into a missing directory: status 1, as the single process's.
 # shellcheck disable=SC2086

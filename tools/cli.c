@@ -196,6 +196,24 @@ void vw_cli_engine_init(int *argc, char ***argv)
 
 void vw_cli_engine_finish(void) { vw_engine_finish(); }
 
+int vw_cli_same_as_first(const char *cmd, const double *v, size_t n, const char *what)
+{
+    if (vw_engine_size() == 1) return 0;
+    double *first = malloc(n * sizeof *first + 1);
+    if (!first) vw_engine_abort(VW_EXIT_FAIL, "vwalls: out of memory comparing the processes' input");
+    memcpy(first, v, n * sizeof *first);
+    vw_engine_broadcast(first, n * sizeof *first);
+    /* Bit for bit: the same text parsed by the same binary gives the same doubles. */
+    vw_status mine = memcmp(first, v, n * sizeof *first) ? VW_E_INVAL : VW_OK;
+    free(first);
+    char msg[256];
+    snprintf(msg, sizeof msg, "was given another %s than rank 0: every process must run the "
+             "same command on the same input", what);
+    if (vw_engine_agree(mine, msg, sizeof msg) == VW_OK) return 0;
+    vw_cli_error(cmd, "%s", msg);
+    return -1;
+}
+
 void vw_progress_begin(vw_progress *p, const char *label, int quiet)
 {
     p->label = label;
@@ -251,4 +269,23 @@ int vw_cli_appendf(char **buf, size_t *len, size_t *cap, const char *fmt, ...)
         *buf = nb;
         *cap = ncap;
     }
+}
+
+int vw_cli_same_view(const char *cmd, int width, int height, long depth, const vw_camera *cam,
+                     const vw_scene *scene)
+{
+    enum { MAXL = 64 };
+    /* As many numbers on every process (the broadcast needs it), unused ones 0; the
+       first MAXL lights and their count. */
+    double v[6 + 10 + 1 + 6 * MAXL] = {0};
+    size_t n = 0;
+    v[n++] = width, v[n++] = height, v[n++] = (double)depth;
+    v[n++] = cam->width, v[n++] = cam->height, v[n++] = cam->hither;
+    for (int k = 0; k < 3; k++) v[n++] = cam->from[k], v[n++] = cam->at[k], v[n++] = cam->up[k];
+    v[n++] = cam->angle;
+    v[n++] = (double)scene->nlights;
+    for (size_t l = 0; l < scene->nlights && l < MAXL; l++)
+        for (int k = 0; k < 3; k++) v[n++] = scene->lights[l].pos[k], v[n++] = scene->lights[l].color[k];
+    return vw_cli_same_as_first(cmd, v, sizeof v / sizeof v[0],
+                                "view (image size, depth, camera or lights)");
 }

@@ -47,6 +47,18 @@ int vw_cli_is_output(void);
    the processes. Valid after vw_cli_engine_init. */
 int vw_cli_job_workers(long workers);
 
+/* Under MPI, checks that every process holds the same n numbers v as the first process
+   (collective: every process calls it with the same n). 0 when they do, or without MPI;
+   else -1 on every process, and the output process prints "vwalls CMD: rank R was given
+   another WHAT than rank 0" (a scene file that differs between hosts, another option). */
+int vw_cli_same_as_first(const char *cmd, const double *v, size_t n, const char *what);
+
+/* vw_cli_same_as_first for what the ray tracer draws: the image size and depth asked
+   for, the camera and the scene's lights (the world's own check at commit compares only
+   the cells and the objects' bounds). */
+int vw_cli_same_view(const char *cmd, int width, int height, long depth, const vw_camera *cam,
+                     const vw_scene *scene);
+
 /* MPI set-up for the command line: initialises MPI when the process was started by a
    launcher (and the build has MPI), so the same binary runs with and without mpirun.
    vw_cli_engine_finish finalises what init started. Both are safe to call without MPI. */

@@ -497,6 +497,11 @@ int vw_anim_main(const char *cmd, int argc, char **argv)
         if (in != stdin) fclose(in);
         goto done;
     }
+    if (vw_cli_same_view(cmd, p.width, p.height, depth, &scene->camera, scene)) {
+        vw_scene_free(scene);
+        if (in != stdin) fclose(in);
+        goto done;
+    }
     vw_status st = rt_anim_create(scene, &p, &s->anim, err, sizeof err);
     if (st != VW_OK) {
         vw_cli_error(cmd, "%s", err);

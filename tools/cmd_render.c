@@ -420,6 +420,12 @@ int vw_cmd_render(int argc, char **argv)
         return VW_EXIT_USAGE;
     }
 
+    if (vw_cli_same_view(CMD, width, height, depth, &cam, scene)) {
+        vw_scene_free(scene);
+        free(speeds), free(slowdown);
+        return VW_EXIT_USAGE;
+    }
+
     rt_params p;
     memset(&p, 0, sizeof p);
     p.width = width;

@@ -3,7 +3,7 @@
 #   * vwalls edit reads stdin, which the launcher gives rank 0 alone: every rank must
 #     apply the same edits (same log and frames as the single process's);
 #   * a scene or an edit script missing on one rank stops every rank, naming it, and
-#     another --workers on one rank is named as such;
+#     another --workers, --depth or camera on one rank is named as such;
 #   * an output only rank 0 writes (animate's frames, --log) into a missing directory,
 #     or a radiosity snapshot on a full disk, stops every rank with the single
 #     process's status.
@@ -57,6 +57,7 @@ fi
 
 # A file only rank 0 has (the others look for s1.nff, e1.txt, ...).
 rank='${OMPI_COMM_WORLD_RANK:-$PMI_RANK}'
+wrank='$(('"$rank"' + 1))'
 # shellcheck disable=SC2086
 run "render, scene missing on rank 1" 2 "rank 1: .*s1.nff" \
     sh -c "exec \"$vwalls\" render \"$dir/s$rank.nff\" -o \"$dir/r.png\" $common"
@@ -67,8 +68,18 @@ run "animate, scene missing on rank 1" 2 "rank 1: .*s1.nff" \
 run "animate, edits missing on rank 1" 2 "rank 1: .*e1.txt" \
     sh -c "exec \"$vwalls\" animate \"$scene\" \"$dir/e$rank.txt\" -o \"$dir/a%d.png\" $common"
 
+# A scene whose camera differs on rank 1, and another --depth there: each would draw
+# another image (the world's check compares only cells and object bounds).
+sed 's/^from [-0-9.e ]*/from 9 9 9 /' "$scene" >"$dir/s1.nff"
+cmp -s "$scene" "$dir/s1.nff" && { echo "FAIL: $scene has no 'from' line"; fail=1; }
+# shellcheck disable=SC2086
+run "render, another camera on rank 1" 2 "rank 1: was given another view" \
+    sh -c "exec \"$vwalls\" render \"$dir/s$rank.nff\" -o \"$dir/r.png\" $common"
+run "animate, another --depth on rank 1" 2 "rank 1: was given another view" \
+    sh -c "exec \"$vwalls\" animate \"$scene\" \"$dir/edits\" -o \"$dir/a%d.png\" --size 48x48 --cells 2x2x2 --depth $wrank"
+rm "$dir/s1.nff"
+
 # Ranks given different worker counts: the message says so (not "invalid argument").
-wrank='$(('"$rank"' + 1))'
 run "render, another worker count on rank 1" 2 "different worker counts" \
     sh -c "exec \"$vwalls\" render \"$scene\" -o \"$dir/r.png\" --size 48x48 --cells 2x2x2 --workers $wrank"
 run "example-pairs, another worker count on rank 1" 1 "different worker counts" \

@@ -77,9 +77,20 @@ VW_API vw_status vw_polygon_triangulate(const double (*v)[3], int n, int (*tri)[
             p[i][0] = v[i][ax];
             p[i][1] = v[i][ay];
         }
+        /* The turn at every corner, between the corners before and after it that lie
+           elsewhere: a repeated corner (a, b, b) turns by 0, and at a reflex corner
+           given twice no triple of consecutive corners saw the turn, so an L whose
+           inner corner a file repeats was fanned across its notch. */
         convex = 1;
-        for (int i = 0; i < n && convex; i++)
-            convex = orient(p, i, (i + 1) % n, (i + 2) % n) >= 0;
+        for (int i = 0; i < n && convex; i++) {
+            int j = (i + 1) % n, k;
+            while (j != i && same_point((const double (*)[2])p, i, j))
+                j = (j + 1) % n;
+            for (k = (j + 1) % n; k != i && same_point((const double (*)[2])p, j, k); k = (k + 1) % n)
+                ;
+            if (j != i && k != j)
+                convex = orient((const double (*)[2])p, i, j, k) >= 0;
+        }
     }
     if (convex) {
         free(p);
@@ -104,6 +115,22 @@ VW_API vw_status vw_polygon_triangulate(const double (*v)[3], int n, int (*tri)[
        degenerate polygon: no interior to keep) is fanned from where the turn ended,
        so there are always n - 2 triangles and the work stays O(n^3) at worst. */
     int k = 0, left = n, b = 0, tried = 0;
+    /* A corner at the same place as the next one is never an ear (it turns by 0), and
+       a ring left with such pairs finds no ear and is fanned across its notches: each
+       is cut off first as a triangle of no area, keeping the count at n - 2. */
+    for (int i = 0; i < n && left > 3; i++) {
+        if (!same_point((const double (*)[2])p, i, next[i]))
+            continue;
+        tri[k][0] = prev[i];
+        tri[k][1] = i;
+        tri[k][2] = next[i];
+        k++;
+        next[prev[i]] = next[i];
+        prev[next[i]] = prev[i];
+        left--;
+        if (b == i)
+            b = next[i];
+    }
     while (left > 3) {
         int a = prev[b], c = next[b];
         if (is_ear((const double (*)[2])p, next, a, b, c)) {

@@ -306,13 +306,20 @@ static vw_status mesh_polygon(rad_mesh *m, size_t *cap, const vw_decomp *d, cons
 #define CHUNK (RAD_MAXV - 10)
 
 /* Does the polygon (on its plane, normal n) turn left, or go straight on, at every
-   corner? A turn to the right by more than rounding makes it concave. */
+   corner? A turn to the right by more than rounding makes it concave. The turn is taken
+   between corners at different places: a corner given twice turns by 0 with its copy,
+   and an L whose inner corner a file repeats was meshed as convex, its corner piece
+   concave. */
 static int is_convex(const double (*v)[3], int nv, const double n[3])
 {
     for (int i = 0; i < nv; i++) {
+        int j = (i + 1) % nv, k;
+        while (j != i && !memcmp(v[j], v[i], sizeof v[i])) j = (j + 1) % nv;
+        for (k = (j + 1) % nv; k != i && !memcmp(v[k], v[j], sizeof v[j]);) k = (k + 1) % nv;
+        if (j == i || k == j) continue;
         double e1[3], e2[3], x[3];
-        rad_sub(v[(i + 1) % nv], v[i], e1);
-        rad_sub(v[(i + 2) % nv], v[(i + 1) % nv], e2);
+        rad_sub(v[j], v[i], e1);
+        rad_sub(v[k], v[j], e2);
         rad_cross(e1, e2, x);
         if (rad_dot(x, n) < -1e-12 * rad_norm(e1) * rad_norm(e2)) return 0;
     }

@@ -663,6 +663,9 @@ static int t_concave(void)
     double lxz[6][2] = {{0, 0}, {0, 2}, {1.07, 2}, {1.07, 1.07}, {2, 1.07}, {2, 0}};
     double lsplit[8][2] = {{0, 0}, {0, 2}, {1.07, 2}, {1.07, 0}, {1.07, 0}, {1.07, 1.07}, {2, 1.07}, {2, 0}};
     int lsplit_n[2] = {4, 4};
+    /* The L with its inner corner given twice: no three consecutive corners show its
+       turn, and it was meshed as a convex polygon, its corner piece concave. */
+    double l2xz[7][2] = {{0, 0}, {0, 2}, {1.07, 2}, {1.07, 1.07}, {1.07, 1.07}, {2, 1.07}, {2, 0}};
     /* The gear: tooth i spans angles (i + f) 2 pi / TEETH for f in 0 .. 0.5, radii 0.7 (root)
        and 1.0 (tip); corners in decreasing angle so the normal is +y. Split: the root
        polygon (2 TEETH corners, convex) and one quad per tooth. */
@@ -696,8 +699,9 @@ static int t_concave(void)
     } sh[] = {
         {"L", lxz, 6, 2 * 2 - 0.93 * 0.93, lsplit, lsplit_n, 2},
         {"gear", gxz, GN, garea, gsplit, gsplit_n, 1 + TEETH},
+        {"L2", l2xz, 7, 2 * 2 - 0.93 * 0.93, lsplit, lsplit_n, 2},
     };
-    for (int si = 0; si < 2; si++) {
+    for (int si = 0; si < 3; si++) {
         vw_scene *sc = floor_scene((const double(*)[2])sh[si].xz, &sh[si].n, 1);
         vw_scene *cv = floor_scene((const double(*)[2])sh[si].split, sh[si].split_n, sh[si].nsplit);
         rad_options o;
@@ -724,7 +728,13 @@ static int t_concave(void)
                 if (pc->poly != 0) continue;
                 area += pc->area;
                 for (int k = 0; k < pc->nv; k++) {
-                    const double *a = pc->v[k], *b = pc->v[(k + 1) % pc->nv], *c = pc->v[(k + 2) % pc->nv];
+                    /* The turn between the next corners elsewhere: a repeated corner
+                       turns by 0 and would hide the turn at it. */
+                    int kb = (k + 1) % pc->nv, kc;
+                    while (kb != k && !memcmp(pc->v[kb], pc->v[k], sizeof pc->v[k])) kb = (kb + 1) % pc->nv;
+                    for (kc = (kb + 1) % pc->nv; kc != k && !memcmp(pc->v[kc], pc->v[kb], sizeof pc->v[kb]);)
+                        kc = (kc + 1) % pc->nv;
+                    const double *a = pc->v[k], *b = pc->v[kb], *c = pc->v[kc];
                     double e1x = b[0] - a[0], e1z = b[2] - a[2], e2x = c[0] - b[0], e2z = c[2] - b[2];
                     /* +y normal: a left turn seen from above is e1 x e2 along +y. */
                     double turn = e1z * e2x - e1x * e2z;

@@ -22,12 +22,18 @@ static int same_point(const double (*p)[2], int a, int b)
     return p[a][0] == p[b][0] && p[a][1] == p[b][1];
 }
 
-/* Is (a, b, c), counterclockwise, an ear of the ring: strictly convex at b, and no other
-   corner of the ring inside it or on its edges? Corners at the same place as a, b or c
-   (repeated vertices) do not count against it. */
-static int is_ear(const double (*p)[2], const int *next, int a, int b, int c)
+/* Is (a, b, c), counterclockwise, an ear of the ring: strictly convex at b, no larger
+   than the area the ring still encloses (twice that area is room), and no other corner
+   of the ring inside it or on its edges? Corners at the same place as a, b or c
+   (repeated vertices) do not count against it. A corner at the same place as a
+   neighbour, or the tip of a spike (a and c at one place: the ring goes out to b and
+   back), encloses nothing and is always cut off, as a triangle of no area. */
+static int is_ear(const double (*p)[2], const int *next, int a, int b, int c, double room)
 {
-    if (!(orient(p, a, b, c) > 0))
+    if (same_point(p, a, b) || same_point(p, b, c) || same_point(p, a, c))
+        return 1;
+    double o = orient(p, a, b, c);
+    if (!(o > 0) || o > room)
         return 0;
     for (int r = next[c]; r != a; r = next[r]) {
         if (same_point(p, r, a) || same_point(p, r, b) || same_point(p, r, c))
@@ -115,25 +121,19 @@ VW_API vw_status vw_polygon_triangulate(const double (*v)[3], int n, int (*tri)[
        degenerate polygon: no interior to keep) is fanned from where the turn ended,
        so there are always n - 2 triangles and the work stays O(n^3) at worst. */
     int k = 0, left = n, b = 0, tried = 0;
-    /* A corner at the same place as the next one is never an ear (it turns by 0), and
-       a ring left with such pairs finds no ear and is fanned across its notches: each
-       is cut off first as a triangle of no area, keeping the count at n - 2. */
-    for (int i = 0; i < n && left > 3; i++) {
-        if (!same_point((const double (*)[2])p, i, next[i]))
-            continue;
-        tri[k][0] = prev[i];
-        tri[k][1] = i;
-        tri[k][2] = next[i];
-        k++;
-        next[prev[i]] = next[i];
-        prev[next[i]] = prev[i];
-        left--;
-        if (b == i)
-            b = next[i];
-    }
+    /* Twice the area the ring still encloses, less each ear cut off: an ear larger than
+       that lies outside the polygon. Where a polygon touches itself at a corner, the
+       corners there do not count against an ear (they are its own corner), and once
+       the parts around it were cut off, the ring left (area 0) took a triangle across
+       the empty side (two squares meeting at a corner came out 3/2 their area). */
+    double room = 0;
+    for (int i = 0; i < n; i++)
+        room += p[i][0] * p[next[i]][1] - p[next[i]][0] * p[i][1];
+    const double slack = 1e-9 * fabs(room);
     while (left > 3) {
         int a = prev[b], c = next[b];
-        if (is_ear((const double (*)[2])p, next, a, b, c)) {
+        if (is_ear((const double (*)[2])p, next, a, b, c, room + slack)) {
+            room -= orient((const double (*)[2])p, a, b, c);
             tri[k][0] = a;
             tri[k][1] = b;
             tri[k][2] = c;

@@ -34,6 +34,13 @@ target_include_directories(test_io_number PRIVATE ${PROJECT_SOURCE_DIR}/tests ${
 target_link_libraries(test_io_number PRIVATE vwalls_static m)
 add_test(NAME io_number COMMAND test_io_number)
 
+# vw_polygon_triangulate on 90,000 random concave polygons with repeated corners and
+# corners passed twice, near and far from the origin: triangles inside, adding up.
+add_executable(test_io_triangulate ${PROJECT_SOURCE_DIR}/tests/io/test_io_triangulate.c)
+target_include_directories(test_io_triangulate PRIVATE ${PROJECT_SOURCE_DIR}/tests)
+target_link_libraries(test_io_triangulate PRIVATE vwalls_static m)
+add_test(NAME io_triangulate COMMAND test_io_triangulate)
+
 # The command's output files and its help texts (each script says what it checks; a
 # few seconds).
 foreach(t outputs help)

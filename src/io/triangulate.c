@@ -22,13 +22,26 @@ static int same_point(const double (*p)[2], int a, int b)
     return p[a][0] == p[b][0] && p[a][1] == p[b][1];
 }
 
+/* Does corner x lie strictly inside the angle the triangle (a, b, c), counterclockwise,
+   has at its corner `at` (0, 1, 2: a, b, c)? */
+static int in_angle(const double (*p)[2], int a, int b, int c, int at, int x)
+{
+    const int t[3] = {a, b, c};
+    int before = t[(at + 2) % 3], here = t[at], after = t[(at + 1) % 3];
+    return orient(p, before, here, x) > 0 && orient(p, here, after, x) > 0;
+}
+
 /* Is (a, b, c), counterclockwise, an ear of the ring: strictly convex at b, no larger
    than the area the ring still encloses (twice that area is room), and no other corner
-   of the ring inside it or on its edges? Corners at the same place as a, b or c
-   (repeated vertices) do not count against it. A corner at the same place as a
-   neighbour, or the tip of a spike (a and c at one place: the ring goes out to b and
-   back), encloses nothing and is always cut off, as a triangle of no area. */
-static int is_ear(const double (*p)[2], const int *next, int a, int b, int c, double room)
+   of the ring inside it or on its edges? A corner at the same place as a, b or c (a
+   repeated corner, or one the polygon passes twice) is not inside, but its ring edges
+   must not enter the triangle there: where two parts of a polygon meet at a corner, a
+   triangle from one part across that corner into the other covered the outside between
+   them. A corner at the same place as a neighbour, or the tip of a spike (a and c at one
+   place: the ring goes out to b and back), encloses nothing and is always cut off, as a
+   triangle of no area. */
+static int is_ear(const double (*p)[2], const int *next, const int *prev, int a, int b, int c,
+                  double room)
 {
     if (same_point(p, a, b) || same_point(p, b, c) || same_point(p, a, c))
         return 1;
@@ -36,8 +49,12 @@ static int is_ear(const double (*p)[2], const int *next, int a, int b, int c, do
     if (!(o > 0) || o > room)
         return 0;
     for (int r = next[c]; r != a; r = next[r]) {
-        if (same_point(p, r, a) || same_point(p, r, b) || same_point(p, r, c))
+        int at = same_point(p, r, a) ? 0 : same_point(p, r, b) ? 1 : same_point(p, r, c) ? 2 : -1;
+        if (at >= 0) {
+            if (in_angle(p, a, b, c, at, prev[r]) || in_angle(p, a, b, c, at, next[r]))
+                return 0;
             continue;
+        }
         if (orient(p, a, b, r) >= 0 && orient(p, b, c, r) >= 0 && orient(p, c, a, r) >= 0)
             return 0;
     }
@@ -126,13 +143,19 @@ VW_API vw_status vw_polygon_triangulate(const double (*v)[3], int n, int (*tri)[
        corners there do not count against an ear (they are its own corner), and once
        the parts around it were cut off, the ring left (area 0) took a triangle across
        the empty side (two squares meeting at a corner came out 3/2 their area). */
-    double room = 0;
-    for (int i = 0; i < n; i++)
-        room += p[i][0] * p[next[i]][1] - p[next[i]][0] * p[i][1];
-    const double slack = 1e-9 * fabs(room);
+    /* Summed as a fan of differences, and compared with a slack of the polygon's size
+       squared: products of the coordinates themselves lose the area to rounding far
+       from the origin. */
+    double room = 0, lo[2] = {p[0][0], p[0][1]}, hi[2] = {p[0][0], p[0][1]};
+    for (int i = 1; i + 1 < n; i++)
+        room += orient((const double (*)[2])p, 0, i, i + 1);
+    for (int i = 1; i < n; i++)
+        for (int a = 0; a < 2; a++)
+            lo[a] = fmin(lo[a], p[i][a]), hi[a] = fmax(hi[a], p[i][a]);
+    const double size = fmax(hi[0] - lo[0], hi[1] - lo[1]), slack = 1e-9 * size * size;
     while (left > 3) {
         int a = prev[b], c = next[b];
-        if (is_ear((const double (*)[2])p, next, a, b, c, room + slack)) {
+        if (is_ear((const double (*)[2])p, next, prev, a, b, c, room + slack)) {
             room -= orient((const double (*)[2])p, a, b, c);
             tri[k][0] = a;
             tri[k][1] = b;

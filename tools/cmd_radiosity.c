@@ -406,6 +406,16 @@ int vw_cmd_radiosity(int argc, char **argv)
         vw_scene_default_camera(sc, &r.cam);
     if (W > 0) r.cam.width = W, r.cam.height = H;
     if (r.cam.width <= 0) r.cam.width = 512, r.cam.height = 512;
+    /* A scene file's own resolution may be larger than --size allows: refused here, as
+       render refuses it, not found out by an allocation after the whole solve. */
+    if (r.image && (r.cam.width > 16384 || r.cam.height > 16384)) {
+        vw_cli_error(CMD, "--image: picture size %dx%d too large (at most 16384 on a side; give "
+                          "--size)", r.cam.width, r.cam.height);
+        rad_mesh_free(&mesh);
+        vw_decomp_free(d);
+        vw_scene_free(sc);
+        return VW_EXIT_USAGE;
+    }
 
     rad_solver *s = NULL;
     double t2 = vw_cli_now();

@@ -81,6 +81,16 @@ awk -F, '$1 == 0 && $3 == 1 && $4 == 1 && $5 == 1 { ok = 1 } END { exit !ok }' "
 [ $rc -eq 2 ] || fail "--image .jpg: exit $rc"
 grep -q "image .*v.jpg: the picture must end in .png or .pfm" "$T/err" || fail "--image .jpg: message: $(cat "$T/err")"
 [ ! -e "$T/v.jpg" ] && [ ! -e "$T/v.ply" ] || fail "--image .jpg: output written"
+# A scene file's own resolution beyond 16384 a side: refused before the solve, as render
+# refuses it (it was allocated after the solve); --size overrides it.
+sed 's/^resolution .*/resolution 20000 10/' "$T/cornell.nff" > "$T/wide.nff"
+"$V" radiosity "$T/wide.nff" --image "$T/w.png" -o "$T/w.ply" --max-shots 4 --quiet 2>"$T/err"; rc=$?
+[ $rc -eq 2 ] || fail "resolution 20000 10: exit $rc"
+grep -q "picture size 20000x10 too large (at most 16384 on a side" "$T/err" ||
+  fail "resolution 20000 10: message: $(cat "$T/err")"
+[ ! -e "$T/w.png" ] && [ ! -e "$T/w.ply" ] || fail "resolution 20000 10: output written"
+"$V" radiosity "$T/wide.nff" --image "$T/w.png" --size 16x8 --max-shots 4 --quiet 2>"$T/err" ||
+  fail "resolution 20000 10 with --size 16x8: $(cat "$T/err")"
 # Looking straight down (+y up would be parallel to the view): +z is up instead.
 "$V" radiosity "$T/cornell.nff" --image "$T/v.png" --view 278,540,280,278,0,280,100 \
   --size 16x16 --max-shots 4 --quiet 2>"$T/err" || fail "vertical --view: $(cat "$T/err")"

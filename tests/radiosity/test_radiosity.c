@@ -87,40 +87,65 @@ static void result_free(result *r)
     free(r->area), free(r->B), free(r->inc);
 }
 
-static result solve(const vw_scene *sc, rad_options o)
+/* A scene meshed on o's layout and solved as o says: what every solving test starts from
+   (rad_options.quiet on; close with solved_close). */
+typedef struct solved {
+    vw_decomp *d;
+    rad_mesh m;
+    rad_solver *s;
+    int conv;
+    const rad_elem_result *e; /* the collected elements */
+    size_t ne;
+} solved;
+
+static void solved_open(const vw_scene *sc, rad_options o, solved *v)
+{
+    memset(v, 0, sizeof *v);
+    o.quiet = 1;
+    vw_box wb = rad_world_box(sc);
+    CHECK(vw_decomp_create_grid(&wb, o.dims, &v->d) == VW_OK);
+    char err[512] = "";
+    vw_status st = rad_mesh_build(sc, "test", v->d, &o, &v->m, err, sizeof err);
+    if (st != VW_OK) fprintf(stderr, "%s\n", err);
+    CHECK(st == VW_OK);
+    st = rad_solver_create(&v->m, v->d, &o, &v->s, err, sizeof err);
+    if (st != VW_OK) fprintf(stderr, "%s\n", err);
+    CHECK(st == VW_OK);
+    CHECK(rad_solver_run(v->s, NULL, NULL, &v->conv, err, sizeof err) == VW_OK);
+    CHECK(rad_solver_collect(v->s, err, sizeof err) == VW_OK);
+    v->e = rad_solver_elements(v->s, &v->ne);
+}
+
+static void solved_close(solved *v)
+{
+    rad_solver_free(v->s);
+    rad_mesh_free(&v->m);
+    vw_decomp_free(v->d);
+}
+
+/* Per polygon: area, radiosity, incident power; and the run's ledger, shots, ratio. */
+static result result_of(const solved *v)
 {
     result r;
     memset(&r, 0, sizeof r);
-    o.quiet = 1;
-    vw_box wb = rad_world_box(sc);
-    vw_decomp *d;
-    CHECK(vw_decomp_create_grid(&wb, o.dims, &d) == VW_OK);
-    rad_mesh m;
-    char err[512] = "";
-    vw_status st = rad_mesh_build(sc, "test", d, &o, &m, err, sizeof err);
-    if (st != VW_OK) fprintf(stderr, "%s\n", err);
-    CHECK(st == VW_OK);
-    rad_solver *s;
-    st = rad_solver_create(&m, d, &o, &s, err, sizeof err);
-    if (st != VW_OK) fprintf(stderr, "%s\n", err);
-    CHECK(st == VW_OK);
-    int conv = 0;
-    CHECK(rad_solver_run(s, NULL, NULL, &conv, err, sizeof err) == VW_OK);
-    CHECK(rad_solver_collect(s, err, sizeof err) == VW_OK);
-    size_t ne;
-    const rad_elem_result *e = rad_solver_elements(s, &ne);
-    r.npoly = m.npolys;
+    r.npoly = v->m.npolys;
     r.area = calloc(r.npoly, sizeof *r.area);
     r.B = calloc(r.npoly, sizeof *r.B);
     r.inc = calloc(r.npoly, sizeof *r.inc);
-    rad_polygon_sums(e, ne, r.npoly, r.area, r.B, r.inc);
-    r.ledger = rad_solver_ledger(s);
-    r.shots = rad_solver_shots(s);
-    r.ratio = rad_solver_unshot_ratio(s);
-    if (o.max_rounds == 0 && o.max_shots == 0) CHECK(conv);
-    rad_solver_free(s);
-    rad_mesh_free(&m);
-    vw_decomp_free(d);
+    rad_polygon_sums(v->e, v->ne, r.npoly, r.area, r.B, r.inc);
+    r.ledger = rad_solver_ledger(v->s);
+    r.shots = rad_solver_shots(v->s);
+    r.ratio = rad_solver_unshot_ratio(v->s);
+    return r;
+}
+
+static result solve(const vw_scene *sc, rad_options o)
+{
+    solved v;
+    solved_open(sc, o, &v);
+    result r = result_of(&v);
+    if (o.max_rounds == 0 && o.max_shots == 0) CHECK(v.conv);
+    solved_close(&v);
     return r;
 }
 
@@ -321,34 +346,16 @@ typedef struct leaf {
 /* Solves like solve() and also returns the leaves of non-emitting polygons. */
 static result solve_leaves(const vw_scene *sc, rad_options o, leaf **out, size_t *nout)
 {
-    result r;
-    memset(&r, 0, sizeof r);
-    o.quiet = 1;
-    vw_box wb = rad_world_box(sc);
-    vw_decomp *d;
-    CHECK(vw_decomp_create_grid(&wb, o.dims, &d) == VW_OK);
-    rad_mesh m;
-    char err[512] = "";
-    CHECK(rad_mesh_build(sc, "test", d, &o, &m, err, sizeof err) == VW_OK);
-    rad_solver *s;
-    CHECK(rad_solver_create(&m, d, &o, &s, err, sizeof err) == VW_OK);
-    int conv = 0;
-    CHECK(rad_solver_run(s, NULL, NULL, &conv, err, sizeof err) == VW_OK);
-    CHECK(conv);
-    CHECK(rad_solver_collect(s, err, sizeof err) == VW_OK);
-    size_t ne;
-    const rad_elem_result *e = rad_solver_elements(s, &ne);
-    r.npoly = m.npolys;
-    r.area = calloc(r.npoly, sizeof *r.area);
-    r.B = calloc(r.npoly, sizeof *r.B);
-    r.inc = calloc(r.npoly, sizeof *r.inc);
-    rad_polygon_sums(e, ne, r.npoly, r.area, r.B, r.inc);
-    r.ledger = rad_solver_ledger(s);
-    r.shots = rad_solver_shots(s);
+    solved v;
+    solved_open(sc, o, &v);
+    CHECK(v.conv);
+    result r = result_of(&v);
+    const rad_elem_result *e = v.e;
+    size_t ne = v.ne;
     *out = calloc(ne, sizeof **out);
     *nout = 0;
     for (size_t i = 0; i < ne; i++) {
-        const rad_piece *pc = &m.pieces[e[i].piece];
+        const rad_piece *pc = &v.m.pieces[e[i].piece];
         /* Emitters, and slivers left by clipping (few pixels, noisy in any solution). */
         double size = pc->elem / (double)(1 << e[i].level);
         if (pc->emit[0] + pc->emit[1] + pc->emit[2] > 0 || e[i].area < 0.5 * size * size) continue;
@@ -361,9 +368,7 @@ static result solve_leaves(const vw_scene *sc, rad_options o, leaf **out, size_t
         l->y = (pc->rho[0] * e[i].incident[0] + pc->rho[1] * e[i].incident[1] + pc->rho[2] * e[i].incident[2]) /
                (3 * e[i].area);
     }
-    rad_solver_free(s);
-    rad_mesh_free(&m);
-    vw_decomp_free(d);
+    solved_close(&v);
     return r;
 }
 
@@ -491,31 +496,18 @@ static size_t count_elements(const vw_scene *sc, const char *layout, size_t *sli
 {
     rad_options o;
     rad_options_init(&o);
-    o.quiet = 1;
     o.workers = 2;
     o.max_shots = 1;
     vw_layout_parse(layout, o.dims, NULL, 0);
-    vw_box wb = rad_world_box(sc);
-    vw_decomp *d;
-    CHECK(vw_decomp_create_grid(&wb, o.dims, &d) == VW_OK);
-    rad_mesh m;
-    char err[512] = "";
-    CHECK(rad_mesh_build(sc, "test", d, &o, &m, err, sizeof err) == VW_OK);
-    rad_solver *s;
-    CHECK(rad_solver_create(&m, d, &o, &s, err, sizeof err) == VW_OK);
-    int conv = 0;
-    CHECK(rad_solver_run(s, NULL, NULL, &conv, err, sizeof err) == VW_OK);
-    CHECK(rad_solver_collect(s, err, sizeof err) == VW_OK);
-    size_t ne;
-    const rad_elem_result *e = rad_solver_elements(s, &ne);
+    solved v;
+    solved_open(sc, o, &v);
     *slivers = 0;
-    for (size_t i = 0; i < ne; i++) {
-        double h = m.pieces[e[i].piece].elem / (double)(1 << e[i].level);
-        *slivers += !(e[i].area > 1e-6 * h * h);
+    for (size_t i = 0; i < v.ne; i++) {
+        double h = v.m.pieces[v.e[i].piece].elem / (double)(1 << v.e[i].level);
+        *slivers += !(v.e[i].area > 1e-6 * h * h);
     }
-    rad_solver_free(s);
-    rad_mesh_free(&m);
-    vw_decomp_free(d);
+    size_t ne = v.ne;
+    solved_close(&v);
     return ne;
 }
 

@@ -98,17 +98,26 @@ typedef struct solved {
     size_t ne;
 } solved;
 
+/* The scene's world box cut on o's layout, and the scene meshed on it (named `name` in
+   messages); what every solving and meshing test starts from. */
+static void meshed(const vw_scene *sc, const char *name, const rad_options *o, vw_decomp **d,
+                   rad_mesh *m)
+{
+    vw_box wb = rad_world_box(sc);
+    CHECK(vw_decomp_create_grid(&wb, o->dims, d) == VW_OK);
+    char err[512] = "";
+    vw_status st = rad_mesh_build(sc, name, *d, o, m, err, sizeof err);
+    if (st != VW_OK) fprintf(stderr, "%s\n", err);
+    CHECK(st == VW_OK);
+}
+
 static void solved_open(const vw_scene *sc, rad_options o, solved *v)
 {
     memset(v, 0, sizeof *v);
     o.quiet = 1;
-    vw_box wb = rad_world_box(sc);
-    CHECK(vw_decomp_create_grid(&wb, o.dims, &v->d) == VW_OK);
+    meshed(sc, "test", &o, &v->d, &v->m);
     char err[512] = "";
-    vw_status st = rad_mesh_build(sc, "test", v->d, &o, &v->m, err, sizeof err);
-    if (st != VW_OK) fprintf(stderr, "%s\n", err);
-    CHECK(st == VW_OK);
-    st = rad_solver_create(&v->m, v->d, &o, &v->s, err, sizeof err);
+    vw_status st = rad_solver_create(&v->m, v->d, &o, &v->s, err, sizeof err);
     if (st != VW_OK) fprintf(stderr, "%s\n", err);
     CHECK(st == VW_OK);
     CHECK(rad_solver_run(v->s, NULL, NULL, &v->conv, err, sizeof err) == VW_OK);
@@ -468,10 +477,9 @@ static result reference(const vw_scene *sc, rad_options o, rad_reference *ref)
     o.dims[0] = o.dims[1] = o.dims[2] = 1;
     vw_box wb = rad_world_box(sc);
     vw_decomp *d;
-    CHECK(vw_decomp_create_grid(&wb, o.dims, &d) == VW_OK);
     rad_mesh m;
+    meshed(sc, "test", &o, &d, &m);
     char err[512] = "";
-    CHECK(rad_mesh_build(sc, "test", d, &o, &m, err, sizeof err) == VW_OK);
     vw_status st = rad_reference_solve(&m, &wb, o.res, 1e-13, 100000, ref, err, sizeof err);
     if (st != VW_OK) fprintf(stderr, "%s\n", err);
     CHECK(st == VW_OK);
@@ -707,12 +715,9 @@ static int t_concave(void)
         for (int l = 0; l < 3; l++) {
             vw_layout_parse(layouts[l], o.dims, NULL, 0);
             /* The mesh: convex pieces inside the polygon that add up to its area. */
-            vw_box wb = rad_world_box(sc);
             vw_decomp *d;
-            CHECK(vw_decomp_create_grid(&wb, o.dims, &d) == VW_OK);
             rad_mesh m;
-            char err[512] = "";
-            CHECK(rad_mesh_build(sc, "test", d, &o, &m, err, sizeof err) == VW_OK);
+            meshed(sc, "test", &o, &d, &m);
             double area = 0;
             int concave = 0, outside = 0;
             for (size_t i = 0; i < m.npieces; i++) {
@@ -835,9 +840,8 @@ static int t_reference_file(const char *path, const char *csv, double ps, int re
     o.elem_split = elems;
     vw_box wb = rad_world_box(sc);
     vw_decomp *d;
-    CHECK(vw_decomp_create_grid(&wb, o.dims, &d) == VW_OK);
     rad_mesh m;
-    CHECK(rad_mesh_build(sc, path, d, &o, &m, err, sizeof err) == VW_OK);
+    meshed(sc, path, &o, &d, &m);
     rad_reference ref;
     vw_status st = rad_reference_solve(&m, &wb, o.res, 1e-13, 100000, &ref, err, sizeof err);
     if (st != VW_OK) {

@@ -373,6 +373,7 @@ static vw_status mesh_concave(rad_mesh *m, size_t *cap, const vw_decomp *d, cons
                               const vw_material *mat, int *cells, int ncap, double tiny,
                               double *squares)
 {
+    if (nv < 3) return VW_OK; /* no area (is_convex takes every smaller polygon anyway) */
     int (*tri)[3] = malloc(sizeof *tri * (size_t)(nv - 2));
     part *parts = malloc(sizeof *parts * (size_t)(nv - 2));
     vw_status st = tri && parts ? vw_polygon_triangulate(v, nv, tri) : VW_E_NOMEM;

@@ -78,7 +78,12 @@ vw_status rt_job_farm(rt_job *j, rt_farm f, int *copies, char *err, size_t errle
     int *on = malloc(sizeof(int) * (size_t)gw), *have = malloc(sizeof(int) * (size_t)gw);
     vw_status st = hosts && proc_hosts && on && have ? VW_OK : VW_E_NOMEM;
     for (int c = 0; st == VW_OK && c < nc; c++) {
-        hosts[vw_world_cell_worker(w, c)] = 1;
+        int m = vw_world_cell_worker(w, c); /* -1 only for a cell outside 0..nc-1 */
+        if (m < 0 || m >= gw) {
+            st = VW_E_INVAL;
+            break;
+        }
+        hosts[m] = 1;
         int n = vw_world_replicas(w, c, have, gw);
         for (int i = 0; i < n; i++) hosts[have[i]] = 1;
     }

@@ -227,9 +227,11 @@ static void enqueue(vw_ctx *ctx, int slot, int dest, int cell, int kind, const v
    running its callbacks: the balancer's measured load. The clock is read when the
    worker switches unit by message or step; an inline hand-off (vw_ctx_enter) only
    notes the unit it enters, because a clock read (28 ns here) costs as much as the ray
-   segment it would time. The time since the last read is shared evenly among the units
-   noted since, and read again once VW__METER_N are noted; without hand-offs a unit is
-   charged exactly the time between its switches, as before. */
+   segment it would time. The time since the last read is shared evenly among the notes
+   since (a unit noted k times gets k shares), and read again once VW__METER_N are
+   noted; without hand-offs a unit is charged exactly the time between its switches.
+   A note is a count on the unit, which joins the worker's list of units at its first
+   note: the list has each unit once, however often a ray passes back and forth. */
 static void meter_charge(vw__worker *wk, double now)
 {
     vw_world *w = wk->w;
@@ -243,45 +245,49 @@ static void meter_charge(vw__worker *wk, double now)
         dt = now - wk->mark;
     }
     wk->busy_s += dt;
-    double share = wk->nmetered > 1 ? dt / wk->nmetered : dt;
-    for (int i = 0; i < wk->nmetered; i++)
-        if (wk->metered[i]) *wk->metered[i] += share;
+    double share = wk->nnotes > 1 ? dt / wk->nnotes : dt;
+    for (int i = 0; i < wk->nmetered; i++) {
+        vw__busy *u = wk->metered[i];
+        u->s += u->notes == 1 ? share : share * u->notes;
+        u->notes = 0;
+    }
     wk->mark = now;
-    wk->nmetered = 0;
+    wk->nmetered = wk->nnotes = 0;
 }
 
-/* The busy time of unit (cell, rep), or NULL for no unit (cell < 0). */
-static double *unit_busy(vw_world *w, int cell, int rep)
+/* The busy time of unit (cell, rep), or the worker's `idle` for no unit (cell < 0). */
+static vw__busy *unit_busy(vw__worker *wk, int cell, int rep)
 {
-    if (cell < 0) return NULL;
-    return rep ? &w->cells[cell].reps[rep - 1].busy_s : &w->cells[cell].busy_s;
+    vw_world *w = wk->w;
+    if (cell < 0) return &wk->idle;
+    return rep ? &w->cells[cell].reps[rep - 1].busy : &w->cells[cell].busy;
+}
+
+/* Notes that unit u runs (an inline hand-off, or a switch): timed with the next clock
+   read. At most VW__METER_N notes, so the list of distinct units cannot overflow. */
+static inline void meter_note(vw__worker *wk, vw__busy *u)
+{
+    if (u->notes++ == 0) wk->metered[wk->nmetered++] = u;
+    if (++wk->nnotes == VW__METER_N) meter_charge(wk, vw__now());
 }
 
 /* The worker starts running unit (cell, rep): what ran before is charged. */
 static void meter_switch(vw__worker *wk, int cell, int rep)
 {
     meter_charge(wk, vw__now());
-    wk->metered[0] = unit_busy(wk->w, cell, rep);
-    wk->nmetered = 1;
+    meter_note(wk, unit_busy(wk, cell, rep));
 }
 
 /* Starts the meter on unit (cell, rep), the time before uncharged (inbox, idle). */
 static void meter_start(vw__worker *wk, int cell, int rep)
 {
+    for (int i = 0; i < wk->nmetered; i++) wk->metered[i]->notes = 0;
+    wk->nmetered = wk->nnotes = 0;
     wk->mark = vw__now();
-    wk->metered[0] = unit_busy(wk->w, cell, rep);
-    wk->nmetered = 1;
+    meter_note(wk, unit_busy(wk, cell, rep));
 }
 
 static void meter_stop(vw__worker *wk) { meter_charge(wk, vw__now()); }
-
-/* An inline hand-off to the unit whose busy time is `busy`: noted, timed with the next
-   clock read. */
-static void meter_note(vw__worker *wk, double *busy)
-{
-    if (wk->nmetered == VW__METER_N) meter_charge(wk, vw__now());
-    wk->metered[wk->nmetered++] = busy;
-}
 
 /* ---- the module's side: vw_ctx ------------------------------------------------------ */
 
@@ -375,11 +381,11 @@ void *vw_ctx_enter(vw_ctx *ctx, int cell, int kind)
     int noted = cell != ctx->cell || ctx->rep != rep;
     if (rep) {
         vw__replica *r = &c->reps[rep - 1];
-        if (noted) meter_note(ctx->wk, &r->busy_s);
+        if (noted) meter_note(ctx->wk, &r->busy);
         r->messages_in++;
         state = r->state;
     } else {
-        if (noted) meter_note(ctx->wk, &c->busy_s);
+        if (noted) meter_note(ctx->wk, &c->busy);
         c->messages_in++;
         state = c->state;
     }
@@ -398,7 +404,7 @@ void vw_ctx_restore(vw_ctx *ctx, int cell, int replica)
                                    : vw__cell_rep_of(w, cell, ctx->wk->global) == replica);
         if (!hosted) misuse(ctx, "restored cell %d copy %d, which it does not host", cell, replica);
     }
-    meter_note(ctx->wk, unit_busy(ctx->w, cell, replica));
+    meter_note(ctx->wk, unit_busy(ctx->wk, cell, replica));
     ctx->cell = cell;
     ctx->rep = replica;
 }
@@ -501,7 +507,7 @@ static void handle_packet(vw__worker *wk, vw_ctx *ctx, vw__packet *p)
             msgs_in = rep ? &c->reps[rep - 1].messages_in : &c->messages_in;
         } else if (ctx->cell != cur || ctx->rep != rep) {
             /* The last handler handed off inline and came back: this unit runs again. */
-            meter_note(wk, unit_busy(w, cur, rep));
+            meter_note(wk, unit_busy(wk, cur, rep));
         }
         (*msgs_in)++;
         ctx->cell = ctx->home_cell = h->cell;

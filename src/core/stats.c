@@ -130,9 +130,9 @@ static void write_body(vw_world *w, FILE *f, const char *command, const char *ex
             fprintf(f, ", \"replicas\": [");
             for (int r = 0; r < cl->nreps; r++)
                 fprintf(f, "%s{\"worker\": %d, \"busy_s\": %.6f, \"messages_in\": %llu}", r ? ", " : "",
-                        cl->reps[r].worker, num(cl->reps[r].busy_s),
+                        cl->reps[r].worker, num(cl->reps[r].busy.s),
                         (unsigned long long)cl->reps[r].messages_in);
-            fprintf(f, "], \"master_busy_s\": %.6f", num(cl->busy_s));
+            fprintf(f, "], \"master_busy_s\": %.6f", num(cl->busy.s));
         }
         fprintf(f, "}%s\n", c + 1 < w->ncells ? "," : "");
     }

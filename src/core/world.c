@@ -789,8 +789,8 @@ vw_status vw_world_cell_stats(const vw_world *w, int cell, vw_cell_stats *out)
     out->worker = c->worker;
     out->objects = c->nobjs;
     out->messages_in = c->messages_in;
-    out->busy_s = c->busy_s;
-    out->load = c->busy_s;
+    out->busy_s = c->busy.s;
+    out->load = c->busy.s;
     if (w->m->load && c->built && vw__worker_process(w, c->worker) == w->rank)
         out->load = vw__cell_load((vw_world *)w, cell);
     else if (w->m->load && w->nprocs > 1)
@@ -800,9 +800,9 @@ vw_status vw_world_cell_stats(const vw_world *w, int cell, vw_cell_stats *out)
     for (int r = 0; r < c->nreps; r++) {
         const vw__replica *rp = &c->reps[r];
         out->messages_in += rp->messages_in;
-        out->busy_s += rp->busy_s;
+        out->busy_s += rp->busy.s;
         if (!w->m->load)
-            out->load += rp->busy_s;
+            out->load += rp->busy.s;
         else if (rp->built && vw__worker_process(w, rp->worker) == w->rank)
             out->load += vw__replica_load((vw_world *)w, cell, r + 1);
         else
@@ -816,9 +816,9 @@ double vw_world_worker_busy(const vw_world *w, int g)
     if (g < 0 || g >= w->gworkers) return 0;
     double s = 0;
     for (int c = 0; c < w->ncells; c++) {
-        if (w->cells[c].worker == g) s += w->cells[c].busy_s;
+        if (w->cells[c].worker == g) s += w->cells[c].busy.s;
         for (int r = 0; r < w->cells[c].nreps; r++)
-            if (w->cells[c].reps[r].worker == g) s += w->cells[c].reps[r].busy_s;
+            if (w->cells[c].reps[r].worker == g) s += w->cells[c].reps[r].busy.s;
     }
     return s;
 }
@@ -865,12 +865,12 @@ double vw_world_imbalance(const vw_world *w)
 void vw_world_reset_stats(vw_world *w)
 {
     for (int c = 0; c < w->ncells; c++) {
-        w->cells[c].busy_s = 0;
+        w->cells[c].busy.s = 0;
         w->cells[c].messages_in = 0;
         memset(w->cells[c].counters, 0, sizeof(int64_t) * (size_t)(w->m->ncounters > 0 ? w->m->ncounters : 1));
         for (int r = 0; r < w->cells[c].nreps; r++) {
             vw__replica *rp = &w->cells[c].reps[r];
-            rp->busy_s = 0;
+            rp->busy.s = 0;
             rp->messages_in = 0;
             memset(rp->counters, 0, sizeof(int64_t) * (size_t)(w->m->ncounters > 0 ? w->m->ncounters : 1));
         }

@@ -52,6 +52,13 @@ typedef struct vw__packet {
 /* A copy of a duplicated cell on another worker (balance strategy "duplicate"): its
    own module state built from the cell's objects, and its own figures, which add up
    with the master's to the cell's. */
+/* A unit's (a cell's, or a copy's) measured busy time, and the inline hand-offs into it
+   (vw_ctx_enter) that the meter (runtime.c) noted since its worker last read the clock. */
+typedef struct vw__busy {
+    double s;
+    unsigned notes;
+} vw__busy;
+
 typedef struct vw__replica {
     _Alignas(VW__LINE) int worker; /* global worker id, never the master's */
     void *state;
@@ -62,7 +69,7 @@ typedef struct vw__replica {
     /* Written by the hosting worker per message; other workers read `worker` above
        (vw__cell_rep_of), so these get a line of their own. */
     _Alignas(VW__LINE) uint64_t messages_in;
-    double busy_s;
+    vw__busy busy;
     _Atomic uint64_t batches; /* turns taken in this run (vw_ctx_next_batch; other
                                  workers of the process take them too at the end) */
 } vw__replica;
@@ -96,14 +103,14 @@ typedef struct vw__cell {
     /* Written by the hosting worker per message or hand-off: a line of their own, or
        every other worker's reads of the fields above would bounce it between cores. */
     _Alignas(VW__LINE) uint64_t messages_in;
-    double busy_s;
+    vw__busy busy;
     _Atomic uint64_t batches; /* the master's turns taken in this run (as above) */
 } vw__cell;
 
 /* Stride of vw__cell.rr: one cache line per sending worker. */
 #define VW__RR_STRIDE (VW__LINE / sizeof(unsigned))
 
-/* Inline hand-offs (vw_ctx_enter) noted before the meter reads the clock again. */
+/* Units noted (inline hand-offs, vw_ctx_enter) before the meter reads the clock again. */
 #define VW__METER_N 64
 
 typedef struct vw__worker {
@@ -122,10 +129,11 @@ typedef struct vw__worker {
     uint64_t rng;              /* stress switch */
     double busy_s;
     /* The meter (runtime.c): the units (cell, copy) that ran since the clock was last
-       read at `mark`, as their busy_s (NULL for none); that time is shared evenly among
-       them when it is next read. */
-    double *metered[VW__METER_N];
-    int nmetered;
+       read at `mark`, each once, with how often it was noted (its notes); that time is
+       shared among the nnotes notes when it is next read. `idle` stands for no unit. */
+    vw__busy *metered[VW__METER_N];
+    int nmetered, nnotes;
+    vw__busy idle;
     double mark;
     uint64_t msgs_sent, bytes_sent, packets_sent;
     uint64_t msgs_remote, bytes_remote; /* to other processes */

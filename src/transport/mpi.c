@@ -398,8 +398,8 @@ static vw_status tp_sync(vw_world *w)
         int64_t *row = iv + (size_t)c * (size_t)(1 + nc);
         row[0] = (int64_t)cl->messages_in;
         for (int k = 0; k < nc; k++) row[1 + k] = cl->counters[k];
-        dv[2 * c] = cl->busy_s;
-        dv[2 * c + 1] = w->m->load && cl->built ? vw__cell_load(w, c) : cl->busy_s;
+        dv[2 * c] = cl->busy.s;
+        dv[2 * c + 1] = w->m->load && cl->built ? vw__cell_load(w, c) : cl->busy.s;
     }
     size_t u = (size_t)w->ncells;
     for (int c = 0; c < w->ncells; c++)
@@ -409,8 +409,8 @@ static vw_status tp_sync(vw_world *w)
             int64_t *row = iv + u * (size_t)(1 + nc);
             row[0] = (int64_t)rp->messages_in;
             for (int k = 0; k < nc; k++) row[1 + k] = rp->counters[k];
-            dv[2 * u] = rp->busy_s;
-            dv[2 * u + 1] = w->m->load && rp->built ? vw__replica_load(w, c, r + 1) : rp->busy_s;
+            dv[2 * u] = rp->busy.s;
+            dv[2 * u + 1] = w->m->load && rp->built ? vw__replica_load(w, c, r + 1) : rp->busy.s;
         }
     int64_t *wv = iv + ni;
     for (int i = 0; i < w->nworkers; i++) {
@@ -431,7 +431,7 @@ static vw_status tp_sync(vw_world *w)
         const int64_t *row = iv + (size_t)c * (size_t)(1 + nc);
         cl->messages_in = (uint64_t)row[0];
         for (int k = 0; k < nc; k++) cl->counters[k] = row[1 + k];
-        cl->busy_s = dv[2 * c];
+        cl->busy.s = dv[2 * c];
         cl->load = dv[2 * c + 1];
     }
     u = (size_t)w->ncells;
@@ -441,7 +441,7 @@ static vw_status tp_sync(vw_world *w)
             const int64_t *row = iv + u * (size_t)(1 + nc);
             rp->messages_in = (uint64_t)row[0];
             for (int k = 0; k < nc; k++) rp->counters[k] = row[1 + k];
-            rp->busy_s = dv[2 * u];
+            rp->busy.s = dv[2 * u];
             rp->load = dv[2 * u + 1];
         }
     for (size_t g = 0; g < nw; g++) {

@@ -10,6 +10,7 @@ target_link_libraries(test_dynamic PRIVATE vwalls_apps m)
 
 add_test(NAME dynamic_primitives COMMAND test_dynamic primitives)
 add_test(NAME dynamic_tunnel COMMAND test_dynamic tunnel)
+add_test(NAME dynamic_swept COMMAND test_dynamic swept)
 foreach(w 1 2 4)
   add_test(NAME dynamic_placement_w${w} COMMAND test_dynamic placement 4 --workers ${w})
   add_test(NAME dynamic_decisions_w${w} COMMAND test_dynamic decisions 4 --workers ${w})

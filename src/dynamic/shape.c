@@ -120,7 +120,10 @@ static double dist2_seg_seg(const double p1[3], const double q1[3], const double
 
 /* Squared distance between segment pq and triangle abc: zero when the segment pierces
    the triangle, else the nearest of its end points to the triangle and of the segment
-   to the three edges (the minimum of a convex pair lies on one of those features). */
+   to the three edges (the minimum of a convex pair lies on one of those features).
+   Piercing is decided by signs, not by a distance: the point where the segment meets
+   the plane is off the plane by rounding, so its distance to the triangle was never
+   exactly 0, and a small sphere flying through a tilted triangle's middle passed. */
 static double dist2_seg_tri(const double p[3], const double q[3], const double a[3],
                             const double b[3], const double c[3])
 {
@@ -132,12 +135,18 @@ static double dist2_seg_tri(const double p[3], const double q[3], const double a
         double ap[3], aq[3];
         sub(p, a, ap), sub(q, a, aq);
         double sp = dot(ap, n), sq = dot(aq, n);
-        if ((sp <= 0 && sq >= 0) || (sp >= 0 && sq <= 0)) {
-            if (sp != sq) {
-                double t = sp / (sp - sq), x[3];
-                for (int k = 0; k < 3; k++) x[k] = p[k] + t * (q[k] - p[k]);
-                if (dist2_point_tri(x, a, b, c) == 0) return 0;
-            }
+        if (((sp <= 0 && sq >= 0) || (sp >= 0 && sq <= 0)) && sp != sq) {
+            /* The line pq passes inside the triangle when the three scalar triple
+               products of pq with the corners taken in pairs share a sign (Ericson
+               5.3.4); a pierce near an edge that rounding puts outside is caught by
+               the edge distances below, which are then about zero. */
+            double pq[3], pa[3], pb[3], pc[3], m[3], w3[3];
+            sub(q, p, pq), sub(a, p, pa), sub(b, p, pb), sub(c, p, pc);
+            cross(pq, pc, m);
+            double u = dot(pb, m), v = -dot(pa, m);
+            cross(pq, pb, w3);
+            double w = dot(pa, w3);
+            if ((u >= 0 && v >= 0 && w >= 0) || (u <= 0 && v <= 0 && w <= 0)) return 0;
         }
     }
     double best = dist2_point_tri(p, a, b, c);

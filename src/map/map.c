@@ -156,8 +156,15 @@ vw_status vw_map_greedy(const vw_decomp *d, const double *cell_load, int gworker
     if (!d || gworkers < 1 || !cell_worker || !(slack >= 0)) return VW_E_INVAL;
     /* A speed that is not positive (or a negative slack) left no worker within the
        slack of the best, and the cell went to worker -1, past the start of t. */
-    for (int g = 0; speeds && g < gworkers; g++)
+    /* Speeds are relative: taken as fractions of the fastest, the finish times below are
+       of the loads' own size. Raw speeds of 1e308 made them about 1e-306, under the
+       absolute slack 1e-300, so every worker was "near the best" and the neighbours
+       alone placed the cells: seven of eight on one worker of two equal ones. */
+    double smax = 0;
+    for (int g = 0; speeds && g < gworkers; g++) {
         if (!(speeds[g] > 0) || !isfinite(speeds[g])) return VW_E_INVAL;
+        smax = fmax(smax, speeds[g]);
+    }
     int nc = vw_decomp_cell_count(d);
     ranked_cell *order = malloc(sizeof *order * (size_t)nc);
     double *ones = NULL, *t = calloc((size_t)gworkers, sizeof *t);
@@ -183,14 +190,14 @@ vw_status vw_map_greedy(const vw_decomp *d, const double *cell_load, int gworker
         /* Longest processing time first: the worker that would finish this cell first. */
         double best = INFINITY;
         for (int g = 0; g < gworkers; g++) {
-            double f = (t[g] + l) / (speeds ? speeds[g] : 1.0);
+            double f = (t[g] + l) / (speeds ? speeds[g] / smax : 1.0);
             if (f < best) best = f;
         }
         /* Among workers nearly as good, the one hosting most of the cell's neighbours. */
         int pick = -1, pick_nb = -1;
         double pick_f = INFINITY;
         for (int g = 0; g < gworkers; g++) {
-            double f = (t[g] + l) / (speeds ? speeds[g] : 1.0);
+            double f = (t[g] + l) / (speeds ? speeds[g] / smax : 1.0);
             if (f > best * (1.0 + slack) + 1e-300) continue;
             int cnt = 0;
             if (slack > 0)

@@ -492,6 +492,16 @@ static int t_map(void)
         for (int c = 0; c < 256; c++) total += load[c] = 1.0 + (double)((c * 37) % 11);
         EXPECT(vw_map_weighted(d, load, 4, sp, cw) == VW_OK, "weighted");
         for (int c = 0; c < 256; c++) got[cw[c]] += load[c];
+        /* Speeds are relative: scaled by 1e300 (or by 1e-300) they map alike. With raw
+           speeds near 1e308 the finish times fell below the greedy's absolute slack,
+           and two equal workers got seven cells and one. */
+        double big[4], small[4];
+        int cw_big[256], cw_small[256];
+        for (int g = 0; g < 4; g++) big[g] = sp[g] * 1e300, small[g] = sp[g] * 1e-300;
+        EXPECT(vw_map_weighted(d, load, 4, big, cw_big) == VW_OK, "weighted, speeds * 1e300");
+        EXPECT(vw_map_weighted(d, load, 4, small, cw_small) == VW_OK, "weighted, speeds * 1e-300");
+        EXPECT(!memcmp(cw, cw_big, sizeof cw), "speeds * 1e300 map otherwise");
+        EXPECT(!memcmp(cw, cw_small, sizeof cw), "speeds * 1e-300 map otherwise");
         for (int g = 0; g < 4; g++) {
             double want = total * sp[g] / 8.0;
             printf("map: weighted worker %d speed %.0f: load %.1f, proportional share %.1f\n", g,

@@ -640,10 +640,17 @@ static int *make_shares(const vw_world *w, int master, const int *workers, int k
         return NULL;
     }
     int *seq = blk, *pos = blk + L, *first = blk + 2 * L, *n = first; /* n: counts, then offsets */
-    double total = 0;
+    /* As fractions of the fastest unit's speed, so the total is at most k: speeds of
+       1e308 summed to infinity, L * speed / total was inf / inf, and the NaN cast to a
+       count made a share of INT_MIN slots (a crash taking the first turn). */
+    double total = 0, top = 0;
     for (int u = 0; u < k; u++) {
         int g = u ? workers[u - 1] : master;
         want[u] = w->speeds ? w->speeds[g] : 1.0;
+        top = want[u] > top ? want[u] : top;
+    }
+    for (int u = 0; u < k; u++) {
+        want[u] /= top;
         total += want[u];
     }
     int given = 0;

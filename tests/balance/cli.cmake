@@ -58,6 +58,11 @@ render(${WORK}/slow.png ${VWALLS} render ${SCENE} -o ${WORK}/slow.png ${common} 
        --workers 2 --map weighted --slow 1:3)
 render(${WORK}/speeds.png ${VWALLS} render ${SCENE} -o ${WORK}/speeds.png ${common} --cells 4x2
        --workers 2 --map weighted --speeds 1,2)
+# Speeds are relative, at any scale: 1e308 each once summed to infinity, and the shares of
+# a duplicated cell's copies came out NaN (a crash).
+render(${WORK}/huge.png ${VWALLS} render ${SCENE} -o ${WORK}/huge.png ${common} --cells 2x2x2
+       --workers 2 --map weighted --balance duplicate --balance-load segments
+       --speeds 1e308,1e308)
 
 # Bad values: exit 2, no output.
 foreach(bad "--balance;sideways" "--map;random" "--speeds;1,x" "--speeds;1" "--slow;9:2"

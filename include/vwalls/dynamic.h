@@ -67,7 +67,9 @@ VW_API int vw_shape_collide(const vw_shape *a, const double d[3], const vw_shape
    process (through one mailbox cell per process), so every process decides the same.
    No separate ghost exchange is needed: a shape overlapping a wall is held by the cells
    on both sides (the placement rule), so the cells a probe reaches hold every shape
-   that can touch it. */
+   that can touch it. With more processes than cells (mpirun -np 2 on one cell) the
+   collider divides its own copy of the decomposition until every process hosts a cell;
+   vw_collider_world then reports that copy. */
 typedef struct vw_collider vw_collider;
 
 /* What a probe asks. The object `start` (all of whose shapes carry id) moves to `end`.

@@ -215,6 +215,75 @@ static vw_status find_mailboxes(vw_collider *c)
     return VW_OK;
 }
 
+/* More processes than cells (mpirun -np 2 with one cell): a process without a cell has
+   no mailbox, and could not learn the contacts. The collider needs no particular walls,
+   only the placement rule, so it then divides its own copy of the decomposition: the
+   largest cell (by volume; the lowest id on ties) is halved along its longest side, the
+   low half keeping the cell and its worker, the high half a new cell on the first
+   worker of a process without one, until every process hosts a cell. Every process
+   computes the same division. */
+static vw_status give_every_process_a_cell(vw_collider *c, const vw_decomp *d)
+{
+    int np = vw_world_processes(c->world), nw = vw_world_workers(c->world);
+    int nc = vw_decomp_cell_count(d), nn0;
+    const vw_kd_node *n0 = vw_decomp_nodes(d, &nn0);
+    if (!n0 || nc + np > VW_MAX_CELLS) return VW_E_INVAL;
+    vw_kd_node *nodes = malloc(sizeof *nodes * (size_t)(nn0 + 2 * np));
+    int *cw = malloc(sizeof(int) * (size_t)(nc + np));
+    int *hosts = calloc((size_t)np, sizeof(int));
+    vw_decomp *cur = NULL;
+    vw_status st = nodes && cw && hosts ? vw_decomp_clone(d, &cur) : VW_E_NOMEM;
+    int nn = nn0;
+    if (st == VW_OK) {
+        memcpy(nodes, n0, sizeof *nodes * (size_t)nn0);
+        for (int cl = 0; cl < nc; cl++) {
+            cw[cl] = vw_world_cell_worker(c->world, cl);
+            hosts[cw[cl] / nw]++;
+        }
+    }
+    const double *F = vw_decomp_frame(d);
+    vw_box wb = vw_decomp_world(d);
+    for (int p = 0; p < np && st == VW_OK; p++) {
+        if (hosts[p]) continue;
+        int big = 0;
+        double bigv = -1;
+        for (int cl = 0; cl < nc; cl++) {
+            vw_box b = vw_decomp_cell_box(cur, cl);
+            double v = (b.hi[0] - b.lo[0]) * (b.hi[1] - b.lo[1]) * (b.hi[2] - b.lo[2]);
+            if (v > bigv) big = cl, bigv = v;
+        }
+        vw_box b = vw_decomp_cell_box(cur, big);
+        int axis = 0;
+        for (int a = 1; a < 3; a++)
+            if (b.hi[a] - b.lo[a] > b.hi[axis] - b.lo[axis]) axis = a;
+        double split = 0.5 * (b.lo[axis] + b.hi[axis]);
+        if (!(split > b.lo[axis] && split < b.hi[axis])) {
+            st = VW_E_INVAL; /* a cell too thin to halve */
+            break;
+        }
+        int leaf = -1;
+        for (int i = 0; i < nn; i++)
+            if (nodes[i].axis < 0 && nodes[i].cell == big) leaf = i;
+        nodes[nn] = (vw_kd_node){-1, 0, -1, -1, big};
+        nodes[nn + 1] = (vw_kd_node){-1, 0, -1, -1, nc};
+        nodes[leaf] = (vw_kd_node){axis, split, nn, nn + 1, -1};
+        nn += 2;
+        cw[nc++] = p * nw;
+        hosts[p]++;
+        vw_decomp *nd = NULL;
+        st = vw_decomp_create_kd(&wb, nodes, nn, F, VW_DECOMP_DIVIDED, &nd);
+        if (st == VW_OK) {
+            vw_decomp_free(cur);
+            cur = nd;
+        }
+    }
+    if (st == VW_OK) st = vw_world_redecompose(c->world, cur, cw);
+    if (st == VW_OK) st = find_mailboxes(c);
+    vw_decomp_free(cur);
+    free(nodes), free(cw), free(hosts);
+    return st;
+}
+
 vw_status vw_collider_create(const vw_decomp *d, const vw_config *cfg, double tol,
                              vw_collider **out)
 {
@@ -225,7 +294,7 @@ vw_status vw_collider_create(const vw_decomp *d, const vw_config *cfg, double to
     c->tol = tol > 0 ? tol : 0;
     pthread_mutex_init(&c->mu, NULL);
     vw_status st = vw_world_create(&collider_module, c, d, cfg, &c->world);
-    if (st == VW_OK) st = find_mailboxes(c);
+    if (st == VW_OK && find_mailboxes(c) != VW_OK) st = give_every_process_a_cell(c, d);
     if (st != VW_OK) {
         vw_collider_free(c);
         return st;
@@ -260,7 +329,8 @@ vw_status vw_collider_redecompose(vw_collider *c, const vw_decomp *d, const int 
 {
     if (!c || !d) return VW_E_INVAL;
     vw_status st = vw_world_redecompose(c->world, d, cell_worker);
-    return st == VW_OK ? find_mailboxes(c) : st;
+    if (st == VW_OK && find_mailboxes(c) != VW_OK) st = give_every_process_a_cell(c, d);
+    return st;
 }
 
 vw_world *vw_collider_world(vw_collider *c) { return c ? c->world : NULL; }

@@ -46,7 +46,9 @@ vw_status vw_map_parse_speeds(const char *s, double *speeds, int n)
         double v = strtod(q, &end);
         if (end == q || !(v > 0) || !isfinite(v) || k >= n) return VW_E_INVAL;
         speeds[k++] = v;
-        if (*end == ',') end++;
+        /* A comma must be followed by a number: "1,2," is a list cut short, not two
+           speeds. */
+        if (*end == ',' && end[1]) end++;
         else if (*end) return VW_E_INVAL;
         q = end;
     }

@@ -10,7 +10,8 @@
  *                         counted work of a 100%-clustered 1000-sphere scene, 16 cells
  *   rotate                the principal-axis frame of an oblique line of load is the line
  *   map                   every cell mapped once; block keeps a hand layout's neighbour
- *                         share; weighted gives speeds 1,1,2,4 proportional load
+ *                         share; weighted gives speeds 1,1,2,4 proportional load; bad
+ *                         speeds and speed lists refused
  *   duplicate             cell duplication: the same sums and exact counters with copies,
  *                         copies built from the cell's objects (and rebuilt when they
  *                         change), bad copy lists refused, and lambda of the counted work
@@ -532,6 +533,18 @@ static int t_map(void)
                "workers overflow");
         EXPECT(vw_map_compute(VW_MAP_BLOCK, d, load, 0, 2, NULL, cw) == VW_E_INVAL, "0 processes");
         vw_decomp_free(d);
+    }
+    /* Speed lists: exactly n positive numbers between commas. A trailing comma ("1,2,"
+       for 2 workers) used to pass as the two speeds before it. */
+    {
+        double sp[3] = {0};
+        EXPECT(vw_map_parse_speeds("1,2.5", sp, 2) == VW_OK && sp[0] == 1 && sp[1] == 2.5,
+               "'1,2.5': %g %g", sp[0], sp[1]);
+        static const char *const bad[] = {"1,2,", "1,2,,", ",1,2", "1,,2", "1,2,3", "1", "",
+                                          "1,0", "1,-2", "1,nan", "1,inf", "1;2", "1,2x", "1, "};
+        for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++)
+            EXPECT(vw_map_parse_speeds(bad[i], sp, 2) == VW_E_INVAL, "'%s' accepted", bad[i]);
+        EXPECT(vw_map_parse_speeds("1,2,", sp, 3) == VW_E_INVAL, "'1,2,' for 3 workers");
     }
     return vw_test_failures ? 1 : 0;
 }

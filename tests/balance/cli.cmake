@@ -65,7 +65,7 @@ render(${WORK}/huge.png ${VWALLS} render ${SCENE} -o ${WORK}/huge.png ${common} 
        --speeds 1e308,1e308)
 
 # Bad values: exit 2, no output.
-foreach(bad "--balance;sideways" "--map;random" "--speeds;1,x" "--speeds;1" "--slow;9:2"
+foreach(bad "--balance;sideways" "--map;random" "--speeds;1,x" "--speeds;1" "--speeds;1,2," "--slow;9:2"
             "--slow;0:0.5" "--balance-load;guess" "--overlay-by;colour")
   execute_process(COMMAND ${VWALLS} render ${SCENE} -o ${WORK}/bad.png --workers 2 ${bad}
                   RESULT_VARIABLE rc OUTPUT_QUIET ERROR_VARIABLE err)

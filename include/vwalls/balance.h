@@ -62,7 +62,13 @@ VW_API void vw_load_spec_init(vw_load_spec *s);
 /* Per-cell loads of the last run(s) under the model: out has vw_decomp_cell_count()
    entries. Valid on every process after run() (the figures are global then). */
 VW_API vw_status vw_balance_cell_loads(const vw_world *w, const vw_load_spec *s, double *out);
-/* lambda = max / mean over workers of sum(cell load) / speed (speeds NULL = all 1). */
+/* lambda = max / mean over workers of sum(cell load) / speed (speeds NULL = all 1):
+   at least 1; 1 when no worker has load (nothing measured), and for no worker.
+   Never NaN: INFINITY when a speed is not positive and finite (such a worker never
+   finishes; the mappers, vw_balance_world, vw_config.worker_speeds and
+   vw_map_parse_speeds refuse such speeds with VW_E_INVAL) or when a load is negative,
+   NaN or infinite; 0 only when out of memory. cell_worker NULL: cell c on worker
+   c % gworkers; a cell mapped outside [0, gworkers) is not counted. */
 VW_API double vw_balance_imbalance(const double *cell_load, const int *cell_worker, int ncells,
                                    int gworkers, const double *speeds);
 

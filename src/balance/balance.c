@@ -151,6 +151,14 @@ vw_status vw_balance_world(vw_world *w, const vw_load_field *f, const vw_balance
     if (pp.gworkers <= 0) pp.gworkers = w->gworkers;
     const double *speeds = a && a->speeds ? a->speeds : p->speeds;
     pp.speeds = speeds;
+    /* A worker of speed 0 (or less, or NaN) would get no load, or all of it; its lambda
+       is no number to decide by. Refused, as the world refuses such worker_speeds. */
+    for (int g = 0; speeds && g < w->gworkers; g++)
+        if (!(speeds[g] > 0) || !isfinite(speeds[g])) {
+            if (rep) *rep = r;
+            return vw__world_error(w, VW_E_INVAL, "vw_balance_world: worker %d has speed %g: "
+                                   "speeds must be positive and finite", g, speeds[g]);
+        }
 
     /* Before: the field's loads on the current layout and mapping (the field was made
        from, or calibrated by, the last measurement, so these are the measured loads). */

@@ -48,6 +48,11 @@ double vw_balance_imbalance(const double *cell_load, const int *cell_worker, int
                             int gworkers, const double *speeds)
 {
     if (gworkers < 1) return 1.0;
+    /* A worker of speed 0 never finishes its share: no finite lambda describes that,
+       and dividing by it gave inf / inf = NaN, which every comparison a caller makes
+       (lambda <= 1 + tolerance, predicted < before) takes as false. */
+    for (int g = 0; speeds && g < gworkers; g++)
+        if (!(speeds[g] > 0) || !isfinite(speeds[g])) return INFINITY;
     double *t = calloc((size_t)gworkers, sizeof *t);
     if (!t) return 0;
     for (int c = 0; c < ncells; c++) {
@@ -55,12 +60,15 @@ double vw_balance_imbalance(const double *cell_load, const int *cell_worker, int
         if (g >= 0 && g < gworkers) t[g] += cell_load[c];
     }
     double max = 0, sum = 0;
+    int bad = 0;
     for (int g = 0; g < gworkers; g++) {
         double x = speeds ? t[g] / speeds[g] : t[g];
+        bad |= !(x >= 0) || !isfinite(x); /* a negative, NaN or infinite load */
         sum += x;
         if (x > max) max = x;
     }
     free(t);
+    if (bad) return INFINITY;
     return sum > 0 ? max / (sum / gworkers) : 1.0;
 }
 

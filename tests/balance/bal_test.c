@@ -3,7 +3,8 @@
  *   identical SCENE WxH   every strategy (and mapping) renders the same fixed-point sums
  *                         as one cell on one worker
  *   conserve              migration keeps every object in exactly the cells its bounds
- *                         overlap (ids, counts and checksums) through a chain of balancers
+ *                         overlap (ids, counts and checksums) through a chain of balancers;
+ *                         worker speeds of 0 or less refused
  *   staggered8            staggered reaches lambda <= 1.10 on the counted work of a
  *                         50%-clustered 1000-sphere scene with 8 cells
  *   divide16              divide (with its extra rounds) reaches lambda <= 1.06 on the
@@ -11,7 +12,7 @@
  *   rotate                the principal-axis frame of an oblique line of load is the line
  *   map                   every cell mapped once; block keeps a hand layout's neighbour
  *                         share; weighted gives speeds 1,1,2,4 proportional load; bad
- *                         speeds and speed lists refused
+ *                         speeds and speed lists refused; lambda never NaN
  *   duplicate             cell duplication: the same sums and exact counters with copies,
  *                         copies built from the cell's objects (and rebuilt when they
  *                         change), bad copy lists refused, and lambda of the counted work
@@ -299,6 +300,31 @@ static int t_conserve(void)
                rep.imbalance_predicted, (unsigned long long)rep.migrated_objects,
                rep.max_neighbours);
     }
+    /* A worker speed of 0, less, or NaN is refused, by the speeds of the call and of
+       the apply step alike, and the world keeps its walls and placement. */
+    {
+        int cells = vw_decomp_cell_count(vw_world_decomp(w));
+        const double bad[][3] = {{1, 0, 1}, {1, -1, 1}, {1, 1, NAN}, {INFINITY, 1, 1}};
+        for (int i = 0; i < 4; i++)
+            for (int via_apply = 0; via_apply < 2; via_apply++) {
+                vw_balance_params p;
+                vw_balance_params_init(&p);
+                p.strategy = VW_BALANCE_TENSOR;
+                vw_balance_apply ap;
+                memset(&ap, 0, sizeof ap);
+                if (via_apply) ap.speeds = bad[i];
+                else p.speeds = bad[i];
+                vw_balance_report rep;
+                vw_status st = vw_balance_world(w, f, &p, &ap, &rep);
+                EXPECT(st == VW_E_INVAL, "speeds %g,%g,%g (%s): %s", bad[i][0], bad[i][1],
+                       bad[i][2], via_apply ? "apply" : "params", vw_status_name(st));
+            }
+        EXPECT(vw_decomp_cell_count(vw_world_decomp(w)) == cells, "the walls changed");
+        EXPECT(strstr(vw_world_errmsg(w), "speeds must be positive") != NULL, "message: %s",
+               vw_world_errmsg(w));
+        vw_world_commit(w);
+        check_placement(w, objs, n, "after bad speeds");
+    }
     vw_load_field_free(f);
     vw_world_free(w);
     vw_decomp_free(d);
@@ -533,6 +559,29 @@ static int t_map(void)
                "workers overflow");
         EXPECT(vw_map_compute(VW_MAP_BLOCK, d, load, 0, 2, NULL, cw) == VW_E_INVAL, "0 processes");
         vw_decomp_free(d);
+    }
+    /* lambda is never NaN: a worker of speed 0 (it used to give inf / inf, or 0 / 0
+       without load), a negative or NaN speed, or a NaN, infinite or negative load give
+       INFINITY; no load at all gives 1. */
+    {
+        double load[4] = {1, 2, 3, 4}, none[4] = {0}, nanl[4] = {1, NAN, 1, 1};
+        double infl[4] = {1, INFINITY, 1, 1}, negl[4] = {1, -1, 1, 1};
+        int cw[4] = {0, 1, 2, 3};
+        double s1[4] = {1, 1, 1, 1}, s0[4] = {1, 0, 1, 1}, sneg[4] = {1, 1, -2, 1};
+        double snan[4] = {1, 1, 1, NAN}, sinf[4] = {INFINITY, 1, 1, 1};
+        struct { const double *load, *speeds; double want; const char *what; } cases[] = {
+            {load, s1, 4 / 2.5, "1,2,3,4"},       {load, NULL, 4 / 2.5, "no speeds"},
+            {none, s1, 1, "no load"},             {load, s0, INFINITY, "speed 0"},
+            {none, s0, INFINITY, "speed 0, no load"}, {load, sneg, INFINITY, "speed -2"},
+            {load, snan, INFINITY, "speed NaN"},  {load, sinf, INFINITY, "speed inf"},
+            {nanl, NULL, INFINITY, "load NaN"},   {infl, s1, INFINITY, "load inf"},
+            {negl, NULL, INFINITY, "load -1"},
+        };
+        for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+            double lam = vw_balance_imbalance(cases[i].load, cw, 4, 4, cases[i].speeds);
+            EXPECT(lam == cases[i].want || fabs(lam - cases[i].want) <= 1e-12,
+                   "imbalance, %s: %g (want %g)", cases[i].what, lam, cases[i].want);
+        }
     }
     /* Speed lists: exactly n positive numbers between commas. A trailing comma ("1,2,"
        for 2 workers) used to pass as the two speeds before it. */

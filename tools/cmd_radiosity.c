@@ -456,6 +456,15 @@ int vw_cmd_radiosity(int argc, char **argv)
     vw_world *w = rad_solver_world(s);
     if (vw_world_is_output(w)) {
         rad_ledger L = rad_solver_ledger(s);
+        if (vw_cli_fault("ledger")) L.error = INFINITY; /* tests: a run that fails the check */
+        /* Checked before any file is written: a run whose energy does not add up is a
+           failed run, and a failed run leaves no output (a snapshot or a checkpoint
+           written while solving stays: they were right when written). */
+        if (!(L.error <= 1e-6)) { /* NaN too */
+            vw_cli_error(CMD, "energy ledger off by %.3g (relative): no output written", L.error);
+            rc = VW_EXIT_FAIL;
+            goto done;
+        }
         if (write_outputs(&r, s)) {
             rc = VW_EXIT_FAIL;
             goto done;
@@ -521,10 +530,6 @@ int vw_cmd_radiosity(int argc, char **argv)
             fprintf(stderr, "vwalls radiosity: warning: converged before the first shot: no "
                             "patch holds sf = %g of the emitted power (the emitters are meshed "
                             "finer); give a smaller --sf or a larger --patch-size\n", o.sf);
-        if (!(L.error <= 1e-6)) { /* NaN too */
-            vw_cli_error(CMD, "energy ledger off by %.3g (relative)", L.error);
-            rc = VW_EXIT_FAIL;
-        }
     }
 done:
     free(r.trace);

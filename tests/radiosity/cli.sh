@@ -91,6 +91,16 @@ grep -q "picture size 20000x10 too large (at most 16384 on a side" "$T/err" ||
 [ ! -e "$T/w.png" ] && [ ! -e "$T/w.ply" ] || fail "resolution 20000 10: output written"
 "$V" radiosity "$T/wide.nff" --image "$T/w.png" --size 16x8 --max-shots 4 --quiet 2>"$T/err" ||
   fail "resolution 20000 10 with --size 16x8: $(cat "$T/err")"
+# A run whose energy ledger does not add up (forced by the test switch VW_FAULT=ledger)
+# fails with status 1 and leaves none of its outputs: the check comes before the writes
+# (they used to be written complete, and the run failed after them).
+VW_FAULT=ledger "$V" radiosity "$T/cornell.nff" -o "$T/l.ply" --csv "$T/l.csv" --image "$T/l.png" \
+  --stats "$T/l.json" --trace "$T/l.trace" --checkpoint "$T/l.ck" --size 16x16 --max-shots 4 \
+  --quiet 2>"$T/err"; rc=$?
+[ $rc -eq 1 ] || fail "ledger off: exit $rc"
+grep -q "energy ledger off by inf (relative): no output written" "$T/err" || fail "ledger off: message: $(cat "$T/err")"
+for f in l.ply l.csv l.png l.json l.trace l.ck; do [ ! -e "$T/$f" ] || fail "ledger off: $f written"; done
+ls "$T" | grep -q "tmp\." && fail "ledger off: temporary file left behind"
 # Looking straight down (+y up would be parallel to the view): +z is up instead.
 "$V" radiosity "$T/cornell.nff" --image "$T/v.png" --view 278,540,280,278,0,280,100 \
   --size 16x16 --max-shots 4 --quiet 2>"$T/err" || fail "vertical --view: $(cat "$T/err")"

@@ -8,6 +8,7 @@
 
 #include "cli.h"
 #include "commands.h"
+#include "vwalls/engine.h"
 #include "vwalls/gen.h"
 
 static void gen_usage(FILE *f)
@@ -31,7 +32,8 @@ static void gen_usage(FILE *f)
             "  --cluster F       fraction of spheres in the cluster region, 0..1 (default 0)\n"
             "                    (an option the scene has no use for is an error)\n"
             "  --resolution WxH  camera resolution (default 512x512)\n"
-            "  -o FILE           write to FILE (atomically) instead of stdout\n"
+            "  -o FILE           write to FILE (atomically) instead of stdout; under mpirun\n"
+            "                    the first process alone writes it\n"
             "  --help            this text\n"
             "\nexit status: 0 success, 2 bad input or usage, 1 any other failure\n");
 }
@@ -118,7 +120,10 @@ int vw_cmd_gen(int argc, char **argv)
         return st == VW_E_INVAL || st == VW_E_LIMIT ? VW_EXIT_USAGE : VW_EXIT_FAIL;
     }
     if (out) {
-        st = vw_scene_write_nff_file(s, out, err, sizeof err);
+        /* Under mpirun only the output process writes the file, as every command writes
+           its outputs (the others wrote the same bytes over it); all return its status. */
+        st = vw_cli_is_output() ? vw_scene_write_nff_file(s, out, err, sizeof err) : VW_OK;
+        st = vw_engine_agree(st, err, sizeof err);
     } else {
         st = vw_scene_write_nff(s, stdout);
         if (fflush(stdout) != 0 || ferror(stdout))

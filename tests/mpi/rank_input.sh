@@ -4,7 +4,8 @@
 #     apply the same edits (same log and frames as the single process's);
 #   * a scene or an edit script missing on one rank stops every rank, naming it, and
 #     another --workers, --depth or camera on one rank is named as such;
-#   * an output only rank 0 writes (animate's frames, --log) into a missing directory,
+#   * gen -o is written by rank 0 alone;
+#   * an output only rank 0 writes (animate's frames, --log, gen -o) into a missing directory,
 #     or a radiosity snapshot on a full disk, stops every rank with the single
 #     process's status.
 # Every job must end within 30 s.
@@ -92,6 +93,14 @@ run "animate -o into a missing directory" 1 "nodir/0.png" \
 # shellcheck disable=SC2086
 run "animate --log into a missing directory" 1 "nodir/log" \
     "$vwalls" animate "$scene" "$dir/edits" -o "$dir/a%d.png" --log "$dir/nodir/log" $common
+# gen -o: rank 0 alone writes the file (every rank used to write it, each atomically);
+# the others would write g1.nff, ... here. Into a missing directory: status 1.
+run "gen -o, rank 0 alone writes" 0 "" \
+    sh -c "exec \"$vwalls\" gen balls --size 1 -o \"$dir/g$rank.nff\""
+[ -s "$dir/g0.nff" ] || { echo "FAIL: gen -o: rank 0 wrote no file"; fail=1; }
+[ ! -e "$dir/g1.nff" ] || { echo "FAIL: gen -o: rank 1 wrote the file too"; fail=1; }
+run "gen -o into a missing directory" 1 "nodir/g.nff" \
+    "$vwalls" gen balls --size 1 -o "$dir/nodir/g.nff"
 # A radiosity snapshot rank 0 cannot write (a full disk) stops every rank.
 "$vwalls" gen cornell -o "$dir/cornell.nff"
 run "radiosity, a snapshot that cannot be written" 1 "No space left" \

@@ -280,6 +280,36 @@ int vw_cli_appendf(char **buf, size_t *len, size_t *cap, const char *fmt, ...)
     }
 }
 
+int vw_cli_same_options(const char *cmd, const char *const *names, const double *v, size_t n)
+{
+    if (vw_engine_size() == 1) return 0;
+    double *first = malloc(n * sizeof *first + 1);
+    if (!first) vw_engine_abort(VW_EXIT_FAIL, "vwalls: out of memory comparing the processes' options");
+    memcpy(first, v, n * sizeof *first);
+    vw_engine_broadcast(first, n * sizeof *first);
+    /* The first option that differs, bit for bit (the same text parsed by the same
+       binary gives the same doubles), with all its values: --cells is three. */
+    size_t k = 0;
+    while (k < n && !memcmp(&first[k], &v[k], sizeof *v)) k++;
+    char msg[512] = "", mine[160] = "", theirs[160] = "";
+    if (k < n) {
+        size_t a = k, b = k;
+        while (a > 0 && !strcmp(names[a - 1], names[k])) a--;
+        while (b + 1 < n && !strcmp(names[b + 1], names[k])) b++;
+        for (size_t i = a; i <= b; i++) {
+            size_t lm = strlen(mine), lt = strlen(theirs);
+            snprintf(mine + lm, sizeof mine - lm, "%s%g", i > a ? "x" : "", v[i]);
+            snprintf(theirs + lt, sizeof theirs - lt, "%s%g", i > a ? "x" : "", first[i]);
+        }
+        snprintf(msg, sizeof msg, "was given another %s than rank 0 (%s, rank 0 %s): every "
+                 "process must run the same command on the same input", names[k], mine, theirs);
+    }
+    free(first);
+    if (vw_engine_agree(k < n ? VW_E_INVAL : VW_OK, msg, sizeof msg) == VW_OK) return 0;
+    vw_cli_error(cmd, "%s", msg);
+    return -1;
+}
+
 int vw_cli_same_view(const char *cmd, int width, int height, long depth, const vw_camera *cam,
                      const vw_scene *scene)
 {

@@ -58,6 +58,12 @@ int vw_cli_job_workers(long workers);
    another WHAT than rank 0" (a scene file that differs between hosts, another option). */
 int vw_cli_same_as_first(const char *cmd, const double *v, size_t n, const char *what);
 
+/* vw_cli_same_as_first for options: names[k] is the option that gave v[k] (an option of
+   several numbers, like --cells, repeats its name over consecutive entries). The
+   message names the first option that differs and both values: "rank R: was given
+   another --sf than rank 0 (0.0001, rank 0 0.001): ...". */
+int vw_cli_same_options(const char *cmd, const char *const *names, const double *v, size_t n);
+
 /* vw_cli_same_as_first for what the ray tracer draws: the image size and depth asked
    for, the camera and the scene's lights (the world's own check at commit compares only
    the cells and the objects' bounds). */

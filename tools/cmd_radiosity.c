@@ -334,6 +334,22 @@ int vw_cmd_radiosity(int argc, char **argv)
     memset(&cam_view, 0, sizeof cam_view);
     if (view && parse_view(view, &cam_view)) return VW_EXIT_USAGE;
     {
+        /* Under MPI every process must solve the same problem: the world's commit
+           compares only the cells and the objects' bounds, and another --sf or
+           --hemicube on one rank made it shoot and rasterise by other rules (a wrong
+           solution, or a wait for a shot that never comes). The picture's options
+           (--view, --size) and the outputs are the output process's alone. */
+        static const char *const names[] = {"--cells", "--cells", "--cells", "--sf", "--hemicube",
+                                            "--patch-size", "--elements", "--per-round",
+                                            "--neighbourhood", "--subdivide", "--max-level",
+                                            "--max-shots", "--max-rounds"};
+        const double v[] = {o.dims[0], o.dims[1], o.dims[2], o.sf, o.res, o.patch_size,
+                            o.elem_split, o.per_round, o.neighbourhood, o.subdivide,
+                            o.max_level, (double)o.max_shots, o.max_rounds};
+        _Static_assert(sizeof v / sizeof v[0] == sizeof names / sizeof names[0], "one name a value");
+        if (vw_cli_same_options(CMD, names, v, sizeof v / sizeof v[0])) return VW_EXIT_USAGE;
+    }
+    {
         /* Only the output process writes; all stop if it cannot. */
         const char *opts[] = {"-o", "--csv", "--image", "--stats", "--trace", "--checkpoint"};
         const char *paths[] = {r.out, r.csv, r.image, r.stats, trace, o.checkpoint};

@@ -3,7 +3,8 @@
 #   * vwalls edit reads stdin, which the launcher gives rank 0 alone: every rank must
 #     apply the same edits (same log and frames as the single process's);
 #   * a scene or an edit script missing on one rank stops every rank, naming it, and
-#     another --workers, --depth or camera on one rank is named as such;
+#     another --workers, --depth or camera on one rank is named as such, and so is
+#     another radiosity option that changes the solution (--sf, --hemicube, ...);
 #   * gen -o is written by rank 0 alone;
 #   * an output only rank 0 writes (animate's frames, --log, gen -o) into a missing directory,
 #     or a radiosity snapshot on a full disk, stops every rank with the single
@@ -105,4 +106,18 @@ run "gen -o into a missing directory" 1 "nodir/g.nff" \
 "$vwalls" gen cornell -o "$dir/cornell.nff"
 run "radiosity, a snapshot that cannot be written" 1 "No space left" \
     "$vwalls" radiosity "$dir/cornell.nff" -o /dev/full --snapshot-every 20 --cells 2x2x2 --workers 1
+# Radiosity options that change the solution, another on rank 1: status 2 naming the
+# option, no output (the ranks used to agree on the cells alone and solve by different
+# rules). The same options on both ranks still run.
+for opt in "--sf:1e-\$((3 + $rank))" "--hemicube:\$((32 + 32 * $rank))" \
+           "--elements:\$((2 + $rank))" "--subdivide:0.\$((3 + $rank))"; do
+  oname=${opt%%:*} oval=${opt#*:}  # (run sets $name)
+  rm -f "$dir/rad.ply"
+  run "radiosity, another $oname on rank 1" 2 "rank 1: was given another $oname than rank 0" \
+      sh -c "exec \"$vwalls\" radiosity \"$dir/cornell.nff\" -o \"$dir/rad.ply\" --cells 2x2x2 --workers 1 --max-shots 8 --quiet $oname $oval"
+  [ ! -e "$dir/rad.ply" ] || { echo "FAIL: radiosity, another $oname on rank 1: output written"; fail=1; }
+done
+run "radiosity, the same options on every rank" 0 "" \
+    "$vwalls" radiosity "$dir/cornell.nff" -o "$dir/rad.ply" --cells 2x2x2 --workers 1 --max-shots 8 \
+    --quiet --sf 1e-4 --hemicube 32
 exit $fail

@@ -274,6 +274,9 @@ static int session_line(vw_anim_session *s, const char *line, size_t len, int li
         if (rc != VW_OK) {
             if (vw_cli_is_output()) fprintf(stderr, "%s:%d: balance: %s\n", s->name, lineno, err);
             if (rc != VW_E_UNSUPPORTED && !s->interactive) s->failed = 1;
+        } else if (before == 0) { /* the loads were reset by a rebalance: 1 -> 1 said nothing */
+            say(s, "balance: no load measured on the current walls yet (render a frame "
+                   "first): walls unchanged\n");
         } else {
             say(s, "balanced: lambda %.3f -> %.3f predicted\n", before, pred);
         }

@@ -309,6 +309,18 @@ vw_status rt_anim_balance(rt_anim *a, const char *strategy, double *before, doub
     ls.model = VW_LOAD_COUNTER;   /* ray-cell visits: deterministic, the same on every */
     ls.counter = RT_C_SEGMENTS;   /* process and every run, unlike busy time */
     vw_status st = load && cw ? vw_balance_cell_loads(w, &ls, load) : VW_E_NOMEM;
+    /* New walls start with no load measured: until a frame is rendered on them there
+       is nothing to balance by (the loads are the job's own, equal on every process,
+       so every process returns here alike). */
+    double total = 0;
+    for (int c = 0; st == VW_OK && c < nc; c++) total += load[c];
+    if (st == VW_OK && !(total > 0)) {
+        if (before) *before = 0;
+        if (predicted) *predicted = 0;
+        free(load);
+        free(cw);
+        return VW_OK;
+    }
     if (st == VW_OK) st = vw_load_field_create(&f);
     if (st == VW_OK) st = vw_load_field_add_cells(f, vw_world_decomp(w), load, 4);
     vw_balance_report rep;

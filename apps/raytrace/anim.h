@@ -62,7 +62,9 @@ vw_status rt_anim_apply(rt_anim *a, const vw_edit *edits, size_t n, int check, i
    rt_job_rgb8(rt_anim_job(a)) on the output process. */
 vw_status rt_anim_render(rt_anim *a, rt_anim_stats *st, char *err, size_t errlen);
 /* Rebalances the render world with the given strategy from the last frame's measured
-   loads (VW_E_UNSUPPORTED when the build has no balancer); the collider follows. */
+   loads (VW_E_UNSUPPORTED when the build has no balancer); the collider follows. When
+   no load has been measured on the current walls (no frame rendered yet, or none since
+   the last rebalance reset the counters), nothing is done and both lambdas are 0. */
 vw_status rt_anim_balance(rt_anim *a, const char *strategy, double *lambda_before,
                           double *lambda_predicted, char *err, size_t errlen);
 /* Lambda (max/mean worker busy time) of the last frame. */

@@ -57,6 +57,21 @@ a, b = ([(f["work_lambda"], f["balanced"]) for f in json.load(open(x))["animatio
         for x in sys.argv[1:])
 assert a == b and all(bal == (lam > 1.2) for lam, bal in a), (a, b)
 PY
+# The balance command on walls no frame has measured yet (at the start, and right after
+# a rebalance reset the loads) says so and leaves the walls; it used to report
+# "lambda 1.000 -> 1.000". After a frame on unchanged walls it balances by that frame.
+"$V" gen spheres --count 300 --cluster 1 --seed 3 --resolution 32x32 -o clustered.nff || fail "gen clustered"
+printf 'balance\nframe\nbalance\n' > bal.txt
+"$V" animate clustered.nff bal.txt -o 'b%02d.png' --cells 2x2x1 --workers 2 --balance tensor \
+  --threshold 0 --trigger work > bal.out || fail "balance command: status $?"
+sed -n 3p bal.out | grep -q "rebalanced (tensor)" || fail "balance command: frame 0 did not rebalance: $(cat bal.out)"
+[ "$(grep -c "^balance: no load measured on the current walls yet (render a frame first): walls unchanged$" bal.out)" -eq 2 ] &&
+  ! grep -q "1.000 -> 1.000" bal.out || fail "balance command without a measured load: $(cat bal.out)"
+printf 'frame\nbalance\n' > bal2.txt
+"$V" animate clustered.nff bal2.txt -o 'b%02d.png' --cells 2x2x1 --workers 2 --farm none > bal2.out ||
+  fail "balance after a frame: status $?"
+grep -Eq "^balanced: lambda 1\.[0-9]*[1-9][0-9]* -> 1\.[0-9]+ predicted$" bal2.out && ! grep -q "no load measured" bal2.out ||
+  fail "balance after a frame: $(cat bal2.out)"
 "$V" animate scene.nff ok.txt -o 'y%02d.png' --trigger most 2> yerr.txt; rc=$?
 [ $rc -eq 2 ] || fail "--trigger most: status $rc, expected 2"
 grep -q "trigger: bad value 'most'" yerr.txt || fail "--trigger most message: $(cat yerr.txt)"

@@ -191,6 +191,8 @@ double vw_cli_now(void)
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
+static void ignore_warning(const char *msg, void *user) { (void)msg, (void)user; }
+
 /* MPI only when a launcher started us (the library decides: vw_engine_init does nothing
    otherwise), so a plain run of the binary is exactly the threads engine. */
 void vw_cli_engine_init(int *argc, char ***argv)
@@ -201,6 +203,8 @@ void vw_cli_engine_init(int *argc, char ***argv)
         vw_engine_abort(VW_EXIT_FAIL, NULL);
     }
     cli_rank = vw_engine_rank();
+    /* Every process reads the scene; the output process alone warns about it. */
+    if (cli_rank != 0) vw_scene_set_warning_handler(ignore_warning, NULL);
 }
 
 void vw_cli_engine_finish(void) { vw_engine_finish(); }

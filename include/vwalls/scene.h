@@ -83,9 +83,21 @@ typedef struct vw_scene {
 VW_API vw_status vw_scene_read_file(const char *path, vw_scene **out, char *err, size_t errlen);
 VW_API vw_status vw_scene_read_nff(const char *name, const char *text, size_t len,
                                    vw_scene **out, char *err, size_t errlen);
-/* OBJ text; mtllib files are resolved relative to dir (may be NULL: none loaded). */
+/* OBJ text; mtllib files are resolved relative to dir (may be NULL: none loaded, and
+   usemtl names are then not checked). A library that cannot be read and a usemtl
+   name no library defined are warnings, as in common OBJ tools: the faces get the
+   default material (0.8 grey), and each missing library and each unknown name is
+   reported once. An error inside a library that was read still fails the read. */
 VW_API vw_status vw_scene_read_obj(const char *name, const char *text, size_t len,
                                    const char *dir, vw_scene **out, char *err, size_t errlen);
+
+/* Warnings: input the readers take with a fallback. Each is one line, "file:line:
+   warning: message" (no newline), handed to fn(msg, user); the default (and fn NULL)
+   prints it on stderr. The handler is process-wide: set it before reading, not while
+   another thread reads. An MPI program whose processes all read the scene may pass a
+   function that does nothing on all but one of them. */
+typedef void (*vw_warning_fn)(const char *msg, void *user);
+VW_API void vw_scene_set_warning_handler(vw_warning_fn fn, void *user);
 VW_API void vw_scene_free(vw_scene *s);
 
 /* Writers. The NFF written reads back to the same scene, bit for bit (numbers are

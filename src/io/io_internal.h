@@ -25,6 +25,10 @@ void vw__errf(char *err, size_t errlen, const char *fmt, ...)
 vw_status vw__input_error(char *err, size_t errlen, const char *name, int line,
                           const char *fmt, va_list ap);
 
+/* Reports "name:line: warning: message" through the handler of
+   vw_scene_set_warning_handler (by default one line on stderr). */
+void vw__scene_warning(const char *name, int line, const char *fmt, va_list ap);
+
 /* A whole token as a decimal integer with an optional sign, at most maxlen characters
    (so it cannot overflow). Returns 1 and stores it, or 0 when the token is not one. */
 int vw__parse_int(const char *s, size_t n, size_t maxlen, long long *out);

@@ -4,7 +4,9 @@
  * OBJ and MTL specifications' continuation), and messages name the physical line of
  * the token they are about. Faces stay polygons (consumers triangulate) over the shared
  * vertex array; texture coordinates, groups, objects and smoothing are accepted and
- * ignored. OBJ has no camera and no lights: camera.valid is 0.
+ * ignored. OBJ has no camera and no lights: camera.valid is 0. A material library
+ * that cannot be read and a usemtl name no library defines are warnings (once each),
+ * and the faces get the default material, as in common OBJ tools.
  */
 #include <errno.h>
 #include <float.h>
@@ -40,6 +42,8 @@ typedef struct obj {
     size_t nnames, cap_names;
     int cur_mat;          /* -1: the default material, created on first use */
     int default_mat;
+    char **warned;        /* what was warned about ("lib PATH", "mat NAME"): once each */
+    size_t nwarned, cap_warned;
 } obj;
 
 static int is_space(char c)
@@ -132,6 +136,44 @@ static vw_status fail(obj *O, const char *fmt, ...)
     vw_status st = vw__input_error(O->err, O->errlen, O->name, O->line, fmt, ap);
     va_end(ap);
     return st;
+}
+
+/* A warning about key (a library or a material name), unless one was given already:
+   an OBJ naming a missing material on a thousand faces warns once. */
+static vw_status warn_once(obj *O, const char *kind, span key, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 4, 5)))
+#endif
+    ;
+
+static vw_status warn_once(obj *O, const char *kind, span key, const char *fmt, ...)
+{
+    size_t kn = strlen(kind);
+    for (size_t i = 0; i < O->nwarned; i++)
+        if (!strncmp(O->warned[i], kind, kn) && O->warned[i][kn] == ' ' &&
+            strlen(O->warned[i] + kn + 1) == key.n && !memcmp(O->warned[i] + kn + 1, key.s, key.n))
+            return VW_OK;
+    if (O->nwarned == O->cap_warned) {
+        size_t ncap = O->cap_warned ? O->cap_warned * 2 : 8;
+        char **q = realloc(O->warned, ncap * sizeof *q);
+        if (!q)
+            return VW_E_NOMEM;
+        O->warned = q;
+        O->cap_warned = ncap;
+    }
+    char *copy = malloc(kn + 1 + key.n + 1);
+    if (!copy)
+        return VW_E_NOMEM;
+    memcpy(copy, kind, kn);
+    copy[kn] = ' ';
+    memcpy(copy + kn + 1, key.s, key.n);
+    copy[kn + 1 + key.n] = '\0';
+    O->warned[O->nwarned++] = copy;
+    va_list ap;
+    va_start(ap, fmt);
+    vw__scene_warning(O->name, O->line, fmt, ap);
+    va_end(ap);
+    return VW_OK;
 }
 
 static vw_status fail_status(obj *O, vw_status st)
@@ -343,10 +385,19 @@ static vw_status load_mtllib(obj *O, const char *dir, span fname)
     size_t len;
     char why[256] = "";
     vw_status st = vw__read_whole_file(path, &text, &len, why, sizeof why);
-    if (st != VW_OK) {
+    if (st == VW_E_NOMEM) {
         fail(O, "material library %s", why);
         free(path);
-        return st == VW_E_NOMEM ? st : VW_E_INPUT;
+        return st;
+    }
+    if (st != VW_OK) {
+        /* Not there (or not readable): the faces that name its materials get the
+           default one, as in common OBJ tools; a mesh is still worth showing. */
+        span p = {path, strlen(path)};
+        st = warn_once(O, "lib", p, "material library %s; its materials are not defined "
+                                    "(the default material is used)", why);
+        free(path);
+        return st == VW_OK ? VW_OK : fail_status(O, st);
     }
     const char *obj_name = O->name;
     int obj_line = O->line, obj_next = O->next_no;
@@ -475,15 +526,21 @@ static vw_status parse_obj(obj *O, const char *text, size_t len, const char *dir
         } else if (span_is(key, "usemtl")) {
             span name = rest_of_line(line);
             O->cur_mat = -1;
-            /* Unknown names fall back to the default material: exporters write
-               usemtl without shipping the library often enough that refusing the
-               mesh would help nobody. */
+            /* Unknown names fall back to the default material, with a warning (once a
+               name): exporters write usemtl without shipping the library often enough
+               that refusing the mesh would help nobody. Without a directory no
+               library was loaded, on purpose, so no name can be known. */
             for (size_t i = O->nnames; i-- > 0;)
                 if (strlen(O->mat_names[i]) == name.n &&
                     memcmp(O->mat_names[i], name.s, name.n) == 0) {
                     O->cur_mat = O->mat_ids[i];
                     break;
                 }
+            char sb[48];
+            if (O->cur_mat < 0 && dir &&
+                (st = warn_once(O, "mat", name, "material '%s' is not defined by a material "
+                                "library (the default material is used)", show(name, sb))) != VW_OK)
+                return fail_status(O, st);
         } else if (span_is(key, "mtllib")) {
             span fname;
             if (!dir)
@@ -526,6 +583,9 @@ VW_API vw_status vw_scene_read_obj(const char *name, const char *text, size_t le
     for (size_t i = 0; i < O.nnames; i++)
         free(O.mat_names[i]);
     free(O.mat_names);
+    for (size_t i = 0; i < O.nwarned; i++)
+        free(O.warned[i]);
+    free(O.warned);
     free(O.mat_ids);
     free(O.vn);
     if (st != VW_OK) {

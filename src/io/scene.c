@@ -131,6 +131,27 @@ vw_status vw__input_error(char *err, size_t errlen, const char *name, int line,
     return VW_E_INPUT;
 }
 
+/* The warning handler: process-wide, like the readers it serves, and set before them. */
+static vw_warning_fn warning_fn;
+static void *warning_user;
+
+VW_API void vw_scene_set_warning_handler(vw_warning_fn fn, void *user)
+{
+    warning_fn = fn;
+    warning_user = fn ? user : NULL;
+}
+
+void vw__scene_warning(const char *name, int line, const char *fmt, va_list ap)
+{
+    char msg[1024];
+    int k = snprintf(msg, sizeof msg, "%s:%d: warning: ", name, line);
+    if (k >= 0 && (size_t)k < sizeof msg) vsnprintf(msg + k, sizeof msg - (size_t)k, fmt, ap);
+    if (warning_fn)
+        warning_fn(msg, warning_user);
+    else
+        fprintf(stderr, "%s\n", msg);
+}
+
 /* ---- builder ---------------------------------------------------------------- */
 
 /* Grows *p to hold at least need elements. Capacities double, so n appends cost

@@ -163,6 +163,15 @@ int main(int argc, char **argv)
     t = text_of(out_path);
     CHECK(strstr(t, "camera: none") != NULL);
     free(t);
+    /* info on an OBJ whose library is missing: read, with its warnings on stderr, one
+       line each (it used to be refused, status 2, for the library). */
+    snprintf(bad, sizeof bad, "%s/warn/obj_missing_mtl.obj", argv[1]);
+    CHECK_EQ_INT(run(vw_cmd_info, (const char *[]){"info", bad, NULL}), 0);
+    t = text_of(err_path);
+    printf("missing library: %s", t);
+    CHECK(lines(t) == 2 && strstr(t, "obj_missing_mtl.obj:5: warning: material library ") != NULL &&
+          strstr(t, "obj_missing_mtl.obj:11: warning: material 'red' is not defined") != NULL);
+    free(t);
 
     /* -o into a missing directory: exit 1, nothing written. */
     snprintf(file, sizeof file, "%s/missing/x.nff", dir);

@@ -5,7 +5,7 @@
 #   * a scene or an edit script missing on one rank stops every rank, naming it, and
 #     another --workers, --depth or camera on one rank is named as such, and so is
 #     another radiosity option that changes the solution (--sf, --hemicube, ...);
-#   * gen -o is written by rank 0 alone;
+#   * gen -o is written by rank 0 alone, and warnings about a scene come from rank 0;
 #   * an output only rank 0 writes (animate's frames, --log, gen -o) into a missing directory,
 #     or a radiosity snapshot on a full disk, stops every rank with the single
 #     process's status.
@@ -94,6 +94,14 @@ run "animate -o into a missing directory" 1 "nodir/0.png" \
 # shellcheck disable=SC2086
 run "animate --log into a missing directory" 1 "nodir/log" \
     "$vwalls" animate "$scene" "$dir/edits" -o "$dir/a%d.png" --log "$dir/nodir/log" $common
+# Warnings about a scene every rank reads (an OBJ's missing material library): once,
+# from rank 0, not once a rank.
+warned=$(dirname "$scene")/../warn/obj_missing_mtl.obj
+# shellcheck disable=SC2086
+$launch "$vwalls" info "$warned" >/dev/null 2>"$dir/warn.err" || { echo "FAIL: info $warned: status $?"; fail=1; }
+n=$(grep -c "warning: " "$dir/warn.err")
+[ "$n" -eq 2 ] && echo "ok: scene warnings from rank 0 alone" ||
+  { echo "FAIL: scene warnings: $n lines, want 2 (one a warning, from rank 0):"; sed 's/^/    /' "$dir/warn.err"; fail=1; }
 # gen -o: rank 0 alone writes the file (every rank used to write it, each atomically);
 # the others would write g1.nff, ... here. Into a missing directory: status 1.
 run "gen -o, rank 0 alone writes" 0 "" \

@@ -3,7 +3,10 @@
 vwalls render's conventions: no ambient, diffuse = colour * Kd, Phong highlight Ks with
 exponent Shine, mirror reflection Ks, transmission T with ior, lights without colour at
 1/sqrt(#lights), linear output (assumed_gamma 1), the same camera (NFF angle is the
-vertical field of view; POV's is horizontal) and a right-handed image.
+vertical field of view; POV's is horizontal) and a right-handed image. Polygons of more
+than three corners become POV-Ray polygons (drawn concave or not), pp ones smooth
+triangles by ear clipping: a fan from the first corner covers a concave polygon's
+notches.
 
 usage: nff2pov.py SCENE.nff WIDTH HEIGHT DEPTH > SCENE.pov
 """
@@ -78,13 +81,19 @@ def main():
                 vs.append(vec())
                 if t == 'pp':
                     ns.append(vec())
-            for j in range(1, n - 1):
-                if t == 'pp':
+            if t == 'p' and n > 3:
+                # POV-Ray's polygon fills by the even-odd rule, so a concave polygon (the
+                # SPD gears' faces) is drawn as it is; a fan from the first corner would
+                # also cover the notches. Closed by repeating the first corner.
+                objects.append('polygon { %d, %s @M%d@ }' % (
+                    n + 1, ', '.join(_v(x) for x in vs + vs[:1]), mat))
+            elif t == 'p':
+                objects.append('triangle { %s, %s, %s @M%d@ }' % (_v(vs[0]), _v(vs[1]), _v(vs[2]), mat))
+            else:
+                # A polygon has no vertex normals: smooth triangles from ear clipping.
+                for a, b, c in _triangulate(vs):
                     objects.append('smooth_triangle { %s, %s, %s, %s, %s, %s @M%d@ }' % (
-                        _v(vs[0]), _v(ns[0]), _v(vs[j]), _v(ns[j]), _v(vs[j + 1]), _v(ns[j + 1]), mat))
-                else:
-                    objects.append('triangle { %s, %s, %s @M%d@ }' % (
-                        _v(vs[0]), _v(vs[j]), _v(vs[j + 1]), mat))
+                        _v(vs[a]), _v(ns[a]), _v(vs[b]), _v(ns[b]), _v(vs[c]), _v(ns[c]), mat))
         else:
             sys.exit('%s: unknown NFF entity %r' % (path, t))
 
@@ -113,6 +122,51 @@ def main():
         inside = ' interior { ior %r }' % ior if tr > 0 else ''
         o.append(parts[0] + 'texture { M%d }%s' % (m, inside) + parts[2])
     print('\n'.join(o))
+
+
+def _triangulate(vs):
+    """Corner index triples covering the polygon vs (convex or concave, simple): ear
+    clipping in the plane of its Newell normal. A corner is an ear when it turns the
+    polygon's way and no other corner lies inside its triangle. Where no ear is found
+    (a self-intersecting ring) the rest is fanned."""
+    n = len(vs)
+    nrm = [0.0, 0.0, 0.0]
+    for i in range(n):
+        p, q = vs[i], vs[(i + 1) % n]
+        nrm[0] += (p[1] - q[1]) * (p[2] + q[2])
+        nrm[1] += (p[2] - q[2]) * (p[0] + q[0])
+        nrm[2] += (p[0] - q[0]) * (p[1] + q[1])
+    drop = max(range(3), key=lambda k: abs(nrm[k]))
+    u, w = [k for k in range(3) if k != drop]
+    pts = [(v[u], v[w]) for v in vs]
+    sign = 1 if sum(pts[i][0] * pts[(i + 1) % n][1] - pts[(i + 1) % n][0] * pts[i][1]
+                    for i in range(n)) >= 0 else -1
+
+    def cross(o, a, b):
+        return (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0])
+
+    def inside(p, a, b, c):
+        return (sign * cross(a, b, p) >= 0 and sign * cross(b, c, p) >= 0
+                and sign * cross(c, a, p) >= 0)
+
+    ring, tris = list(range(n)), []
+    while len(ring) > 3:
+        for k in range(len(ring)):
+            i, j, l = ring[k - 1], ring[k], ring[(k + 1) % len(ring)]
+            a, b, c = pts[i], pts[j], pts[l]
+            if sign * cross(a, b, c) <= 0:
+                continue  # reflex or straight: not an ear
+            if any(inside(pts[m], a, b, c) for m in ring
+                   if m not in (i, j, l) and pts[m] not in (a, b, c)):
+                continue
+            tris.append((i, j, l))
+            del ring[k]
+            break
+        else:
+            tris.extend((ring[0], ring[k], ring[k + 1]) for k in range(1, len(ring) - 1))
+            return tris
+    tris.append(tuple(ring))
+    return tris
 
 
 def _isnum(s):

@@ -58,6 +58,14 @@ if(EXISTS ${PROJECT_SOURCE_DIR}/bench/embree_raw.c)
   set_tests_properties(bench_embree_raw PROPERTIES LABELS "bench")
 endif()
 
+# bench/nff2pov.py (POV-Ray, the benchmark's reference) converts concave polygons so
+# that povray covers the pixels vwalls covers. Skipped without povray or python3.
+add_test(NAME bench_nff2pov_concave
+         COMMAND sh ${PROJECT_SOURCE_DIR}/tests/raytrace/nff2pov.sh $<TARGET_FILE:vwalls_tool>
+                 ${PROJECT_SOURCE_DIR}/bench/nff2pov.py ${PROJECT_SOURCE_DIR}/tests/data/good/concave.nff
+                 ${CMAKE_CURRENT_BINARY_DIR}/bench_nff2pov_concave)
+set_tests_properties(bench_nff2pov_concave PROPERTIES LABELS "bench" SKIP_RETURN_CODE 77 TIMEOUT 60)
+
 # Under mpirun (when the build has MPI; launcher flags: cmake/mpi_launcher.cmake): the
 # same PNG bytes as the threads engine.
 if(VW_HAVE_MPI AND MPIEXEC_EXECUTABLE)

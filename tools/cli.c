@@ -209,13 +209,20 @@ void vw_cli_engine_init(int *argc, char ***argv)
 
 void vw_cli_engine_finish(void) { vw_engine_finish(); }
 
-int vw_cli_same_as_first(const char *cmd, const double *v, size_t n, const char *what)
+/* Rank 0's n values (collective; a copy to free). */
+static double *first_values(const double *v, size_t n)
 {
-    if (vw_engine_size() == 1) return 0;
     double *first = malloc(n * sizeof *first + 1);
     if (!first) vw_engine_abort(VW_EXIT_FAIL, "vwalls: out of memory comparing the processes' input");
     memcpy(first, v, n * sizeof *first);
     vw_engine_broadcast(first, n * sizeof *first);
+    return first;
+}
+
+int vw_cli_same_as_first(const char *cmd, const double *v, size_t n, const char *what)
+{
+    if (vw_engine_size() == 1) return 0;
+    double *first = first_values(v, n);
     /* Bit for bit: the same text parsed by the same binary gives the same doubles. */
     vw_status mine = memcmp(first, v, n * sizeof *first) ? VW_E_INVAL : VW_OK;
     free(first);
@@ -287,10 +294,7 @@ int vw_cli_appendf(char **buf, size_t *len, size_t *cap, const char *fmt, ...)
 int vw_cli_same_options(const char *cmd, const char *const *names, const double *v, size_t n)
 {
     if (vw_engine_size() == 1) return 0;
-    double *first = malloc(n * sizeof *first + 1);
-    if (!first) vw_engine_abort(VW_EXIT_FAIL, "vwalls: out of memory comparing the processes' options");
-    memcpy(first, v, n * sizeof *first);
-    vw_engine_broadcast(first, n * sizeof *first);
+    double *first = first_values(v, n);
     /* The first option that differs, bit for bit (the same text parsed by the same
        binary gives the same doubles), with all its values: --cells is three. */
     size_t k = 0;

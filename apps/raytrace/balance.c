@@ -185,11 +185,11 @@ static double measured_lambda(vw_world *w, const vw_load_spec *ls, const double 
         for (int g = 0; g < gw; g++) id[g] = g;
         if (ls->model == VW_LOAD_COUNTER)
             for (int g = 0; g < gw; g++) t[g] = (double)vw_world_worker_counter(w, g, ls->counter);
-        else if (ls->model == VW_LOAD_BUSY)
-            for (int g = 0; g < gw; g++) t[g] = vw_world_worker_busy(w, g);
         else
             for (int c = 0; c < nc; c++) t[vw_world_cell_worker(w, c)] += cell_load[c];
-        lam = vw_balance_imbalance(t, id, gw, gw, speeds);
+        /* Busy times are times already: the world's lambda weighs them by speed. */
+        lam = ls->model == VW_LOAD_BUSY ? vw_world_imbalance(w)
+                                        : vw_balance_imbalance(t, id, gw, gw, speeds);
     }
     free(t), free(id);
     return lam;

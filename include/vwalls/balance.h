@@ -62,7 +62,9 @@ VW_API void vw_load_spec_init(vw_load_spec *s);
 /* Per-cell loads of the last run(s) under the model: out has vw_decomp_cell_count()
    entries. Valid on every process after run() (the figures are global then). */
 VW_API vw_status vw_balance_cell_loads(const vw_world *w, const vw_load_spec *s, double *out);
-/* lambda = max / mean over workers of sum(cell load) / speed (speeds NULL = all 1):
+/* lambda = the slowest worker's time, max over workers of sum(cell load) / speed,
+   against the time of a split in proportion to the speeds, sum(load) / sum(speed)
+   (speeds NULL = all 1: max / mean of the workers' loads):
    at least 1; 1 when no worker has load (nothing measured), and for no worker.
    Never NaN: INFINITY when a speed is not positive and finite (such a worker never
    finishes; the mappers, vw_balance_world, vw_config.worker_speeds and

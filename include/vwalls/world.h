@@ -138,7 +138,9 @@ VW_API int64_t vw_world_counter(const vw_world *w, int idx);
 VW_API int64_t vw_world_cell_counter(const vw_world *w, int cell, int idx);
 /* Sum of module counter idx over the cells and copies that global worker g hosts. */
 VW_API int64_t vw_world_worker_counter(const vw_world *w, int g, int idx);
-/* Imbalance lambda = max / mean of worker busy times. */
+/* Imbalance lambda = max / mean of worker busy times; with worker speeds
+   (vw_config.worker_speeds), the longest busy time against the time the work would take
+   split in proportion to the speeds (a worker's work: its busy time times its speed). */
 VW_API double vw_world_imbalance(const vw_world *w);
 VW_API void vw_world_reset_stats(vw_world *w);
 

@@ -19,6 +19,26 @@ void vw_load_spec_init(vw_load_spec *s)
     s->w_objects = s->w_pixels = s->w_messages = 1.0;
 }
 
+/* Cell c's measured busy time as work: each unit's (the master's, each copy's) busy time
+   times its worker's speed, as a fraction of the fastest (a worker three times slower
+   takes three times as long for the same rays; the balancers then divide by the speed
+   of the worker they plan for). Without speeds, the busy time. */
+static double busy_work(const vw_world *w, int c)
+{
+    const vw__cell *cl = &w->cells[c];
+    if (!w->speeds) {
+        double s = cl->busy.s;
+        for (int r = 0; r < cl->nreps; r++) s += cl->reps[r].busy.s;
+        return s;
+    }
+    double top = 0;
+    for (int g = 0; g < w->gworkers; g++) top = w->speeds[g] > top ? w->speeds[g] : top;
+    double s = cl->busy.s * (w->speeds[cl->worker] / top);
+    for (int r = 0; r < cl->nreps; r++)
+        s += cl->reps[r].busy.s * (w->speeds[cl->reps[r].worker] / top);
+    return s;
+}
+
 vw_status vw_balance_cell_loads(const vw_world *w, const vw_load_spec *s, double *out)
 {
     if (!w || !s || !out) return VW_E_INVAL;
@@ -32,7 +52,7 @@ vw_status vw_balance_cell_loads(const vw_world *w, const vw_load_spec *s, double
                               ? vw_world_cell_counter(w, c, s->counter)
                               : 0;
         switch (s->model) {
-        case VW_LOAD_BUSY: out[c] = cs.busy_s; break;
+        case VW_LOAD_BUSY: out[c] = busy_work(w, c); break;
         case VW_LOAD_COUNTER: out[c] = (double)counter; break;
         case VW_LOAD_MODEL:
             out[c] = s->w_objects * (double)cs.objects + s->w_messages * (double)cs.messages_in +
@@ -50,26 +70,17 @@ double vw_balance_imbalance(const double *cell_load, const int *cell_worker, int
     if (gworkers < 1) return 1.0;
     /* A worker of speed 0 never finishes its share: no finite lambda describes that,
        and dividing by it gave inf / inf = NaN, which every comparison a caller makes
-       (lambda <= 1 + tolerance, predicted < before) takes as false. */
-    for (int g = 0; speeds && g < gworkers; g++)
-        if (!(speeds[g] > 0) || !isfinite(speeds[g])) return INFINITY;
+       (lambda <= 1 + tolerance, predicted < before) takes as false. vw__lambda says
+       INFINITY for it, as for a negative, NaN or infinite load. */
     double *t = calloc((size_t)gworkers, sizeof *t);
     if (!t) return 0;
     for (int c = 0; c < ncells; c++) {
         int g = cell_worker ? cell_worker[c] : c % gworkers;
         if (g >= 0 && g < gworkers) t[g] += cell_load[c];
     }
-    double max = 0, sum = 0;
-    int bad = 0;
-    for (int g = 0; g < gworkers; g++) {
-        double x = speeds ? t[g] / speeds[g] : t[g];
-        bad |= !(x >= 0) || !isfinite(x); /* a negative, NaN or infinite load */
-        sum += x;
-        if (x > max) max = x;
-    }
+    double lam = vw__lambda(t, speeds, gworkers);
     free(t);
-    if (bad) return INFINITY;
-    return sum > 0 ? max / (sum / gworkers) : 1.0;
+    return lam;
 }
 
 /* ---- the field ------------------------------------------------------------------------ */

@@ -858,15 +858,39 @@ int64_t vw_world_counter(const vw_world *w, int idx)
     return s;
 }
 
+double vw__lambda(const double *t, const double *speeds, int n)
+{
+    /* Speeds as fractions of the fastest, so their sum cannot overflow (1e308 each). */
+    double top = 0;
+    for (int g = 0; speeds && g < n; g++) {
+        if (!(speeds[g] > 0) || !isfinite(speeds[g])) return INFINITY;
+        top = speeds[g] > top ? speeds[g] : top;
+    }
+    double max = 0, sum = 0, ssum = 0;
+    for (int g = 0; g < n; g++) {
+        if (!(t[g] >= 0) || !isfinite(t[g])) return INFINITY;
+        double s = speeds ? speeds[g] / top : 1.0, x = t[g] / s;
+        sum += t[g];
+        ssum += s;
+        if (x > max) max = x;
+    }
+    return sum > 0 ? max / (sum / ssum) : 1.0;
+}
+
+/* The busy times are times already (a slower worker's are longer for the same work),
+   so a worker's work is its busy time times its speed. */
 double vw_world_imbalance(const vw_world *w)
 {
-    double max = 0, sum = 0;
-    for (int g = 0; g < w->gworkers; g++) {
-        double b = vw_world_worker_busy(w, g);
-        sum += b;
-        if (b > max) max = b;
-    }
-    return sum > 0 ? max / (sum / w->gworkers) : 1.0;
+    if (w->gworkers < 1) return 1.0;
+    double *t = malloc(sizeof *t * (size_t)w->gworkers);
+    if (!t) return 0;
+    double top = 0;
+    for (int g = 0; w->speeds && g < w->gworkers; g++) top = w->speeds[g] > top ? w->speeds[g] : top;
+    for (int g = 0; g < w->gworkers; g++)
+        t[g] = vw_world_worker_busy(w, g) * (w->speeds ? w->speeds[g] / top : 1.0);
+    double lam = vw__lambda(t, w->speeds, w->gworkers);
+    free(t);
+    return lam;
 }
 
 void vw_world_reset_stats(vw_world *w)

@@ -52,6 +52,13 @@ typedef struct vw__packet {
 /* A copy of a duplicated cell on another worker (balance strategy "duplicate"): its
    own module state built from the cell's objects, and its own figures, which add up
    with the master's to the cell's. */
+/* Imbalance lambda of the workers' work t[g] (time on a worker of speed 1) given their
+   relative speeds (NULL: all equal): the slowest worker's time max t[g] / speed[g]
+   against the ideal, the time of a split by speed, sum t / sum speed. With equal
+   speeds that is max / mean of t, DESIGN's definition. 1 with no work; INFINITY when a
+   speed is not positive and finite or a t is negative, NaN or infinite. */
+double vw__lambda(const double *t, const double *speeds, int n);
+
 /* A unit's (a cell's, or a copy's) measured busy time, and the inline hand-offs into it
    (vw_ctx_enter) that the meter (runtime.c) noted since its worker last read the clock. */
 typedef struct vw__busy {

@@ -569,6 +569,9 @@ static int t_map(void)
         int cw[4] = {0, 1, 2, 3};
         double s1[4] = {1, 1, 1, 1}, s0[4] = {1, 0, 1, 1}, sneg[4] = {1, 1, -2, 1};
         double snan[4] = {1, 1, 1, NAN}, sinf[4] = {INFINITY, 1, 1, 1};
+        double fast[4] = {0, 5, 5, 5}, s1000[4] = {1, 1000, 1000, 1000}, prop[4] = {1, 2, 3, 4};
+        double s1234[4] = {1, 2, 3, 4}, slow[4] = {10, 0, 0, 0}, s7[4] = {7, 7, 7, 7};
+        double sbig[4] = {1e308, 1e308, 1e308, 1e308};
         struct { const double *load, *speeds; double want; const char *what; } cases[] = {
             {load, s1, 4 / 2.5, "1,2,3,4"},       {load, NULL, 4 / 2.5, "no speeds"},
             {none, s1, 1, "no load"},             {load, s0, INFINITY, "speed 0"},
@@ -576,6 +579,15 @@ static int t_map(void)
             {load, snan, INFINITY, "speed NaN"},  {load, sinf, INFINITY, "speed inf"},
             {nanl, NULL, INFINITY, "load NaN"},   {infl, s1, INFINITY, "load inf"},
             {negl, NULL, INFINITY, "load -1"},
+            /* Unequal speeds: the slowest worker's time against a split by speed. The
+               load evenly on the three fast workers of 1,1000,1000,1000 is 3001/3000
+               (it was 4/3: the idle slow worker pulled the mean down); a split in
+               proportion to the speeds is 1; all on the slowest of 1,2,3,4 takes 10
+               times the best; equal speeds of any size are max / mean. */
+            {fast, s1000, 3001.0 / 3000, "even on the fast of 1,1000,1000,1000"},
+            {prop, s1234, 1, "in proportion to 1,2,3,4"},
+            {slow, s1234, 10, "all on the slowest of 1,2,3,4"},
+            {load, s7, 4 / 2.5, "speeds 7"},      {load, sbig, 4 / 2.5, "speeds 1e308"},
         };
         for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
             double lam = vw_balance_imbalance(cases[i].load, cw, 4, 4, cases[i].speeds);

@@ -296,6 +296,14 @@ vw_status rt_job_balance(rt_job *j, const rt_balance *b, rt_balance_result *bi, 
         if (b->strategy == VW_BALANCE_NONE) {
             /* Mapping only: greedy / weighted by the measured loads. */
             st = rt_job_map(j, b->map, load, b->speeds, err, errlen);
+            if (st == VW_OK) {
+                int nc = vw_decomp_cell_count(d), *cw = malloc(sizeof(int) * (size_t)nc);
+                for (int c = 0; cw && c < nc; c++) cw[c] = vw_world_cell_worker(w, c);
+                int gw = vw_world_workers(w) * vw_world_processes(w);
+                bi->rep.imbalance_before = lam;
+                bi->rep.imbalance_predicted = cw ? vw_balance_imbalance(load, cw, nc, gw, b->speeds) : 0;
+                free(cw);
+            }
             stale = 0;
             bi->rounds++;
             break;

@@ -63,6 +63,17 @@ render(${WORK}/speeds.png ${VWALLS} render ${SCENE} -o ${WORK}/speeds.png ${comm
 render(${WORK}/huge.png ${VWALLS} render ${SCENE} -o ${WORK}/huge.png ${common} --cells 2x2x2
        --workers 2 --map weighted --balance duplicate --balance-load segments
        --speeds 1e308,1e308)
+# A mapping alone (--map weighted, no --balance) reports the lambda it measured and the
+# one it predicts, by counted work: they were printed as 0.000 (never filled in).
+execute_process(COMMAND ${VWALLS} render ${SCENE} -o ${WORK}/mapped.png --size 80x60 --cells 2x2x2
+                --workers 2 --farm none --map weighted --balance-load segments --speeds 1,3
+                --stats ${WORK}/mapped.json RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+file(READ ${WORK}/mapped.json json)
+string(JSON before GET "${json}" balance_detail imbalance_before)
+string(JSON predicted GET "${json}" balance_detail imbalance_predicted)
+if(NOT rc EQUAL 0 OR NOT out MATCHES "lambda before [1-9]" OR before LESS 1 OR predicted LESS 1)
+  message(FATAL_ERROR "--map weighted: exit ${rc}, before ${before}, predicted ${predicted}: ${out}${err}")
+endif()
 
 # Bad values: exit 2, no output.
 foreach(bad "--balance;sideways" "--map;random" "--speeds;1,x" "--speeds;1" "--speeds;1,2," "--slow;9:2"

@@ -76,3 +76,8 @@ vw_core_test(test_farm)
 add_test(NAME core_farm COMMAND test_farm)
 add_test(NAME core_farm_stress COMMAND test_farm --stress)
 set_tests_properties(core_farm core_farm_stress PROPERTIES LABELS "core;threads")
+
+# Corner cases of the worker loop: the meter after its list of noted units filled up.
+vw_core_test(test_runtime)
+add_test(NAME core_runtime_meter COMMAND test_runtime meter)
+set_tests_properties(core_runtime_meter PROPERTIES LABELS "core;threads" TIMEOUT 60)

@@ -264,11 +264,14 @@ static vw__busy *unit_busy(vw__worker *wk, int cell, int rep)
 }
 
 /* Notes that unit u runs (an inline hand-off, or a switch): timed with the next clock
-   read. At most VW__METER_N notes, so the list of distinct units cannot overflow. */
+   read. At most VW__METER_N notes, so the list of distinct units cannot overflow. A full
+   list is charged before u is noted, never after: u runs from now on, and charged after,
+   the list was empty and the time until the next read belonged to no unit. */
 static inline void meter_note(vw__worker *wk, vw__busy *u)
 {
+    if (wk->nnotes == VW__METER_N) meter_charge(wk, vw__now());
     if (u->notes++ == 0) wk->metered[wk->nmetered++] = u;
-    if (++wk->nnotes == VW__METER_N) meter_charge(wk, vw__now());
+    wk->nnotes++;
 }
 
 /* The worker starts running unit (cell, rep): what ran before is charged. */

@@ -77,7 +77,13 @@ add_test(NAME core_farm COMMAND test_farm)
 add_test(NAME core_farm_stress COMMAND test_farm --stress)
 set_tests_properties(core_farm core_farm_stress PROPERTIES LABELS "core;threads")
 
-# Corner cases of the worker loop: the meter after its list of noted units filled up.
+# Corner cases of the worker loop: a step() that sends and reports no work, the meter
+# after its list of noted units filled up.
 vw_core_test(test_runtime)
-add_test(NAME core_runtime_meter COMMAND test_runtime meter)
-set_tests_properties(core_runtime_meter PROPERTIES LABELS "core;threads" TIMEOUT 60)
+foreach(t step-send meter)
+  add_test(NAME core_runtime_${t} COMMAND test_runtime ${t})
+  set_tests_properties(core_runtime_${t} PROPERTIES LABELS "core;threads" TIMEOUT 60)
+endforeach()
+add_test(NAME core_runtime_step-send_stress COMMAND test_runtime step-send)
+set_tests_properties(core_runtime_step-send_stress PROPERTIES LABELS "core;threads" TIMEOUT 60
+                     ENVIRONMENT "VW_STRESS=5")

@@ -629,8 +629,7 @@ static int step(vw_ctx *ctx, void *state)
         if (made) return 1;
     }
     /* Called after every delivery too: a partial package leaves here, so no
-       contribution waits in a cell when the world goes quiet. Sending counts as work:
-       the runtime flushes its open packets only before it calls step() again. */
+       contribution waits in a cell when the world goes quiet. */
     if (c->rays_pending) {
         atomic_fetch_add(&c->sh->rays, c->rays_pending);
         c->rays_pending = 0;

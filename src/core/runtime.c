@@ -585,6 +585,10 @@ static void worker_run(vw__worker *wk)
         if (flush_all(wk)) continue;
         int stepped = run_step(wk, &ctx);
         if (stepped > 0) continue;
+        /* A step() may send and still report no work (it handed over what it buffered):
+           those packets leave now, or the worker went idle with them open and the run
+           ended without them (they left at the next run, maybe to cells since moved). */
+        if (stepped == 0 && flush_all(wk)) continue;
         if (stepped < 0) {
             /* Over the cap: what this worker sent is being handled by counted workers of
                this process, so the cap falls; wait for that (or a packet), still busy. */

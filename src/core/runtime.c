@@ -695,6 +695,22 @@ static void pool_wait(vw_world *w)
 
 vw_status vw__runtime_run(vw_world *w)
 {
+    /* The threads first: a run that cannot start them fails before it counts anything
+       or takes the posted messages, so the next run starts as this one would have (a
+       posted packet left counted in an inbox was handled uncounted by the next run,
+       whose count then reached zero while a worker was busy: a cut-short run). */
+    int failed = pool_start(w);
+    if (failed >= 0) {
+        vw_status st = vw__world_error(w, VW_E_LIMIT, "cannot start worker thread %d", failed);
+        /* Other processes cannot finish without this one's workers; a process that
+           cannot run them must end the job rather than leave the others waiting. */
+        if (w->transport) {
+            char msg[600];
+            snprintf(msg, sizeof msg, "vwalls: rank %d: %s", w->rank, w->errmsg);
+            vw_engine_abort(1, msg);
+        }
+        return st;
+    }
     atomic_store(&w->finished, 0);
     /* With a transport, its thread (this one) is counted too: see the top of the file. */
     atomic_store(&w->active, w->nworkers + (w->transport ? 1 : 0));
@@ -723,23 +739,10 @@ vw_status vw__runtime_run(vw_world *w)
         else
             free(p);
     }
+    pool_dispatch(w, worker_run);
     vw_status st = VW_OK;
-    int failed = pool_start(w);
-    if (failed >= 0)
-        st = vw__world_error(w, VW_E_LIMIT, "cannot start worker thread %d", failed);
-    else
-        pool_dispatch(w, worker_run);
-    if (w->transport) {
-        /* Other processes cannot finish without this one's workers; a process that
-           cannot run them must end the job rather than leave the others waiting. */
-        if (st != VW_OK) {
-            char msg[600];
-            snprintf(msg, sizeof msg, "vwalls: rank %d: %s", w->rank, w->errmsg);
-            vw_engine_abort(1, msg);
-        }
-        st = w->transport->run(w);
-    }
-    if (failed < 0) pool_wait(w);
+    if (w->transport) st = w->transport->run(w);
+    pool_wait(w);
     w->runs++;
     vw__stats_local(w);
     if (w->transport && st == VW_OK) st = w->transport->sync(w);

@@ -6,18 +6,38 @@
  *   meter      a handler hands off inline (vw_ctx_enter / vw_ctx_restore) 0..70 times and
  *              then works in its own cell: that time must be charged to the cells (shared
  *              among the units noted since the last clock read, as the meter does), also
- *              when the last hand-off filled the meter's list of notes.
+ *              when the last hand-off filled the meter's list of notes;
+ *   thread-fail  a run whose worker threads cannot all be started fails, and the next
+ *              runs, with threads, deliver everything: a chain of hops between two
+ *              workers, started by a message posted before the failed run.
  *
- * usage: test_runtime step-send|meter   (also honours VW_STRESS)
+ * usage: test_runtime step-send|meter|thread-fail   (also honours VW_STRESS)
+ * (pthread_create is wrapped at link time, so thread-fail can make it fail.)
  */
+#include <errno.h>
+#include <pthread.h>
+#include <stdatomic.h>
 #include <string.h>
 #include <time.h>
 
 #include "vw_test.h"
 #include "vwalls/vwalls.h"
 
-enum { MSG_PING, MSG_WORK, NKINDS };
-enum { CNT_PINGS, CNT_OUTPUTS, NCOUNTERS };
+enum { MSG_PING, MSG_WORK, MSG_HOP, NKINDS };
+enum { CNT_PINGS, CNT_OUTPUTS, CNT_HOPS, NCOUNTERS };
+
+/* Failing pthread_create (EAGAIN, as when threads run out): 0 never, 1 always, 2 every
+   second call (the first of two threads starts, the second does not). */
+static atomic_int fail_threads, thread_calls;
+
+int __real_pthread_create(pthread_t *t, const pthread_attr_t *a, void *(*fn)(void *), void *arg);
+int __wrap_pthread_create(pthread_t *t, const pthread_attr_t *a, void *(*fn)(void *), void *arg);
+int __wrap_pthread_create(pthread_t *t, const pthread_attr_t *a, void *(*fn)(void *), void *arg)
+{
+    int mode = atomic_load(&fail_threads), call = atomic_fetch_add(&thread_calls, 1);
+    if (mode == 1 || (mode == 2 && call % 2 == 1)) return EAGAIN;
+    return __real_pthread_create(t, a, fn, arg);
+}
 
 typedef struct shared {
     int run;          /* the run in progress, bumped by the test between runs */
@@ -90,11 +110,24 @@ static void on_work(vw_ctx *ctx, void *state, const void *msg)
     }
 }
 
+/* A hop goes on to the other cell until its count is used up. */
+static void on_hop(vw_ctx *ctx, void *state, const void *msg)
+{
+    (void)state;
+    int32_t left = *(const int32_t *)msg;
+    vw_count(ctx, CNT_HOPS, 1);
+    if (left > 0) {
+        int32_t next = left - 1;
+        vw_send_cell(ctx, 1 - vw_ctx_cell(ctx), MSG_HOP, &next);
+    }
+}
+
 static const vw_msg_kind kinds[NKINDS] = {
     [MSG_PING] = {"ping", 0, on_ping, out_ping, 0},
     [MSG_WORK] = {"work", sizeof(work), on_work, NULL, 0},
+    [MSG_HOP] = {"hop", sizeof(int32_t), on_hop, NULL, 0},
 };
-static const char *const counters[NCOUNTERS] = {"pings", "outputs"};
+static const char *const counters[NCOUNTERS] = {"pings", "outputs", "hops"};
 
 static vw_module module = {
     .abi = VW_MODULE_ABI,
@@ -178,11 +211,47 @@ static int test_meter(void)
     TEST_DONE();
 }
 
+static int test_thread_fail(void)
+{
+    module.step = NULL;
+    for (int fails = 1; fails <= 2; fails++) {
+        shared sh = {0};
+        vw_decomp *d;
+        /* Two cells on two workers: every hop crosses between them. */
+        vw_world *w = make_world("2", 2, &sh, &d);
+        CHECK_EQ_INT(vw_world_cell_worker(w, 0), 0);
+        CHECK_EQ_INT(vw_world_cell_worker(w, 1), 1);
+        int32_t hops = 200;
+        CHECK_EQ_INT(vw_world_post(w, 0, MSG_HOP, &hops), VW_OK);
+        /* No thread, or only the first of two, starts: the cells are built without
+           them, and the run fails. */
+        atomic_store(&thread_calls, 0);
+        atomic_store(&fail_threads, fails);
+        vw_status st = vw_world_run(w);
+        atomic_store(&fail_threads, 0);
+        EXPECT(st == VW_E_LIMIT, "run without threads: status %d", (int)st);
+        /* Then threads start: the posted chain runs whole, and so do new ones. */
+        int64_t want = 0;
+        for (int run = 0; run < 20; run++) {
+            if (run > 0) CHECK_EQ_INT(vw_world_post(w, run % 2, MSG_HOP, &hops), VW_OK);
+            CHECK_EQ_INT(vw_world_run(w), VW_OK);
+            want += hops + 1;
+            EXPECT(vw_world_counter(w, CNT_HOPS) == want, "after a failed run, run %d: %lld of "
+                   "%lld hops", run, (long long)vw_world_counter(w, CNT_HOPS), (long long)want);
+            if (vw_world_counter(w, CNT_HOPS) != want) break;
+        }
+        vw_world_free(w);
+        vw_decomp_free(d);
+    }
+    TEST_DONE();
+}
+
 int main(int argc, char **argv)
 {
     const char *what = argc > 1 ? argv[1] : "";
     if (!strcmp(what, "step-send")) return test_step_send();
     if (!strcmp(what, "meter")) return test_meter();
-    fprintf(stderr, "usage: test_runtime step-send|meter\n");
+    if (!strcmp(what, "thread-fail")) return test_thread_fail();
+    fprintf(stderr, "usage: test_runtime step-send|meter|thread-fail\n");
     return 2;
 }

@@ -46,6 +46,12 @@ vw_mpi_test(mpi_pairs_stress_np4 4 ENV "VW_STRESS=99"
 if(TARGET test_storm)
   vw_mpi_test(mpi_core_storm_np3 3 COMMAND $<TARGET_FILE:test_storm> 2)
 endif()
+# A step() that sends and reports no work: what it sent arrives in that run, across
+# processes too.
+if(TARGET test_runtime)
+  vw_mpi_test(mpi_runtime_step_send_np2 2 COMMAND $<TARGET_FILE:test_runtime> step-send)
+  vw_mpi_test(mpi_runtime_step_send_np3 3 ENV "VW_STRESS=7" COMMAND $<TARGET_FILE:test_runtime> step-send)
+endif()
 vw_mpi_test(mpi_agree_np1 1 COMMAND $<TARGET_FILE:test_mpi_storm> --agree)
 vw_mpi_test(mpi_agree_np3 3 COMMAND $<TARGET_FILE:test_mpi_storm> --agree)
 

@@ -11,7 +11,8 @@
  *              runs, with threads, deliver everything: a chain of hops between two
  *              workers, started by a message posted before the failed run.
  *
- * usage: test_runtime step-send|meter|thread-fail   (also honours VW_STRESS)
+ * usage: test_runtime step-send|meter|thread-fail   (also honours VW_STRESS; step-send
+ * also runs under mpirun)
  * (pthread_create is wrapped at link time, so thread-fail can make it fail.)
  */
 #include <errno.h>
@@ -166,8 +167,9 @@ static int test_step_send(void)
             EXPECT(vw_world_counter(w, CNT_PINGS) == run,
                    "%d workers, run %d: %lld pings arrived", workers, run,
                    (long long)vw_world_counter(w, CNT_PINGS));
-            EXPECT(sh.outputs == run, "%d workers, run %d: %ld outputs arrived", workers, run,
-                   sh.outputs);
+            if (vw_world_is_output(w))
+                EXPECT(sh.outputs == run, "%d workers, run %d: %ld outputs arrived", workers,
+                       run, sh.outputs);
         }
         vw_world_free(w);
         vw_decomp_free(d);

@@ -78,10 +78,11 @@ add_test(NAME core_farm_stress COMMAND test_farm --stress)
 set_tests_properties(core_farm core_farm_stress PROPERTIES LABELS "core;threads")
 
 # Corner cases of the worker loop: a step() that sends and reports no work, the meter
-# after its list of noted units filled up, runs after one whose threads did not start.
+# after its list of noted units filled up, runs after one whose threads did not start,
+# hand-offs tried outside a run.
 vw_core_test(test_runtime)
 target_link_options(test_runtime PRIVATE -Wl,--wrap=pthread_create)
-foreach(t step-send meter thread-fail)
+foreach(t step-send meter thread-fail build-enter)
   add_test(NAME core_runtime_${t} COMMAND test_runtime ${t})
   set_tests_properties(core_runtime_${t} PROPERTIES LABELS "core;threads" TIMEOUT 60)
 endforeach()

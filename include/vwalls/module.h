@@ -139,7 +139,8 @@ VW_API void vw_send_output(vw_ctx *ctx, int kind, const void *msg);
    time are charged to it), and must go back with vw_ctx_restore(ctx, cell, replica)
    using the values vw_ctx_cell() and vw_ctx_replica() had before, before it returns or
    uses the first cell's state again. Messages are the model; this only skips the packet
-   for the common case of a neighbour on the same worker (a ray crossing a wall). */
+   for the common case of a neighbour on the same worker (a ray crossing a wall). Only
+   in handlers and step(): cell_build and load get NULL (there is no run to hand off in). */
 VW_API void *vw_ctx_enter(vw_ctx *ctx, int cell, int kind);
 VW_API void vw_ctx_restore(vw_ctx *ctx, int cell, int replica);
 

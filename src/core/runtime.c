@@ -34,6 +34,11 @@ struct vw_ctx {
        (vw_ctx_enter) and restores it, which then needs no check that this worker
        hosts it. */
     int home_cell, home_rep;
+    /* 1 in the worker loop (messages, steps); 0 in cell_build and load, which run outside
+       the meter's windows: a hand-off there is refused, for the meter would keep the
+       note across runs (and a new decomposition freeing the cell), and charge it the
+       time since its last clock read. */
+    int in_run;
 };
 
 /* The figures and state of copy rep of a cell (0: the master itself). */
@@ -370,6 +375,7 @@ void *vw_ctx_enter(vw_ctx *ctx, int cell, int kind)
     vw_world *w = ctx->w;
     if ((unsigned)cell >= (unsigned)w->ncells || (unsigned)kind >= (unsigned)w->m->nkinds)
         misuse(ctx, "entered cell %d with message kind %d: no such cell or kind", cell, kind);
+    if (!ctx->in_run) return NULL;
     vw__cell *c = &w->cells[cell];
     int rep = 0;
     if (c->nreps) {
@@ -407,7 +413,7 @@ void vw_ctx_restore(vw_ctx *ctx, int cell, int replica)
                                    : vw__cell_rep_of(w, cell, ctx->wk->global) == replica);
         if (!hosted) misuse(ctx, "restored cell %d copy %d, which it does not host", cell, replica);
     }
-    meter_note(ctx->wk, unit_busy(ctx->wk, cell, replica));
+    if (ctx->in_run) meter_note(ctx->wk, unit_busy(ctx->wk, cell, replica));
     ctx->cell = cell;
     ctx->rep = replica;
 }
@@ -570,7 +576,7 @@ static void stress_pause(vw__worker *wk)
 static void worker_run(vw__worker *wk)
 {
     vw_world *w = wk->w;
-    vw_ctx ctx = {w, wk, -1, 0, -1, 0};
+    vw_ctx ctx = {w, wk, -1, 0, -1, 0, 1};
     for (;;) {
         pthread_mutex_lock(&wk->mu);
         vw__packet *p = take(wk);

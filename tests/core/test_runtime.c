@@ -7,11 +7,16 @@
  *              then works in its own cell: that time must be charged to the cells (shared
  *              among the units noted since the last clock read, as the meter does), also
  *              when the last hand-off filled the meter's list of notes;
+ *   build-enter  a cell_build that tries inline hand-offs (there is no run to hand off
+ *              in, and the other cells may not be built yet): refused, and they must
+ *              leave the meter alone, also across a new decomposition (the meter kept
+ *              pointers to the old cells' figures and charged them the time since the
+ *              clock's epoch);
  *   thread-fail  a run whose worker threads cannot all be started fails, and the next
  *              runs, with threads, deliver everything: a chain of hops between two
  *              workers, started by a message posted before the failed run.
  *
- * usage: test_runtime step-send|meter|thread-fail   (also honours VW_STRESS; step-send
+ * usage: test_runtime step-send|meter|thread-fail|build-enter   (also honours VW_STRESS; step-send
  * also runs under mpirun)
  * (pthread_create is wrapped at link time, so thread-fail can make it fail.)
  */
@@ -59,10 +64,19 @@ static double now_s(void)
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
+static int build_enters; /* build-enter: hand-offs cell_build tries */
+static int build_entered; /* ... and how many were taken */
+
 static vw_status build(vw_ctx *ctx, const void *objs, size_t n, void **state)
 {
     (void)objs, (void)n;
     *state = vw_ctx_user(ctx);
+    int cell = vw_ctx_cell(ctx), rep = vw_ctx_replica(ctx);
+    int ncells = vw_decomp_cell_count(vw_ctx_decomp(ctx));
+    for (int i = 0; i < build_enters; i++) {
+        if (vw_ctx_enter(ctx, (cell + 1 + i % 2) % ncells, MSG_WORK)) build_entered++;
+        vw_ctx_restore(ctx, cell, rep);
+    }
     return VW_OK;
 }
 
@@ -213,6 +227,34 @@ static int test_meter(void)
     TEST_DONE();
 }
 
+static int test_build_enter(void)
+{
+    module.step = NULL;
+    build_enters = 100;
+    shared sh = {0};
+    vw_decomp *d, *d2;
+    vw_world *w = make_world("3", 1, &sh, &d);
+    CHECK_EQ_INT(vw_world_commit(w), VW_OK);
+    EXPECT(build_entered == 0, "cell_build was let into %d cells", build_entered);
+    CHECK_EQ_INT(vw_world_run(w), VW_OK);
+    double busy = cells_busy(w);
+    EXPECT(busy < 1.0, "the cells were charged %.3f s for a run with nothing to do", busy);
+    /* New walls (the old cells freed), built and run: nothing ran, nothing is charged. */
+    vw_box box = {{0, 0, 0}, {1, 1, 1}};
+    int dims[3] = {2, 2, 1};
+    CHECK_EQ_INT(vw_decomp_create_grid(&box, dims, &d2), VW_OK);
+    CHECK_EQ_INT(vw_world_redecompose(w, d2, NULL), VW_OK);
+    CHECK_EQ_INT(vw_world_run(w), VW_OK);
+    CHECK_EQ_INT(vw_world_run(w), VW_OK);
+    busy = cells_busy(w);
+    EXPECT(busy < 1.0, "the new cells were charged %.3f s for runs with nothing to do", busy);
+    vw_world_free(w);
+    vw_decomp_free(d);
+    vw_decomp_free(d2);
+    build_enters = 0;
+    TEST_DONE();
+}
+
 static int test_thread_fail(void)
 {
     module.step = NULL;
@@ -254,6 +296,7 @@ int main(int argc, char **argv)
     if (!strcmp(what, "step-send")) return test_step_send();
     if (!strcmp(what, "meter")) return test_meter();
     if (!strcmp(what, "thread-fail")) return test_thread_fail();
-    fprintf(stderr, "usage: test_runtime step-send|meter|thread-fail\n");
+    if (!strcmp(what, "build-enter")) return test_build_enter();
+    fprintf(stderr, "usage: test_runtime step-send|meter|thread-fail|build-enter\n");
     return 2;
 }

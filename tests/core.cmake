@@ -41,7 +41,8 @@ set_tests_properties(core_misuse_limits core_misuse_slowdown PROPERTIES TIMEOUT 
 foreach(case "send;sent message kind 1 to cell 0, but the kind has no handle"
              "output;sent message kind 0 to the output, but the kind has no output handler"
              "count;counted into counter 5 of 1"
-             "face;sent message kind 0 to face 6 (faces are 0..5)")
+             "face;sent message kind 0 to face 6 (faces are 0..5)"
+             "build-send;sent message kind 0 from cell 0 outside a run")
   list(GET case 0 m)
   list(GET case 1 want)
   add_test(NAME core_misuse_${m} COMMAND test_misuse ${m} ${want})

@@ -184,6 +184,16 @@ static int flush_all(vw__worker *wk)
     return any;
 }
 
+/* A module's misuse of the context is a bug in the module: it stops the process. */
+static void __attribute__((noreturn, noinline, cold))
+misuse(const vw_ctx *ctx, const char *fmt, int a, int b)
+{
+    fprintf(stderr, "vwalls: module '%s' ", ctx->w->m->name);
+    fprintf(stderr, fmt, a, b);
+    fprintf(stderr, " (worker %d)\n", ctx->wk->global);
+    abort();
+}
+
 static void enqueue(vw_ctx *ctx, int slot, int dest, int cell, int kind, const void *msg)
 {
     vw_world *w = ctx->w;
@@ -192,6 +202,12 @@ static void enqueue(vw_ctx *ctx, int slot, int dest, int cell, int kind, const v
         fprintf(stderr, "vwalls: module '%s' sent unknown message kind %d\n", w->m->name, kind);
         abort();
     }
+    /* cell_build and load run between runs: a packet opened there was flushed at the
+       next run, to the worker that hosted the cell at the build (a remap since, and it
+       received a message for a cell it no longer hosts). */
+    if (!ctx->in_run)
+        misuse(ctx, "sent message kind %d from cell %d outside a run (cell_build or load)", kind,
+               ctx->cell);
     size_t size = w->m->kinds[kind].size;
     size_t stride = msg_stride(size);
     vw__packet *p = wk->out[slot];
@@ -347,16 +363,6 @@ uint64_t vw_ctx_next_batch(vw_ctx *ctx, uint64_t nbatches)
         if (b < nbatches) return b;
     }
     return nbatches;
-}
-
-/* A module's misuse of the context is a bug in the module: it stops the process. */
-static void __attribute__((noreturn, noinline, cold))
-misuse(const vw_ctx *ctx, const char *fmt, int a, int b)
-{
-    fprintf(stderr, "vwalls: module '%s' ", ctx->w->m->name);
-    fprintf(stderr, fmt, a, b);
-    fprintf(stderr, " (worker %d)\n", ctx->wk->global);
-    abort();
 }
 
 /* Which copy of duplicated cell c this worker may hand a message of `kind` to inline,

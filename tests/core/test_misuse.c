@@ -7,7 +7,8 @@
  *   stats    phase names of any length and number, escaped in the stats JSON
  *   slowdown vw_config.worker_slowdown is copied at create, like the speeds
  *   signal   kinds of size 0 are sent and posted with no buffer
- *   send | output | count   a module's bad send or count stops the process (abort)
+ *   send | output | count | build-send   a module's bad send (also one from
+ *            cell_build) or count stops the process (abort)
  *            with a message on stderr: run in a child, whose end and stderr are checked
  * Usage: test_misuse MODE [EXPECTED-MESSAGE]
  */
@@ -58,9 +59,11 @@ static int step(vw_ctx *ctx, void *state)
 
 static vw_status build(vw_ctx *ctx, const void *objects, size_t n, void **state)
 {
-    (void)ctx, (void)objects, (void)n;
+    (void)objects, (void)n;
     static int done[64];
     *state = &done[vw_ctx_cell(ctx)];
+    int x = 0;
+    if (!strcmp(mode, "build-send") && vw_ctx_cell(ctx) == 0) vw_send_cell(ctx, 0, 0, &x);
     return VW_OK;
 }
 

@@ -71,14 +71,12 @@ static double units_lambda(const vw_world *w, const double *load, const double *
         t[cl->worker] += load[c] * vw__unit_share(cl, 0);
         for (int r = 0; r < cl->nreps; r++) t[cl->reps[r].worker] += load[c] * vw__unit_share(cl, r + 1);
     }
-    double max = 0, sum = 0;
-    for (int g = 0; g < w->gworkers; g++) {
-        double x = speeds ? t[g] / speeds[g] : t[g];
-        sum += x;
-        if (x > max) max = x;
-    }
+    /* The one definition (vw__lambda): max / mean of load / speed read an idle slow
+       worker's 0 into the mean, so 'before' was 2 where vw_balance_imbalance, and so
+       every 'predicted' compared with it, said 1.001 (speeds 1,1000). */
+    double lam = vw__lambda(t, speeds, w->gworkers);
     free(t);
-    return sum > 0 ? max / (sum / w->gworkers) : 1.0;
+    return lam;
 }
 
 /* Duplication: the walls stay, overloaded cells get copies on underloaded workers (the

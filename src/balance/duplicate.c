@@ -18,6 +18,7 @@
  * Cost: O(max_extra * (S log S + S * workers)) for S shares, plus cells * workers bytes.
  */
 #include "balance/balance_internal.h"
+#include "core/world_internal.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -54,6 +55,8 @@ vw_status vw__balance_duplicate_plan(const double *load, const int *cell_worker,
         free(t), free(k), free(sh), free(pc), free(pw), free(holds), free(span), free(time);
         return VW_E_NOMEM;
     }
+    double top = 0; /* the fastest speed */
+    for (int g = 0; speeds && g < gworkers; g++) top = speeds[g] > top ? speeds[g] : top;
     for (int c = 0; c < ncells; c++) k[c] = 1;
     double best = -1;
     int extra = 0;
@@ -94,12 +97,12 @@ vw_status vw__balance_duplicate_plan(const double *load, const int *cell_worker,
             for (int g = 0; g < gworkers; g++)
                 if (h[g]) time[g] += span[c];
         }
-        double max = 0, sum = 0;
-        for (int g = 0; g < gworkers; g++) {
-            sum += time[g];
-            if (time[g] > max) max = time[g];
-        }
-        double lam = sum > 0 ? max / (sum / gworkers) : 1.0;
+        /* lambda as vw_balance_imbalance defines it: the slowest worker's time
+           against a split by speed (vw__lambda, given each worker's work, its time
+           times its speed as a fraction of the fastest). Max / mean of the times let
+           an idle slow worker lift lambda, and the plan copied cells to it. */
+        for (int g = 0; g < gworkers; g++) time[g] *= speeds ? speeds[g] / top : 1.0;
+        double lam = vw__lambda(time, speeds, gworkers);
         if (best < 0 || lam < best - 1e-12) {
             best = lam;
             *npairs = ns;

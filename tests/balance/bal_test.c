@@ -629,8 +629,9 @@ static void duplicate_plans(void)
         EXPECT(np == 1 && pc[0] == 0 && pw[0] == 1, "speeds 1,3: %d copies", np);
         EXPECT(fabs(lam - 1.0) < 1e-12, "speeds 1,3: lambda %.6f, expected 1", lam);
     }
-    /* Two cells of load 3 on the two workers (speeds 1, 3): lambda 3 / 2 before; the
-       slow worker's cell gets a copy (1.75 / 1.25 = 1.4), then the other one (1). */
+    /* Two cells of load 3 on the two workers (speeds 1, 3): lambda 3 / 1.5 = 2 before
+       (a split by speed takes 6 / 4); the slow worker's cell gets a copy (the slowest
+       worker then takes 1.75: lambda 1.75 / 1.5), then the other one (1). */
     {
         double load[2] = {3, 3}, speeds[2] = {1, 3};
         int cw[2] = {0, 1};
@@ -640,9 +641,27 @@ static void duplicate_plans(void)
         EXPECT(fabs(lam - 1.0) < 1e-12, "two cells, speeds 1,3: lambda %.6f, expected 1", lam);
         EXPECT(vw__balance_duplicate_plan(load, cw, 2, 2, speeds, 0.03, 1, pc, pw, &np, &lam) == VW_OK,
                "plan");
-        EXPECT(np == 1 && pc[0] == 0 && pw[0] == 1 && fabs(lam - 1.4) < 1e-12,
-               "one copy at most: cell %d on worker %d, lambda %.6f, expected cell 0 on 1, 1.4",
+        EXPECT(np == 1 && pc[0] == 0 && pw[0] == 1 && fabs(lam - 1.75 / 1.5) < 1e-12,
+               "one copy at most: cell %d on worker %d, lambda %.6f, expected cell 0 on 1, 7/6",
                np ? pc[0] : -1, np ? pw[0] : -1, lam);
+    }
+    /* lambda by the documented definition (vw_balance_imbalance): the slowest worker's
+       time against a split by speed, not max / mean of the times. Load 4 on the fast
+       worker of speeds 1,3 is lambda 4/3 (max / mean said 2); all of it on the fast one
+       of 1,1000 is within the tolerance already, so no copy is planned (max / mean said
+       2 and copied the cell to the slow worker). */
+    {
+        double load[1] = {4}, speeds[2] = {1, 3}, s1000[2] = {1, 1000};
+        int cw[1] = {1};
+        EXPECT(vw__balance_duplicate_plan(load, cw, 1, 2, speeds, 0.03, 0, pc, pw, &np, &lam) == VW_OK,
+               "plan");
+        double want = vw_balance_imbalance(load, cw, 1, 2, speeds);
+        EXPECT(np == 0 && fabs(lam - want) < 1e-12 && fabs(want - 4.0 / 3) < 1e-12,
+               "no copies, speeds 1,3: %d copies, lambda %.6f, expected %.6f", np, lam, want);
+        EXPECT(vw__balance_duplicate_plan(load, cw, 1, 2, s1000, 0.03, 8, pc, pw, &np, &lam) == VW_OK,
+               "plan");
+        EXPECT(np == 0 && fabs(lam - 1.001) < 1e-12,
+               "all on the fast of 1,1000: %d copies, lambda %.6f, expected none, 1.001", np, lam);
     }
     /* Equal speeds (NULL): loads 6 and 2 -> copies of both, lambda 1. */
     {

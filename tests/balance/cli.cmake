@@ -74,6 +74,21 @@ string(JSON predicted GET "${json}" balance_detail imbalance_predicted)
 if(NOT rc EQUAL 0 OR NOT out MATCHES "lambda before [1-9]" OR before LESS 1 OR predicted LESS 1)
   message(FATAL_ERROR "--map weighted: exit ${rc}, before ${before}, predicted ${predicted}: ${out}${err}")
 endif()
+# lambda before a balance is the one the mapping alone measures on the same layout (one
+# definition, vw_balance_imbalance's): with every cell on the fast worker of 1,1000 the
+# balancers' own 'before' said 2 (max / mean), the measurement 1.001.
+foreach(bal none divide duplicate)
+  execute_process(COMMAND ${VWALLS} render ${SCENE} -o ${WORK}/before_${bal}.png --size 80x60 --quiet
+                  --cells 2x2x2 --workers 2 --farm none --map weighted --balance ${bal}
+                  --balance-load segments --speeds 1,1000 --stats ${WORK}/before_${bal}.json
+                  RESULT_VARIABLE rc ERROR_VARIABLE err)
+  file(READ ${WORK}/before_${bal}.json json)
+  string(JSON before_${bal} GET "${json}" balance_detail imbalance_before)
+  if(NOT rc EQUAL 0 OR NOT before_${bal} STREQUAL before_none)
+    message(FATAL_ERROR "--balance ${bal} --speeds 1,1000: exit ${rc}, lambda before "
+            "${before_${bal}}, measured by the mapping alone ${before_none}: ${err}")
+  endif()
+endforeach()
 
 # Bad values: exit 2, no output.
 foreach(bad "--balance;sideways" "--map;random" "--speeds;1,x" "--speeds;1" "--speeds;1,2," "--slow;9:2"

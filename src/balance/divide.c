@@ -7,6 +7,7 @@
  * median of its load along its longest side. Bounded by max_extra splits.
  */
 #include "balance/balance_internal.h"
+#include "decomp/decomp_internal.h"
 #include "vwalls/map.h"
 
 #include <stdlib.h>
@@ -66,13 +67,7 @@ vw_status vw__balance_divide(const vw_decomp *cur, const vw_load_field *f,
                 p->min_width * (wb.hi[axis] - wb.lo[axis]), &split);
         if (!(split > b.lo[axis] && split < b.hi[axis])) break; /* too thin to divide */
         /* The leaf becomes a wall with the old cell on its low side, a new cell above. */
-        int leaf = -1;
-        for (int i = 0; i < nn; i++)
-            if (nodes[i].axis < 0 && nodes[i].cell == heavy) leaf = i;
-        nodes[nn] = (vw_kd_node){-1, 0, -1, -1, heavy};
-        nodes[nn + 1] = (vw_kd_node){-1, 0, -1, -1, nc};
-        nodes[leaf] = (vw_kd_node){axis, split, nn, nn + 1, -1};
-        nn += 2;
+        nn = vw__kd_divide(nodes, nn, heavy, axis, split, nc);
         nc++;
         extra++;
         vw_decomp *nd;

@@ -33,4 +33,11 @@ struct vw_decomp {
     vw_face_step *face_step; /* per (cell, face): the step of a carried walk (vw_walk_next) */
 };
 
+/* Divides cell `cell` of a kd-tree node array of n nodes (with room for two more) by a
+   wall at `split` across `axis`: the cell's leaf becomes the wall, its low side keeps the
+   cell, its high side is the new cell `newcell`. Returns the new node count, n + 2 (n
+   when no leaf holds the cell). For vw_decomp_create_kd: divide (balancing) and the
+   collider's split per process. */
+int vw__kd_divide(vw_kd_node *nodes, int n, int cell, int axis, double split, int newcell);
+
 #endif

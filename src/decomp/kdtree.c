@@ -784,3 +784,15 @@ refused: /* every refusal leaves dims at 1x1x1, not half parsed ("4x0x2" left 4x
     dims[0] = dims[1] = dims[2] = 1;
     return VW_E_INPUT;
 }
+
+int vw__kd_divide(vw_kd_node *nodes, int n, int cell, int axis, double split, int newcell)
+{
+    int leaf = -1;
+    for (int i = 0; i < n; i++)
+        if (nodes[i].axis < 0 && nodes[i].cell == cell) leaf = i;
+    if (leaf < 0) return n;
+    nodes[n] = (vw_kd_node){-1, 0, -1, -1, cell};
+    nodes[n + 1] = (vw_kd_node){-1, 0, -1, -1, newcell};
+    nodes[leaf] = (vw_kd_node){axis, split, n, n + 1, -1};
+    return n + 2;
+}

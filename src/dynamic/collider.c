@@ -11,6 +11,7 @@
 #include <pthread.h>
 #include <stdlib.h>
 #include <string.h>
+#include "decomp/decomp_internal.h"
 #include "dynamic/dynamic_internal.h"
 
 enum { K_PROBE = 0, K_CONTACT = 1 };
@@ -261,13 +262,7 @@ static vw_status give_every_process_a_cell(vw_collider *c, const vw_decomp *d)
             st = VW_E_INVAL; /* a cell too thin to halve */
             break;
         }
-        int leaf = -1;
-        for (int i = 0; i < nn; i++)
-            if (nodes[i].axis < 0 && nodes[i].cell == big) leaf = i;
-        nodes[nn] = (vw_kd_node){-1, 0, -1, -1, big};
-        nodes[nn + 1] = (vw_kd_node){-1, 0, -1, -1, nc};
-        nodes[leaf] = (vw_kd_node){axis, split, nn, nn + 1, -1};
-        nn += 2;
+        nn = vw__kd_divide(nodes, nn, big, axis, split, nc);
         cw[nc++] = p * nw;
         hosts[p]++;
         vw_decomp *nd = NULL;

@@ -100,3 +100,15 @@ if(VW_MPI_FLAVOUR STREQUAL "openmpi")
   set_tests_properties(mpi_two_hosts PROPERTIES LABELS "mpi" TIMEOUT 180 SKIP_RETURN_CODE 77
                        ENVIRONMENT "${VW_MPI_ENV}" RUN_SERIAL TRUE)
 endif()
+
+# A step of a world's life that fails on one rank only (a bad speed at create, out of
+# memory adding objects, an unknown object, a bad copy or mapping, cell_build failing on
+# that rank's cells at commit or in run's commit): every rank fails that step with the
+# failing rank's message and exits, none waits for the others.
+foreach(step create add update replicas redecompose commit run)
+  add_test(NAME mpi_local_fail_${step}
+           COMMAND sh ${PROJECT_SOURCE_DIR}/tests/mpi/local_fail.sh ${step} 3 $<TARGET_FILE:test_mpi_storm>
+                   "${MPIEXEC_EXECUTABLE} ${MPIEXEC_NUMPROC_FLAG} 3 ${VW_MPI_PREFLAGS}")
+  set_tests_properties(mpi_local_fail_${step} PROPERTIES LABELS "mpi" TIMEOUT 60
+                       ENVIRONMENT "${VW_MPI_ENV}" PROCESSORS 2)
+endforeach()

@@ -8,6 +8,16 @@
  *
  * Engines: worker threads in one process (always), and MPI between processes when the
  * library was built with MPI and the world is created inside an MPI job.
+ *
+ * Under MPI every process takes the steps of a world's life alike, with the same
+ * arguments: vw_world_create, vw_world_add_objects, vw_world_update_object,
+ * vw_world_set_replicas, vw_world_redecompose, vw_world_remap, vw_world_commit and
+ * vw_world_run are collective. Each ends in agreement (vw_world_agree): a step that
+ * fails on one process only (out of memory, a cell_build that fails there) fails on
+ * every process with the status of the lowest failing one, and vw_world_errmsg (for
+ * create: vw_world_errmsg(NULL)) says "rank R: <its message>" everywhere. So a program
+ * may stop at the first failing step on every process alike, and no process is left
+ * waiting for another in a collective call. vw_world_post and the queries are local.
  */
 #ifndef VWALLS_WORLD_H
 #define VWALLS_WORLD_H

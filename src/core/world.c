@@ -48,6 +48,31 @@ const char *vw_world_errmsg(const vw_world *w)
     return w->err == VW_OK ? "no error" : w->errmsg;
 }
 
+/* Under MPI, every process takes the steps of a world's life alike (create, add objects,
+   update an object, set copies, redecompose or remap, commit, run), and the next one
+   after each is collective somewhere. A step that fails on one process only (out of
+   memory, a bad argument given to that process) and succeeds on the others would send
+   that process away (to vw_world_free, MPI_Finalize) while the others wait for it in
+   their next collective call, for ever. So each step ends in agreement: every process
+   returns the status of the lowest failing one, and holds "rank R: its message" as the
+   world's error (that process too, unless it already held an earlier error: the first
+   is kept). One MPI_Allreduce of an int when all is well. `before` is w->err before the
+   step; `step` names it where the failure left no message of its own. */
+static vw_status step_agreed(vw_world *w, vw_status st, vw_status before, const char *step)
+{
+    char msg[512] = "";
+    if (st != VW_OK && before == VW_OK && w->err == VW_OK)
+        vw__world_error(w, st, "%s: %s", step, vw_status_message(st));
+    if (st != VW_OK) snprintf(msg, sizeof msg, "%s", before == VW_OK ? w->errmsg : vw_status_message(st));
+    if (!w->transport) return st;
+    vw_status all = vw_world_agree(w, st, msg, sizeof msg);
+    if (all != VW_OK && before == VW_OK) {
+        w->err = VW_OK; /* this step's own message gives way to the agreed one */
+        vw__world_error(w, all, "%s", msg);
+    }
+    return all;
+}
+
 static uint64_t env_u64(const char *name)
 {
     const char *s = getenv(name);
@@ -289,6 +314,9 @@ vw_status vw_world_create(const vw_module *m, void *user, const vw_decomp *d, co
     if (st == VW_OK) st = copy_speeds(w);
     if (st == VW_OK) st = copy_slowdown(w);
     if (st == VW_OK) st = map_cells(w, c ? c->cell_worker : NULL);
+    /* Every process made the transport (vw__mpi_attach agrees on that); what failed
+       after it may have failed on some processes only. */
+    if (w->transport) st = step_agreed(w, st, VW_OK, "vw_world_create");
     if (st != VW_OK) {
         create_failed(st, "%s", w->err != VW_OK ? w->errmsg : vw_status_message(st));
         vw_world_free(w);
@@ -383,9 +411,9 @@ static vw_status place_object(vw_world *w, size_t id)
     return st;
 }
 
-vw_status vw_world_add_objects(vw_world *w, const void *objects, size_t n)
+static vw_status add_objects(vw_world *w, const void *objects, size_t n)
 {
-    if (!w || (n && !objects)) return VW_E_INVAL;
+    if (n && !objects) return VW_E_INVAL;
     size_t osz = w->m->object_size;
     if (!osz) return n ? VW_E_INVAL : VW_OK;
     if (n == 0) return VW_OK; /* also keeps memcpy away from a NULL buffer */
@@ -411,9 +439,16 @@ vw_status vw_world_add_objects(vw_world *w, const void *objects, size_t n)
     return VW_OK;
 }
 
-vw_status vw_world_update_object(vw_world *w, size_t id, const void *object)
+vw_status vw_world_add_objects(vw_world *w, const void *objects, size_t n)
 {
-    if (!w || !object || id >= w->nobjects) return VW_E_INVAL;
+    if (!w) return VW_E_INVAL;
+    vw_status before = w->err;
+    return step_agreed(w, add_objects(w, objects, n), before, "vw_world_add_objects");
+}
+
+static vw_status update_object(vw_world *w, size_t id, const void *object)
+{
+    if (!object || id >= w->nobjects) return VW_E_INVAL;
     int *cells;
     int n = object_cells(w, id, &cells);
     if (n < 0) return VW_E_NOMEM;
@@ -433,6 +468,13 @@ vw_status vw_world_update_object(vw_world *w, size_t id, const void *object)
     vw_status st = place_object(w, id);
     w->committed = 0;
     return st;
+}
+
+vw_status vw_world_update_object(vw_world *w, size_t id, const void *object)
+{
+    if (!w) return VW_E_INVAL;
+    vw_status before = w->err;
+    return step_agreed(w, update_object(w, id, object), before, "vw_world_update_object");
 }
 
 int vw_world_cells_of_object(const vw_world *w, size_t id, int *out, int max)
@@ -554,9 +596,9 @@ vw_status vw_world_run(vw_world *w)
 
 /* ---- re-decomposition --------------------------------------------------------------- */
 
-vw_status vw_world_redecompose(vw_world *w, const vw_decomp *d, const int *cell_worker)
+static vw_status redecompose(vw_world *w, const vw_decomp *d, const int *cell_worker)
 {
-    if (!w || !d) return VW_E_INVAL;
+    if (!d) return VW_E_INVAL;
     /* A bad mapping is refused before the old cells are torn down: found by map_cells
        after that, it left a world with no objects placed and its workers' cell lists
        from the old decomposition, whose next run called handlers without cell state. */
@@ -603,6 +645,13 @@ vw_status vw_world_redecompose(vw_world *w, const vw_decomp *d, const int *cell_
     w->migrated += migrated;
     w->committed = 0;
     return st;
+}
+
+vw_status vw_world_redecompose(vw_world *w, const vw_decomp *d, const int *cell_worker)
+{
+    if (!w) return VW_E_INVAL;
+    vw_status before = w->err;
+    return step_agreed(w, redecompose(w, d, cell_worker), before, "vw_world_redecompose");
 }
 
 /* ---- duplicated cells --------------------------------------------------------------- */
@@ -706,9 +755,9 @@ double vw__unit_share(const vw__cell *c, int u)
     return (double)(c->share_first[u + 1] - c->share_first[u]) / c->share_len;
 }
 
-vw_status vw_world_set_replicas(vw_world *w, int cell, const int *workers, int n)
+static vw_status set_replicas(vw_world *w, int cell, const int *workers, int n)
 {
-    if (!w || cell < 0 || cell >= w->ncells || n < 0 || (n && !workers)) return VW_E_INVAL;
+    if (cell < 0 || cell >= w->ncells || n < 0 || (n && !workers)) return VW_E_INVAL;
     vw__cell *c = &w->cells[cell];
     if (n) {
         int independent = 0;
@@ -766,6 +815,13 @@ vw_status vw_world_set_replicas(vw_world *w, int cell, const int *workers, int n
     c->share_first = shares ? shares + 2 * c->share_len : NULL;
     w->committed = 0;
     return assign_units(w);
+}
+
+vw_status vw_world_set_replicas(vw_world *w, int cell, const int *workers, int n)
+{
+    if (!w) return VW_E_INVAL;
+    vw_status before = w->err;
+    return step_agreed(w, set_replicas(w, cell, workers, n), before, "vw_world_set_replicas");
 }
 
 int vw_world_replicas(const vw_world *w, int cell, int *out, int max)

@@ -513,16 +513,24 @@ vw_status vw__mpi_attach(vw_world *w)
                                "at least MPI_THREAD_FUNNELED", level);
     if (size == 1) return VW_OK; /* one process: the threads engine, without polling */
     /* Every process needs the same worker count (global worker = rank * W + local). With
-       workers = 0 (as many as cores) the machines may differ: take the smallest. */
-    int wmin = w->nworkers, wmax = w->nworkers, mine[2] = {w->nworkers, -w->nworkers}, all[2];
-    MPI_Allreduce(mine, all, 2, MPI_INT, MPI_MIN, base);
+       workers = 0 (as many as cores) the machines may differ: take the smallest. The same
+       reduction finds the lowest process that could not allocate the transport: all
+       processes go on to MPI_Comm_dup (collective), or none does. */
+    mpi_tp *t = calloc(1, sizeof *t);
+    int wmin, wmax, mine[3] = {w->nworkers, -w->nworkers, t ? size : rank}, all[3];
+    MPI_Allreduce(mine, all, 3, MPI_INT, MPI_MIN, base);
     wmin = all[0];
     wmax = -all[1];
-    if (wmin != wmax && w->cfg.workers > 0)
+    if (all[2] < size) {
+        free(t);
+        return vw__world_error(w, VW_E_NOMEM, "rank %d: out of memory creating the MPI transport",
+                               all[2]);
+    }
+    if (wmin != wmax && w->cfg.workers > 0) {
+        free(t);
         return vw__world_error(w, VW_E_INVAL, "processes were given different worker counts (%d to %d)",
                                wmin, wmax);
-    mpi_tp *t = calloc(1, sizeof *t);
-    if (!t) return VW_E_NOMEM;
+    }
     MPI_Comm_dup(base, &t->comm);
     MPI_Comm_set_errhandler(t->comm, MPI_ERRORS_ARE_FATAL);
     t->level = level;

@@ -3,9 +3,11 @@
  * process, some are posted before the run. What arrives is a pure function of the seed,
  * so every rank checks the global counters, per-cell figures and output against a
  * sequential reference, over two runs of the same world. Also: agreement between ranks,
- * and a rank that dies in the middle of a run (for the fault tests).
+ * a rank that dies in the middle of a run (for the fault tests), and a step of the
+ * world's life that fails on one rank only (--fail: every rank must fail it, naming it).
  *
  * usage: test_mpi_storm [--workers W] [--seeds N] [--agree] [--kill-rank R] [--exit-rank R]
+ *                       [--fail STEP --fail-rank R]
  * Runs alone (threads engine) or under mpirun; honours VW_STRESS / VW_STRESS_SPLIT.
  */
 #include <signal.h>
@@ -31,6 +33,7 @@ typedef struct storm {
     int ncells, roots;
     int64_t output_sum;   /* output handler only (serialised, rank 0) */
     int kill_rank;        /* -1: nobody dies */
+    int fail_build_rank;  /* cell_build fails on this rank's cells (-1: none) */
 } storm;
 
 static uint64_t mix(uint64_t z)
@@ -78,7 +81,8 @@ typedef struct tcell {
 
 static vw_status build(vw_ctx *ctx, const void *objs, size_t n, void **state)
 {
-    (void)ctx, (void)objs, (void)n;
+    (void)objs, (void)n;
+    if (((storm *)vw_ctx_user(ctx))->fail_build_rank == vw_ctx_process(ctx)) return VW_E_INPUT;
     *state = calloc(1, sizeof(tcell));
     return *state ? VW_OK : VW_E_NOMEM;
 }
@@ -211,7 +215,7 @@ static void test_mismatch(int workers)
         int *map = malloc(sizeof(int) * (size_t)nc);
         for (int c = 0; c < nc; c++) map[c] = c % gw;
         if (differs && what == 2) map[0] = 1 % gw, map[1] = 0;
-        storm st = {1, nc, 0, 0, -1};
+        storm st = {1, nc, 0, 0, -1, -1};
         vw_config cfg;
         vw_config_init(&cfg);
         cfg.workers = workers;
@@ -228,9 +232,11 @@ static void test_mismatch(int workers)
             if (differs) pts[2][1] = 0.15; /* one point elsewhere in the same cell */
             CHECK_EQ_INT(vw_world_add_objects(w, pts, 3), VW_OK);
         }
-        if ((differs && what == 3) || (what == 4 && gw > 1)) {
-            int other = (map[0] + 1) % gw;
-            CHECK_EQ_INT(vw_world_set_replicas(w, 0, &other, 1), VW_OK);
+        /* Every process sets the copies (a collective step); the one that differs gives
+           cell 0 a copy where the others give it none. */
+        if (what == 3 || (what == 4 && gw > 1)) {
+            int other = (map[0] + 1) % gw, n = what == 4 || differs ? 1 : 0;
+            CHECK_EQ_INT(vw_world_set_replicas(w, 0, n ? &other : NULL, n), VW_OK);
         }
         vw_status got = vw_world_commit(w);
         if (what == 0 || size == 1 || gw < 2) {
@@ -248,15 +254,89 @@ static void test_mismatch(int workers)
     }
 }
 
+/* One step of a world's life fails on rank `bad` only, the way a local failure does
+   (out of memory, a cell that cannot be built): create (a bad worker speed), add (more
+   objects than memory), update (an unknown object), replicas (a worker that does not
+   exist), redecompose (a mapping to one), commit (cell_build fails on that rank's
+   cells), run (the same, in the commit that run makes). Every rank goes on like any
+   program: it stops at the first step that fails, frees what it has and finishes MPI.
+   The step must fail on every rank with the failing rank's message, or the others
+   would wait for it in the next collective call (and it for them in MPI_Finalize). */
+static int local_failure(const char *step, int bad, int workers)
+{
+    int rank = vw_engine_rank(), here = rank == bad;
+    vw_box box = {{0, 0, 0}, {1, 1, 1}};
+    int dims[3] = {2, 2, 1};
+    vw_decomp *d;
+    CHECK_EQ_INT(vw_decomp_create_grid(&box, dims, &d), VW_OK);
+    int nc = vw_decomp_cell_count(d), gw = vw_engine_size() * workers;
+    storm st = {1, nc, 1, 0, -1, here && (!strcmp(step, "commit") || !strcmp(step, "run")) ? bad : -1};
+    vw_module mod = storm_module;
+    mod.object_size = 3 * sizeof(double);
+    mod.object_bounds = point_bounds;
+    vw_config cfg;
+    vw_config_init(&cfg);
+    cfg.workers = workers;
+    double *speeds = malloc(sizeof(double) * (size_t)gw);
+    for (int g = 0; g < gw; g++) speeds[g] = here && !strcmp(step, "create") ? -1.0 : 1.0;
+    cfg.worker_speeds = speeds;
+    vw_world *w = NULL;
+    const char *failed = "create";
+    vw_status s = vw_world_create(&mod, &st, d, &cfg, &w);
+    free(speeds);
+    double pts[3][3] = {{0.1, 0.2, 0.3}, {0.6, 0.6, 0.6}, {0.9, 0.1, 0.5}};
+    if (s == VW_OK) {
+        failed = "add";
+        /* A count whose bytes do not fit a size_t: refused as out of memory. */
+        s = vw_world_add_objects(w, pts, here && !strcmp(step, "add") ? SIZE_MAX / 2 : 3);
+    }
+    if (s == VW_OK) {
+        failed = "update";
+        s = vw_world_update_object(w, here && !strcmp(step, "update") ? 99 : 1, pts[2]);
+    }
+    if (s == VW_OK && gw > 1) {
+        failed = "replicas";
+        int other = here && !strcmp(step, "replicas") ? gw + 5 : (vw_world_cell_worker(w, 0) + 1) % gw;
+        s = vw_world_set_replicas(w, 0, &other, 1);
+    }
+    if (s == VW_OK) {
+        failed = "redecompose";
+        int *map = malloc(sizeof(int) * (size_t)nc);
+        for (int c = 0; c < nc; c++) map[c] = here && !strcmp(step, "redecompose") ? gw + c : c % gw;
+        s = vw_world_redecompose(w, d, map);
+        free(map);
+    }
+    if (s == VW_OK && strcmp(step, "run") != 0) {
+        failed = "commit";
+        s = vw_world_commit(w);
+    }
+    if (s == VW_OK) {
+        failed = "run";
+        s = vw_world_run(w);
+    }
+    char want[32];
+    snprintf(want, sizeof want, "rank %d: ", bad);
+    const char *msg = vw_world_errmsg(w);
+    int ok = s != VW_OK && !strcmp(failed, step) && strstr(msg, want) == msg;
+    fprintf(stderr, "test_mpi_storm: process %d: %s failed (%s): %s%s\n", rank, failed,
+            vw_status_message(s), msg, ok ? "" : " [UNEXPECTED]");
+    vw_world_free(w);
+    vw_decomp_free(d);
+    return 1; /* as a program whose step failed */
+}
+
 int main(int argc, char **argv)
 {
-    int workers = 2, seeds = 3, agree = 0, kill_rank = -1, exit_rank = -1;
+    int workers = 2, seeds = 3, agree = 0, kill_rank = -1, exit_rank = -1, fail_rank = 1;
+    const char *fail = NULL;
     for (int i = 1; i < argc; i++) {
         if (!strcmp(argv[i], "--workers") && i + 1 < argc) workers = atoi(argv[++i]);
         else if (!strcmp(argv[i], "--seeds") && i + 1 < argc) seeds = atoi(argv[++i]);
         else if (!strcmp(argv[i], "--agree")) agree = 1;
         else if (!strcmp(argv[i], "--kill-rank") && i + 1 < argc) kill_rank = atoi(argv[++i]);
         else if (!strcmp(argv[i], "--exit-rank") && i + 1 < argc) exit_rank = atoi(argv[++i]);
+        else if (!strcmp(argv[i], "--fail") && i + 1 < argc) fail = argv[++i];
+        else if (!strcmp(argv[i], "--fail-rank") && i + 1 < argc) fail_rank = atoi(argv[++i]);
         else {
             fprintf(stderr, "test_mpi_storm: bad argument '%s'\n", argv[i]);
             return 2;
@@ -268,6 +348,11 @@ int main(int argc, char **argv)
         return 1;
     }
     int rank = vw_engine_rank();
+    if (fail) {
+        int rc = local_failure(fail, fail_rank, workers);
+        vw_engine_finish();
+        return rc;
+    }
     if (agree) {
         for (int bad = 0; bad <= vw_engine_size(); bad++) test_agree(bad);
         test_mismatch(workers);
@@ -285,7 +370,7 @@ int main(int argc, char **argv)
             vw_decomp *d;
             CHECK_EQ_INT(vw_decomp_create_grid(&box, dims, &d), VW_OK);
             int ncells = vw_decomp_cell_count(d);
-            storm st = {(uint64_t)seed * 104729u + li, ncells, 5 + (seed * 7 + (int)li) % 30, 0, kill_rank};
+            storm st = {(uint64_t)seed * 104729u + li, ncells, 5 + (seed * 7 + (int)li) % 30, 0, kill_rank, -1};
             int64_t *per_cell = calloc((size_t)ncells, sizeof *per_cell);
             int64_t sum = 0, outputs = 0, outsum = 0;
             for (int c = 0; c < ncells; c++)

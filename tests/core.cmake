@@ -80,10 +80,10 @@ set_tests_properties(core_farm core_farm_stress PROPERTIES LABELS "core;threads"
 
 # Corner cases of the worker loop: a step() that sends and reports no work, the meter
 # after its list of noted units filled up, runs after one whose threads did not start,
-# hand-offs tried outside a run.
+# hand-offs tried outside a run, a cell_build that fails (its state is not the runtime's).
 vw_core_test(test_runtime)
 target_link_options(test_runtime PRIVATE -Wl,--wrap=pthread_create)
-foreach(t step-send meter thread-fail build-enter)
+foreach(t step-send meter thread-fail build-enter build-fail)
   add_test(NAME core_runtime_${t} COMMAND test_runtime ${t})
   set_tests_properties(core_runtime_${t} PROPERTIES LABELS "core;threads" TIMEOUT 60)
 endforeach()

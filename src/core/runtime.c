@@ -819,7 +819,11 @@ static vw_status build_unit(vw_world *w, int cell, int rep, vw__worker *wk)
     vw_status st = VW_OK;
     if (w->m->cell_build) st = w->m->cell_build(&ctx, objs, c->nobjs, state);
     free(objs);
-    if (st != VW_OK) return st;
+    if (st != VW_OK) {
+        /* The build freed what it made (module.h): what it left here is not a state. */
+        *state = NULL;
+        return st;
+    }
     *built = 1;
     if (rp)
         rp->built_version = c->version;

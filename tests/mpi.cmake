@@ -112,3 +112,11 @@ foreach(step create add update replicas redecompose commit run)
   set_tests_properties(mpi_local_fail_${step} PROPERTIES LABELS "mpi" TIMEOUT 60
                        ENVIRONMENT "${VW_MPI_ENV}" PROCESSORS 2)
 endforeach()
+
+# A peer whose module has a message kind more (another build): the receiver checks every
+# packet from another process and stops the job, naming the sender.
+add_test(NAME mpi_wire_check
+         COMMAND sh ${PROJECT_SOURCE_DIR}/tests/mpi/wire.sh $<TARGET_FILE:test_mpi_storm>
+                 "${MPIEXEC_EXECUTABLE} ${MPIEXEC_NUMPROC_FLAG} 2 ${VW_MPI_PREFLAGS}")
+set_tests_properties(mpi_wire_check PROPERTIES LABELS "mpi" TIMEOUT 60
+                     ENVIRONMENT "${VW_MPI_ENV}" PROCESSORS 2)

@@ -169,6 +169,38 @@ void vw__deliver_local(vw_world *w, vw__packet *p, uint64_t *rng)
     pthread_mutex_unlock(&to->mu);
 }
 
+const char *vw__packet_problem(const vw_world *w, const vw__packet *p, char *buf, size_t len)
+{
+    size_t off = 0;
+    for (uint32_t i = 0; i < p->nmsgs; i++) {
+        if (p->used - off < sizeof(vw__msg_header)) {
+            snprintf(buf, len, "message %u of %u lies past its %zu bytes", i, p->nmsgs, p->used);
+            return buf;
+        }
+        const vw__msg_header *h = (const vw__msg_header *)(p->data + off);
+        if (h->kind >= w->m->nkinds || h->size != w->m->kinds[h->kind].size) {
+            snprintf(buf, len, "message %u is of kind %u with %u bytes (module '%s' has %d kinds)",
+                     i, (unsigned)h->kind, (unsigned)h->size, w->m->name, w->m->nkinds);
+            return buf;
+        }
+        if (p->dest != VW__OUTPUT && (h->cell < 0 || h->cell >= w->ncells)) {
+            snprintf(buf, len, "message %u is for cell %d of %d", i, (int)h->cell, w->ncells);
+            return buf;
+        }
+        size_t stride = msg_stride(h->size);
+        if (stride > p->used - off) {
+            snprintf(buf, len, "message %u runs past the packet's %zu bytes", i, p->used);
+            return buf;
+        }
+        off += stride;
+    }
+    if (off != p->used) {
+        snprintf(buf, len, "its %u messages fill %zu of its %zu bytes", p->nmsgs, off, p->used);
+        return buf;
+    }
+    return NULL;
+}
+
 static int flush_all(vw__worker *wk)
 {
     vw_world *w = wk->w;

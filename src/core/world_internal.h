@@ -252,6 +252,13 @@ void vw__deliver(vw_world *w, vw__worker *from, vw__packet *p);
    NULL) drives the stress switch's reordering. */
 void vw__deliver_local(vw_world *w, vw__packet *p, uint64_t *rng);
 void vw__run_output(vw_world *w, const vw__packet *p);
+/* What is wrong with a packet from another process, or NULL: a message header past its
+   end, a kind the module does not have or a size not its kind's, a cell that does not
+   exist, messages that do not fill it exactly (written into buf). The workers index the
+   cells and kinds with these fields unchecked; the MPI transport checks every packet it
+   receives once, on its own thread, so a corrupt or mismatched peer stops the job with
+   a message instead of making them read and write out of bounds. */
+const char *vw__packet_problem(const vw_world *w, const vw__packet *p, char *buf, size_t len);
 void vw__uncount(vw_world *w);
 uint64_t vw__rng_next(uint64_t *s);
 double vw__cell_load(vw_world *w, int cell);

@@ -240,10 +240,14 @@ static int receive(vw_world *w, mpi_tp *t)
         int dest_ok = p->dest == VW__OUTPUT ? w->rank == 0
                                             : p->dest >= 0 && p->dest < w->gworkers &&
                                                   vw__worker_process(w, p->dest) == w->rank;
-        if (p->used != cap || !dest_ok) {
-            char what[200];
-            snprintf(what, sizeof what, "packet from rank %d for worker %d is malformed "
-                     "(do all processes run the same binary and world?)", s.MPI_SOURCE, p->dest);
+        char why[160];
+        const char *problem = p->used != cap || !dest_ok ? "its header is wrong"
+                                                          : vw__packet_problem(w, p, why, sizeof why);
+        if (problem) {
+            char what[400];
+            snprintf(what, sizeof what, "packet from rank %d for worker %d is malformed: %s "
+                     "(do all processes run the same binary and world?)", s.MPI_SOURCE, p->dest,
+                     problem);
             fatal(w, what);
         }
         t->received++;

@@ -4,10 +4,11 @@
  * so every rank checks the global counters, per-cell figures and output against a
  * sequential reference, over two runs of the same world. Also: agreement between ranks,
  * a rank that dies in the middle of a run (for the fault tests), and a step of the
- * world's life that fails on one rank only (--fail: every rank must fail it, naming it).
+ * world's life that fails on one rank only (--fail: every rank must fail it, naming it),
+ * and a peer that sends a message kind this process's module does not have (--wire).
  *
  * usage: test_mpi_storm [--workers W] [--seeds N] [--agree] [--kill-rank R] [--exit-rank R]
- *                       [--fail STEP --fail-rank R]
+ *                       [--fail STEP --fail-rank R] [--wire]
  * Runs alone (threads engine) or under mpirun; honours VW_STRESS / VW_STRESS_SPLIT.
  */
 #include <signal.h>
@@ -325,9 +326,62 @@ static int local_failure(const char *step, int bad, int workers)
     return 1; /* as a program whose step failed */
 }
 
+/* --wire: rank 1 runs a module with one message kind more than rank 0's (another build
+   of the program, which the world's fingerprint does not see) and sends that kind to
+   rank 0's cell. Rank 0 must stop the job naming the packet's sender, not index its
+   kinds past their end. */
+static vw_status wire_build(vw_ctx *ctx, const void *objs, size_t n, void **state)
+{
+    (void)ctx, (void)objs, (void)n;
+    *state = NULL;
+    return VW_OK;
+}
+
+static int wire_step(vw_ctx *ctx, void *state)
+{
+    (void)state;
+    static int sent;
+    if (vw_ctx_process(ctx) != 1 || vw_ctx_cell(ctx) != 1 || sent) return 0;
+    sent = 1;
+    int64_t v = 7;
+    vw_send_cell(ctx, 0, 2, &v);
+    return 1;
+}
+
+static int wire_mismatch(void)
+{
+    static const vw_msg_kind wkinds[3] = {
+        [MSG_TOKEN] = {"token", sizeof(token), on_token, on_output},
+        [MSG_POSTED] = {"posted", sizeof(int64_t), on_posted, NULL, 0},
+        [2] = {"newer", sizeof(int64_t), on_posted, NULL, 0},
+    };
+    vw_module m = storm_module;
+    m.kinds = wkinds;
+    m.nkinds = vw_engine_rank() == 1 ? 3 : 2;
+    m.cell_build = wire_build;
+    m.cell_free = NULL;
+    m.step = wire_step;
+    vw_box box = {{0, 0, 0}, {1, 1, 1}};
+    int dims[3] = {vw_engine_size(), 1, 1};
+    vw_decomp *d;
+    CHECK_EQ_INT(vw_decomp_create_grid(&box, dims, &d), VW_OK);
+    storm st = {1, dims[0], 0, 0, -1, -1};
+    vw_config cfg;
+    vw_config_init(&cfg);
+    cfg.workers = 1;
+    vw_world *w;
+    CHECK_EQ_INT(vw_world_create(&m, &st, d, &cfg, &w), VW_OK);
+    CHECK_EQ_INT(vw_world_run(w), VW_OK);
+    fprintf(stderr, "test_mpi_storm: process %d: the run ended without noticing the stray kind\n",
+            vw_engine_rank());
+    vw_world_free(w);
+    vw_decomp_free(d);
+    return 1;
+}
+
 int main(int argc, char **argv)
 {
-    int workers = 2, seeds = 3, agree = 0, kill_rank = -1, exit_rank = -1, fail_rank = 1;
+    int workers = 2, seeds = 3, agree = 0, kill_rank = -1, exit_rank = -1, fail_rank = 1, wire = 0;
     const char *fail = NULL;
     for (int i = 1; i < argc; i++) {
         if (!strcmp(argv[i], "--workers") && i + 1 < argc) workers = atoi(argv[++i]);
@@ -336,6 +390,7 @@ int main(int argc, char **argv)
         else if (!strcmp(argv[i], "--kill-rank") && i + 1 < argc) kill_rank = atoi(argv[++i]);
         else if (!strcmp(argv[i], "--exit-rank") && i + 1 < argc) exit_rank = atoi(argv[++i]);
         else if (!strcmp(argv[i], "--fail") && i + 1 < argc) fail = argv[++i];
+        else if (!strcmp(argv[i], "--wire")) wire = 1;
         else if (!strcmp(argv[i], "--fail-rank") && i + 1 < argc) fail_rank = atoi(argv[++i]);
         else {
             fprintf(stderr, "test_mpi_storm: bad argument '%s'\n", argv[i]);
@@ -348,8 +403,8 @@ int main(int argc, char **argv)
         return 1;
     }
     int rank = vw_engine_rank();
-    if (fail) {
-        int rc = local_failure(fail, fail_rank, workers);
+    if (wire || fail) {
+        int rc = wire ? wire_mismatch() : local_failure(fail, fail_rank, workers);
         vw_engine_finish();
         return rc;
     }

@@ -297,7 +297,10 @@ vw_status rt_job_balance(rt_job *j, const rt_balance *b, rt_balance_result *bi, 
             /* Mapping only: greedy / weighted by the measured loads. */
             st = rt_job_map(j, b->map, load, b->speeds, err, errlen);
             if (st == VW_OK) {
-                int nc = vw_decomp_cell_count(d), *cw = malloc(sizeof(int) * (size_t)nc);
+                /* (the remap replaced the decomposition: d is gone; the walls are
+                   the same, so load still has a figure per cell) */
+                int nc = vw_decomp_cell_count(vw_world_decomp(w));
+                int *cw = malloc(sizeof(int) * (size_t)nc);
                 for (int c = 0; cw && c < nc; c++) cw[c] = vw_world_cell_worker(w, c);
                 int gw = vw_world_workers(w) * vw_world_processes(w);
                 bi->rep.imbalance_before = lam;

@@ -9,19 +9,9 @@ kill) args="--kill-rank 2" rank=2 ;;
 exit) args="--exit-rank 1" rank=1 ;;
 *) echo "fault.sh: unknown mode '$mode'"; exit 2 ;;
 esac
-out=$(mktemp)
-start=$(date +%s%N)
+. "$(dirname "$0")/must_fail.sh"
 # shellcheck disable=SC2086
-timeout 60 $launch "$prog" --workers 2 --seeds 20 $args >"$out" 2>&1
-rc=$?
-end=$(date +%s%N)
-ms=$(( (end - start) / 1000000 ))
-cat "$out"
-echo "fault.sh: $mode: status $rc after $ms ms"
-fail=0
-[ "$rc" -ne 0 ] || { echo "fault.sh: FAIL: the job succeeded although rank $rank failed"; fail=1; }
-[ "$rc" -ne 124 ] || { echo "fault.sh: FAIL: the job hung (killed by timeout)"; fail=1; }
-[ "$ms" -le 10000 ] || { echo "fault.sh: FAIL: took $ms ms, more than 10 s"; fail=1; }
+must_fail "fault.sh: $mode" 10 60 $launch "$prog" --workers 2 --seeds 20 $args
 # Open MPI's mpirun names the rank ("process rank 2 ... exited on signal 9"). MPICH's
 # Hydra does not: its "BAD TERMINATION" banner gives the pid of the node's first process
 # and the signal, so there we can only require the cause.

@@ -6,19 +6,9 @@
 # they for it in MPI_Finalize, for ever.
 # usage: local_fail.sh STEP NP TEST_MPI_STORM "MPIEXEC -n NP [flags]"
 step=$1 np=$2 prog=$3 launch=$4
-out=$(mktemp)
-start=$(date +%s%N)
+. "$(dirname "$0")/must_fail.sh"
 # shellcheck disable=SC2086
-timeout 30 $launch "$prog" --workers 2 --fail "$step" --fail-rank 1 >"$out" 2>&1
-rc=$?
-end=$(date +%s%N)
-ms=$(( (end - start) / 1000000 ))
-cat "$out"
-echo "local_fail.sh: $step: status $rc after $ms ms"
-fail=0
-[ "$rc" -ne 0 ] || { echo "local_fail.sh: FAIL: the job succeeded although rank 1 failed"; fail=1; }
-[ "$rc" -ne 124 ] || { echo "local_fail.sh: FAIL: the job hung (killed by timeout)"; fail=1; }
-[ "$ms" -le 20000 ] || { echo "local_fail.sh: FAIL: took $ms ms, more than 20 s"; fail=1; }
+must_fail "local_fail.sh: $step" 20 30 $launch "$prog" --workers 2 --fail "$step" --fail-rank 1
 r=0
 while [ "$r" -lt "$np" ]; do
     line=$(grep "^test_mpi_storm: process $r: " "$out")

@@ -4,19 +4,9 @@
 # rank sent the malformed packet and what is wrong with it.
 # usage: wire.sh TEST_MPI_STORM "MPIEXEC -n 2 [flags]"
 prog=$1 launch=$2
-out=$(mktemp)
-start=$(date +%s%N)
+. "$(dirname "$0")/must_fail.sh"
 # shellcheck disable=SC2086
-timeout 30 $launch "$prog" --wire >"$out" 2>&1
-rc=$?
-end=$(date +%s%N)
-ms=$(( (end - start) / 1000000 ))
-cat "$out"
-echo "wire.sh: status $rc after $ms ms"
-fail=0
-[ "$rc" -ne 0 ] || { echo "wire.sh: FAIL: the job succeeded"; fail=1; }
-[ "$rc" -ne 124 ] || { echo "wire.sh: FAIL: the job hung (killed by timeout)"; fail=1; }
-[ "$ms" -le 20000 ] || { echo "wire.sh: FAIL: took $ms ms, more than 20 s"; fail=1; }
+must_fail wire.sh 20 30 $launch "$prog" --wire
 grep -q "rank 0: packet from rank 1 .*malformed: message 0 is of kind 2" "$out" ||
     { echo "wire.sh: FAIL: rank 0 did not name the malformed packet and its sender"; fail=1; }
 rm -f "$out"

@@ -40,7 +40,8 @@ VW_API int vw_engine_size(void);
    msg its message. Returns VW_OK on every rank when every rank passed VW_OK; otherwise
    every rank returns the status of the lowest failing rank, and msg (of size len) holds
    "rank R: <its message>" on every rank. vw_engine_agree runs on MPI_COMM_WORLD (usable
-   before a world exists), vw_world_agree on the world's communicator. */
+   before a world exists), vw_world_agree on the world's communicator (VW_E_INVAL for a
+   NULL world, with MPI or without). */
 VW_API vw_status vw_engine_agree(vw_status local, char *msg, size_t len);
 VW_API vw_status vw_world_agree(vw_world *w, vw_status local, char *msg, size_t len);
 

@@ -1051,8 +1051,8 @@ vw_status vw_engine_agree(vw_status local, char *msg, size_t len)
 }
 vw_status vw_world_agree(vw_world *w, vw_status local, char *msg, size_t len)
 {
-    (void)w, (void)msg, (void)len;
-    return local;
+    (void)msg, (void)len;
+    return w ? local : VW_E_INVAL; /* as the MPI build answers */
 }
 void vw_engine_broadcast(void *buf, size_t n) { (void)buf, (void)n; }
 #endif

@@ -121,6 +121,8 @@ int main(int argc, char **argv)
     cfg.workers = 2;
     vw_world *w = NULL;
     if (!strcmp(mode, "create")) {
+        /* No world to agree on: the same answer with and without the MPI engine. */
+        CHECK_EQ_INT(vw_world_agree(NULL, VW_OK, NULL, 0), VW_E_INVAL);
         vw_module bad = m;
         bad.abi = VW_MODULE_ABI + 1;
         CHECK(vw_world_create(&bad, NULL, d, &cfg, &w) == VW_E_INVAL && !w);

@@ -234,10 +234,11 @@ int vw_cli_same_as_first(const char *cmd, const double *v, size_t n, const char 
     return -1;
 }
 
-void vw_progress_begin(vw_progress *p, const char *label, int quiet)
+void vw_progress_begin(vw_progress *p, const char *label, int show)
 {
     p->label = label;
-    p->enabled = !quiet && vw_cli_is_output() && isatty(2);
+    p->enabled = show != VW_PROGRESS_OFF && vw_cli_is_output() &&
+                 (show == VW_PROGRESS_ON || isatty(2));
     p->start = p->last = vw_cli_now();
 }
 

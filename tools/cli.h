@@ -76,7 +76,7 @@ int vw_cli_same_view(const char *cmd, int width, int height, long depth, const v
 void vw_cli_engine_init(int *argc, char ***argv);
 void vw_cli_engine_finish(void);
 
-/* A progress bar on stderr when it is a terminal and not quiet: a fraction in [0,1] and
+/* A progress bar on stderr (see vw_progress_begin): a fraction in [0,1] and
    a short note (e.g. "2.1 Mrays/s"); redrawn at most ten times a second. Safe to call
    from one thread at a time. */
 typedef struct vw_progress {
@@ -84,7 +84,11 @@ typedef struct vw_progress {
     int enabled;
     double start, last;
 } vw_progress;
-void vw_progress_begin(vw_progress *p, const char *label, int quiet);
+/* show: VW_PROGRESS_OFF (--quiet, or not the output process), VW_PROGRESS_AUTO (a bar when
+   stderr is a terminal) or VW_PROGRESS_ON (--progress: also into a pipe, as under mpirun,
+   whose launcher forwards the output process's stderr through one). */
+enum { VW_PROGRESS_OFF = -1, VW_PROGRESS_AUTO = 0, VW_PROGRESS_ON = 1 };
+void vw_progress_begin(vw_progress *p, const char *label, int show);
 void vw_progress_update(vw_progress *p, double fraction, const char *note);
 void vw_progress_end(vw_progress *p);
 

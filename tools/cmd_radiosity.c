@@ -61,6 +61,7 @@ static void help(void)
            "                       --patch-size, --elements, --hemicube, --subdivide, --max-level\n"
            "                       and --neighbourhood as the run that wrote it (--sf may change)\n"
            "  --max-rounds N       stop after N rounds without writing outputs (tests: a kill)\n"
+           "  --progress           the progress bar even when stderr is no terminal (mpirun)\n"
            "  --quiet              no progress bar and no summary\n"
            "  --help               this text\n"
            "\nexit status: 0 success, 2 bad input or usage, 1 any other failure\n",
@@ -207,6 +208,7 @@ int vw_cmd_radiosity(int argc, char **argv)
 {
     rad_options o;
     rad_options_init(&o);
+    int progress = 0; /* --progress */
     run_ctx r;
     memset(&r, 0, sizeof r);
     const char *scene_path = NULL, *view = NULL, *trace = NULL;
@@ -221,6 +223,8 @@ int vw_cmd_radiosity(int argc, char **argv)
             return VW_EXIT_OK;
         } else if (!strcmp(a, "--quiet")) {
             o.quiet = 1;
+        } else if (!strcmp(a, "--progress")) {
+            progress = 1;
         } else if (!strcmp(a, "-o")) {
             OUTPUT();
             r.out = v;
@@ -446,7 +450,10 @@ int vw_cmd_radiosity(int argc, char **argv)
     r.t_start = r.t_state = t3;
     r.traced_shots = -1;
     rad_solver_on_round(s, on_round, &r);
-    vw_progress_begin(&r.bar, "radiosity", o.quiet || !vw_world_is_output(rad_solver_world(s)));
+    vw_progress_begin(&r.bar, "radiosity",
+                      o.quiet || !vw_world_is_output(rad_solver_world(s)) ? VW_PROGRESS_OFF
+                      : progress ? VW_PROGRESS_ON
+                                 : VW_PROGRESS_AUTO);
     int converged = 0;
     st = rad_solver_run(s, on_progress, &r, &converged, err, sizeof err);
     vw_progress_end(&r.bar);

@@ -69,6 +69,7 @@ static void help(void)
            "  --overlay-by B   load (default): each cell by its measured load; worker: each\n"
            "                   pixel by the worker that made its eye ray (farmed cells show\n"
            "                   their copies' turns)\n"
+           "  --progress       the progress bar even when stderr is no terminal (mpirun)\n"
            "  --quiet          no progress bar and no summary\n"
            "  --help           this text\n"
            "Runs under mpirun too; only the first process writes files.\n"
@@ -170,7 +171,7 @@ int vw_cli_farm_resolve(int farm, int planned)
 int vw_cmd_render(int argc, char **argv)
 {
     const char *scene_path = NULL, *out = NULL, *stats = NULL, *overlay = NULL;
-    int dims[3] = {1, 1, 1}, width = 0, height = 0, quiet = 0;
+    int dims[3] = {1, 1, 1}, width = 0, height = 0, quiet = 0, progress = 0;
     long workers = 0, depth = 5;
     double from[3], at[3], up[3], angle = 0;
     int has_from = 0, has_at = 0, has_up = 0, has_angle = 0;
@@ -192,6 +193,8 @@ int vw_cmd_render(int argc, char **argv)
             return VW_EXIT_OK;
         } else if (!strcmp(a, "--quiet") || !strcmp(a, "-q")) {
             quiet = 1;
+        } else if (!strcmp(a, "--progress")) {
+            progress = 1;
         } else if (!strcmp(a, "-o") || !strcmp(a, "--output")) {
             if (!(out = vw_cli_output(CMD, argc, argv, &i))) return VW_EXIT_USAGE;
         } else if (!strcmp(a, "--cells")) {
@@ -500,7 +503,10 @@ int vw_cmd_render(int argc, char **argv)
     pc.job = job;
     pc.t0 = t_run0;
     atomic_init(&pc.stop, 0);
-    vw_progress_begin(&pc.bar, "render", quiet || !rt_job_is_output(job));
+    vw_progress_begin(&pc.bar, "render",
+                      quiet || !rt_job_is_output(job) ? VW_PROGRESS_OFF
+                      : progress                      ? VW_PROGRESS_ON
+                                                      : VW_PROGRESS_AUTO);
     pthread_t th;
     int have_thread = pc.bar.enabled && pthread_create(&th, NULL, progress_main, &pc) == 0;
     st = rt_job_run(job, err, sizeof err);

@@ -57,4 +57,21 @@ foreach(case "2;2x2x2;1;none" "2;4x1x2;2;none" "3;2x2;1;none" "2;1;1;idle" "3;1;
     endif()
   endif()
 endforeach()
+# The progress bar: rank 0's stderr reaches mpirun through a pipe, so it shows only when
+# asked for (--progress), and then once, from rank 0.
+foreach(ask "" "--progress")
+  execute_process(COMMAND ${MPIRUN} ${NPFLAG} 2 ${pre} ${VWALLS} render ${SCENE}
+                          -o ${WORK}/progress.png --size 80x60 ${ask}
+                  RESULT_VARIABLE rc OUTPUT_QUIET ERROR_VARIABLE err TIMEOUT 60)
+  if(NOT rc EQUAL 0)
+    message(FATAL_ERROR "mpirun -np 2 render ${ask}: exit ${rc}: ${err}")
+  endif()
+  string(REGEX MATCHALL "render \\[" bars "${err}")
+  list(LENGTH bars nbars)
+  if(ask AND nbars EQUAL 0)
+    message(FATAL_ERROR "--progress under mpirun: no progress bar on stderr: ${err}")
+  elseif(NOT ask AND nbars GREATER 0)
+    message(FATAL_ERROR "a progress bar into a pipe, unasked: ${err}")
+  endif()
+endforeach()
 message(STATUS "raytrace_mpi: identical to the threads engine")

@@ -78,11 +78,14 @@ static void help(void)
 
 
 /* The progress bar: a small thread polls the output handler's atomic counter, so the
-   workers never wait for the terminal. */
+   workers never wait for the terminal. It sleeps on a condition, so that the end of the
+   render wakes it at once instead of after its tenth of a second. */
 typedef struct progress_ctx {
     rt_job *job;
     vw_progress bar;
-    atomic_int stop;
+    pthread_mutex_t lock;
+    pthread_cond_t wake;
+    int stop; /* under lock */
     double t0;
 } progress_ctx;
 
@@ -90,17 +93,24 @@ static void *progress_main(void *arg)
 {
     progress_ctx *p = arg;
     int64_t total = rt_job_primary_pixels(p->job);
-    while (!atomic_load(&p->stop)) {
-        struct timespec ts = {0, 100 * 1000 * 1000};
-        nanosleep(&ts, NULL);
-        int64_t done, rays;
+    for (;;) {
+        struct timespec until;
+        clock_gettime(CLOCK_REALTIME, &until);
+        until.tv_nsec += 100 * 1000 * 1000;
+        if (until.tv_nsec >= 1000000000L) until.tv_sec++, until.tv_nsec -= 1000000000L;
+        pthread_mutex_lock(&p->lock);
+        while (!p->stop && pthread_cond_timedwait(&p->wake, &p->lock, &until) == 0) {
+        }
+        int stop = p->stop;
+        pthread_mutex_unlock(&p->lock);
+        int64_t done, rays; /* and at the end the final state, 100 % */
         rt_job_progress(p->job, &done, &rays);
         double el = vw_cli_now() - p->t0;
         char note[64];
         snprintf(note, sizeof note, "%.2f Mrays/s", el > 0 ? rays / el * 1e-6 : 0.0);
         vw_progress_update(&p->bar, total > 0 ? (double)done / (double)total : 1.0, note);
+        if (stop) return NULL;
     }
-    return NULL;
 }
 
 /* ---- balancing: a sparse pre-pass, the balancer, then the full render ----------------- */
@@ -502,7 +512,8 @@ int vw_cmd_render(int argc, char **argv)
     memset(&pc, 0, sizeof pc);
     pc.job = job;
     pc.t0 = t_run0;
-    atomic_init(&pc.stop, 0);
+    pthread_mutex_init(&pc.lock, NULL);
+    pthread_cond_init(&pc.wake, NULL);
     vw_progress_begin(&pc.bar, "render",
                       quiet || !rt_job_is_output(job) ? VW_PROGRESS_OFF
                       : progress                      ? VW_PROGRESS_ON
@@ -511,9 +522,14 @@ int vw_cmd_render(int argc, char **argv)
     int have_thread = pc.bar.enabled && pthread_create(&th, NULL, progress_main, &pc) == 0;
     st = rt_job_run(job, err, sizeof err);
     if (have_thread) {
-        atomic_store(&pc.stop, 1);
+        pthread_mutex_lock(&pc.lock);
+        pc.stop = 1;
+        pthread_cond_signal(&pc.wake);
+        pthread_mutex_unlock(&pc.lock);
         pthread_join(th, NULL);
     }
+    pthread_cond_destroy(&pc.wake);
+    pthread_mutex_destroy(&pc.lock);
     vw_progress_end(&pc.bar);
     double t_run1 = vw_cli_now();
     if (st != VW_OK) {

@@ -103,8 +103,9 @@ endif()
 
 # A step of a world's life that fails on one rank only (a bad speed at create, out of
 # memory adding objects, an unknown object, a bad copy or mapping, cell_build failing on
-# that rank's cells at commit or in run's commit): every rank fails that step with the
-# failing rank's message and exits, none waits for the others.
+# that rank's cells at commit or in run's commit, named: "rank 1: building cell 2 failed"):
+# every rank fails that step with the failing rank's message and exits, none waits for
+# the others.
 foreach(step create add update replicas redecompose commit run)
   add_test(NAME mpi_local_fail_${step}
            COMMAND sh ${PROJECT_SOURCE_DIR}/tests/mpi/local_fail.sh ${step} 3 $<TARGET_FILE:test_mpi_storm>

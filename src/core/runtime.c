@@ -806,14 +806,16 @@ static void build_job(vw__worker *wk)
             vw__replica *rp = &c->reps[r - 1];
             if (rp->built && rp->built_version == c->version) continue;
             wk->build_status = vw__world_build_replica(wk->w, wk->cells[i], r, wk);
-            continue;
+        } else {
+            if (c->built && !c->dirty) continue;
+            wk->build_status = vw__world_build_cell(wk->w, wk->cells[i], wk);
         }
-        if (c->built && !c->dirty) continue;
-        wk->build_status = vw__world_build_cell(wk->w, wk->cells[i], wk);
+        wk->build_cell = wk->cells[i];
+        wk->build_rep = r;
     }
 }
 
-vw_status vw__runtime_build(vw_world *w)
+vw_status vw__runtime_build(vw_world *w, int *cell, int *rep)
 {
     /* Each worker builds its own cells, on its own thread (or all here if threads
        cannot be started). */
@@ -823,9 +825,21 @@ vw_status vw__runtime_build(vw_world *w)
     } else {
         for (int i = 0; i < w->nworkers; i++) build_job(&w->workers[i]);
     }
-    for (int i = 0; i < w->nworkers; i++)
-        if (w->workers[i].build_status != VW_OK) return w->workers[i].build_status;
-    return VW_OK;
+    /* Units are listed by cell, then copy (assign_units), so each worker's failure is
+       its lowest failing unit, and the lowest of those is the lowest of all: the same
+       unit is named whichever worker got there first. */
+    const vw__worker *first = NULL;
+    for (int i = 0; i < w->nworkers; i++) {
+        const vw__worker *wk = &w->workers[i];
+        if (wk->build_status == VW_OK) continue;
+        if (!first || wk->build_cell < first->build_cell ||
+            (wk->build_cell == first->build_cell && wk->build_rep < first->build_rep))
+            first = wk;
+    }
+    if (!first) return VW_OK;
+    *cell = first->build_cell;
+    *rep = first->build_rep;
+    return first->build_status;
 }
 
 /* Builds copy rep of a cell (0: the master) from the cell's objects, in the order they

@@ -545,11 +545,17 @@ vw_status vw_world_commit(vw_world *w)
                                    "differ): every process must run the same command on the same "
                                    "input", r);
     }
-    vw_status st = vw__runtime_build(w);
+    int cell = -1, rep = 0;
+    vw_status st = vw__runtime_build(w, &cell, &rep);
     char msg[512] = "";
-    if (st != VW_OK) snprintf(msg, sizeof msg, "building cells failed: %s", vw_status_message(st));
+    if (st != VW_OK && rep)
+        snprintf(msg, sizeof msg, "building copy %d of cell %d failed: %s", rep, cell,
+                 vw_status_message(st));
+    else if (st != VW_OK)
+        snprintf(msg, sizeof msg, "building cell %d failed: %s", cell, vw_status_message(st));
     /* Under MPI every process builds only its own cells; they agree before anyone runs,
-       so a cell that fails on one process fails the commit everywhere, naming it. */
+       so a cell that fails on one process fails the commit everywhere, naming the cell
+       and (vw_world_agree's "rank R: ") the lowest failing process. */
     if (w->transport) st = vw_world_agree(w, st, msg, sizeof msg);
     if (st != VW_OK) return vw__world_error(w, st, "%s", msg);
     w->committed = 1;

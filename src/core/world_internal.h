@@ -150,6 +150,7 @@ typedef struct vw__worker {
     uint64_t tr_self_msgs, tr_self_bytes;
     uint64_t *tr_proc;
     vw_status build_status;
+    int build_cell, build_rep; /* the unit whose build failed (build_status not VW_OK) */
 } vw__worker;
 
 /* Per-worker figures of all processes (index: global worker), gathered after each run
@@ -245,7 +246,11 @@ int vw__replica_total(const vw_world *w);
 vw_status vw__runtime_run(vw_world *w);
 /* Ends and joins the worker threads (before the world is freed). */
 void vw__runtime_stop(vw_world *w);
-vw_status vw__runtime_build(vw_world *w);
+/* Builds every unit (cell or copy) of this process that needs it. On failure *cell and
+   *rep name the failing unit (rep 0: the master): the lowest (cell, then copy) of the
+   units that failed, whatever the thread timing, as a worker stops at its first
+   failure and builds its units in that order. */
+vw_status vw__runtime_build(vw_world *w, int *cell, int *rep);
 vw__packet *vw__packet_new(int dest, int src, size_t cap);
 void vw__deliver(vw_world *w, vw__worker *from, vw__packet *p);
 /* Queues a packet for a worker of this process, counting it in w->active; rng (may be

@@ -13,7 +13,8 @@
  *              pointers to the old cells' figures and charged them the time since the
  *              clock's epoch);
  *   build-fail  a cell_build that fails (module.h: it frees what it made; what it left
- *              in *state is not the runtime's): the commit fails, cell_free is never
+ *              in *state is not the runtime's): the commit fails naming the lowest
+ *              failing cell, or copy of a cell, whichever worker failed first; cell_free is never
  *              given a failed build's state, a later commit builds the failed cells (and
  *              only those) again, and every state built is freed once (run it under
  *              -DVW_ASAN=ON: LeakSanitizer and double frees);
@@ -297,7 +298,8 @@ static int test_thread_fail(void)
 
 /* ---- build-fail ---- */
 
-static int fail_mask;                 /* cells whose cell_build fails */
+static int fail_mask;                 /* cells whose cell_build fails (their masters) */
+static int fail_copy = -1;            /* ... and the copies of this cell (-1: none) */
 static atomic_int built_ok, freed, built_calls;
 static char stale;                    /* what a failed build leaves in *state */
 
@@ -309,7 +311,8 @@ static vw_status build_or_fail(vw_ctx *ctx, const void *objs, size_t n, void **s
     if (!c) return VW_E_NOMEM;
     *c = vw_ctx_cell(ctx);
     *state = c;
-    if (fail_mask >> vw_ctx_cell(ctx) & 1) {
+    int bad = vw_ctx_replica(ctx) ? vw_ctx_cell(ctx) == fail_copy : fail_mask >> vw_ctx_cell(ctx) & 1;
+    if (bad) {
         /* The build cleans up after itself, as every module in the tree does, and leaves
            something that is no state behind: the runtime must not keep or free it. */
         free(c);
@@ -351,6 +354,9 @@ static int test_build_fail(void)
         CHECK_EQ_INT(vw_world_create(&m, &sh, d, &cfg, &w), VW_OK);
         fail_mask = 1 << 1 | 1 << 3;
         CHECK_EQ_INT(vw_world_commit(w), VW_E_INPUT);
+        /* The message names the lowest failing cell, whichever worker failed first. */
+        EXPECT(strstr(vw_world_errmsg(w), "building cell 1 failed: bad input") != NULL,
+               "%d workers: commit failed with '%s'", workers, vw_world_errmsg(w));
         CHECK_EQ_INT(vw_world_run(w), VW_E_INPUT); /* run commits first: fails the same */
         fail_mask = 0;
         int calls = atomic_load(&built_calls), ok = atomic_load(&built_ok);
@@ -363,6 +369,41 @@ static int test_build_fail(void)
         CHECK_EQ_INT(atomic_load(&freed), 0);
         vw_world_free(w);
         CHECK_EQ_INT(atomic_load(&freed), 4); /* every state built, once */
+        vw_decomp_free(d);
+    }
+    /* A copy that fails is named as the copy it is, not as its cell (whose master built):
+       cells 0 and 2 get a copy each on the other worker, and cell 2's fails. The world's
+       first error is kept, so each case is a world of its own. (Copies need a kind
+       that any copy may handle.) */
+    vw_msg_kind indep[NKINDS];
+    memcpy(indep, kinds, sizeof indep);
+    indep[MSG_PING].flags = VW_MSG_INDEPENDENT;
+    m.kinds = indep;
+    for (int failing = 0; failing <= 1; failing++) {
+        vw_box box = {{0, 0, 0}, {1, 1, 1}};
+        int dims[3] = {4, 1, 1};
+        vw_decomp *d;
+        CHECK_EQ_INT(vw_decomp_create_grid(&box, dims, &d), VW_OK);
+        vw_config cfg;
+        vw_config_init(&cfg);
+        cfg.workers = 2;
+        shared sh = {0};
+        vw_world *w;
+        CHECK_EQ_INT(vw_world_create(&m, &sh, d, &cfg, &w), VW_OK);
+        for (int c = 0; c <= 2; c += 2) {
+            int other = 1 - vw_world_cell_worker(w, c);
+            CHECK_EQ_INT(vw_world_set_replicas(w, c, &other, 1), VW_OK);
+        }
+        fail_mask = failing ? 1 << 3 : 0; /* with a master failing above it too */
+        fail_copy = 2;
+        CHECK_EQ_INT(vw_world_commit(w), VW_E_INPUT);
+        EXPECT(strstr(vw_world_errmsg(w), "building copy 1 of cell 2 failed: bad input") != NULL,
+               "a copy failed (and cell 3: %d): commit failed with '%s'", failing,
+               vw_world_errmsg(w));
+        fail_mask = 0;
+        fail_copy = -1;
+        CHECK_EQ_INT(vw_world_commit(w), VW_OK);
+        vw_world_free(w);
         vw_decomp_free(d);
     }
     TEST_DONE();

@@ -315,8 +315,14 @@ static int local_failure(const char *step, int bad, int workers)
         failed = "run";
         s = vw_world_run(w);
     }
-    char want[32];
+    char want[64];
     snprintf(want, sizeof want, "rank %d: ", bad);
+    /* A build that fails names its cell: the lowest of rank bad's (both its workers
+       fail, the one that fails first need not hold it). */
+    int cell = 0;
+    while (cell < nc && (cell % gw) / workers != bad) cell++;
+    if (!strcmp(step, "commit") || !strcmp(step, "run"))
+        snprintf(want, sizeof want, "rank %d: building cell %d failed: ", bad, cell);
     const char *msg = vw_world_errmsg(w);
     int ok = s != VW_OK && !strcmp(failed, step) && strstr(msg, want) == msg;
     fprintf(stderr, "test_mpi_storm: process %d: %s failed (%s): %s%s\n", rank, failed,

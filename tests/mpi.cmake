@@ -114,6 +114,16 @@ foreach(step create add update replicas redecompose commit run)
                        ENVIRONMENT "${VW_MPI_ENV}" PROCESSORS 2)
 endforeach()
 
+# A run that fails on the output process alone (vwalls radiosity's energy ledger, which
+# rank 0 checks): every rank exits with its status, 1, not 0 on the others.
+foreach(np 2 3)
+  add_test(NAME mpi_rank_status_ledger_np${np}
+           COMMAND sh ${PROJECT_SOURCE_DIR}/tests/mpi/rank_status.sh $<TARGET_FILE:vwalls_tool> ${np}
+                   "${MPIEXEC_EXECUTABLE} ${MPIEXEC_NUMPROC_FLAG} ${np} ${VW_MPI_PREFLAGS}")
+  set_tests_properties(mpi_rank_status_ledger_np${np} PROPERTIES LABELS "mpi" TIMEOUT 90
+                       ENVIRONMENT "${VW_MPI_ENV}" PROCESSORS 2)
+endforeach()
+
 # A peer whose module has a message kind more (another build): the receiver checks every
 # packet from another process and stops the job, naming the sender.
 add_test(NAME mpi_wire_check

@@ -105,8 +105,10 @@ typedef struct vw_balance_params {
     int dims[3];        /* target layout (tensor, rotate, staggered); 0s: the current grid's */
     double min_width;   /* walls keep at least this fraction of the world extent apart
                            (default 1e-3) */
-    int gworkers;       /* divide / duplicate: all workers of the job (0: ncells) */
-    const double *speeds; /* relative worker speeds (gworkers entries) or NULL */
+    int gworkers;       /* divide / duplicate, and rotate with speeds: all workers of the
+                           job (0: ncells) */
+    const double *speeds; /* relative worker speeds (gworkers entries) or NULL; rotate
+                           judges its frames by the lambda of their cells mapped by speed */
     double tolerance;   /* divide / duplicate: stop at lambda <= 1 + tolerance (0.03) */
     int max_extra;      /* divide: at most this many extra cells (0: 4 * gworkers) */
 } vw_balance_params;

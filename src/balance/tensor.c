@@ -10,6 +10,7 @@
  * staggered balancer improve on.
  */
 #include "balance/balance_internal.h"
+#include "vwalls/map.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -103,17 +104,22 @@ static void jacobi3(double A[3][3], double V[3][3], double ev[3])
     for (int i = 0; i < 3; i++) ev[i] = A[i][i];
 }
 
-/* max / mean of the field's loads on d's cells (one cell per worker). */
-static double cells_lambda(const vw_load_field *f, const vw_decomp *d, double *ld)
+/* The predicted lambda of the field's loads on d's cells, by the one definition
+   (vw__lambda, through vw_balance_imbalance). Without worker speeds, one cell per
+   worker: max / mean of the cells' loads. With speeds, the cells mapped onto the
+   p->gworkers workers by speed, longest first (as divide maps its cells), each worker's
+   time its load over its speed: max / mean of the cells told nothing there, and chose a
+   frame of even cells that the fast workers finish early over one whose uneven cells
+   match the speeds. ld and map hold VW_MAX_CELLS entries. */
+static double cells_lambda(const vw_load_field *f, const vw_decomp *d,
+                           const vw_balance_params *p, double *ld, int *map)
 {
     int nc = vw_decomp_cell_count(d);
     vw_load_field_cell_loads(f, d, ld);
-    double max = 0, sum = 0;
-    for (int c = 0; c < nc; c++) {
-        sum += ld[c];
-        if (ld[c] > max) max = ld[c];
-    }
-    return sum > 0 ? max / (sum / nc) : 1.0;
+    if (!p->speeds) return vw_balance_imbalance(ld, NULL, nc, nc, NULL);
+    int gw = p->gworkers > 0 ? p->gworkers : nc;
+    if (vw_map_greedy(d, ld, gw, p->speeds, 0.0, map) != VW_OK) return INFINITY;
+    return vw_balance_imbalance(ld, map, nc, gw, p->speeds);
 }
 
 vw_status vw__balance_rotate(const vw_decomp *cur, const vw_load_field *f,
@@ -189,17 +195,19 @@ vw_status vw__balance_rotate(const vw_decomp *cur, const vw_load_field *f,
        the axis with most cells first), turned about the principal axis in steps of 15
        degrees (when the load is round about its axis the fit fixes no second axis),
        and the unrotated frame. The one whose tensor walls give the lowest predicted
-       max/mean cell load wins, so rotation never predicts worse than tensor. */
+       lambda (cells_lambda) wins, so rotation never predicts worse than tensor. */
     double best_lam = INFINITY;
     vw_decomp *best = NULL;
     vw_status st = vw__balance_tensor(cur, f, p, dims, &best);
     if (st != VW_OK) return st;
     double *ld = malloc(sizeof(double) * VW_MAX_CELLS);
-    if (!ld) {
+    int *map = malloc(sizeof(int) * VW_MAX_CELLS);
+    if (!ld || !map) {
+        free(ld), free(map);
         vw_decomp_free(best);
         return VW_E_NOMEM;
     }
-    best_lam = cells_lambda(f, best, ld);
+    best_lam = cells_lambda(f, best, p, ld, map);
     double P[8][3];
     world_corners(cur, P);
     for (int perm = 0; perm < 6 && st == VW_OK; perm++) {
@@ -232,7 +240,7 @@ vw_status vw__balance_rotate(const vw_decomp *cur, const vw_load_field *f,
             vw_decomp *d = NULL;
             st = tensor_in_frame(f, F, &wb, dims, p->min_width, &d);
             if (st != VW_OK) break;
-            double lam = cells_lambda(f, d, ld);
+            double lam = cells_lambda(f, d, p, ld, map);
             if (lam < best_lam - 1e-9) {
                 vw_decomp_free(best);
                 best = d;
@@ -242,7 +250,7 @@ vw_status vw__balance_rotate(const vw_decomp *cur, const vw_load_field *f,
             }
         }
     }
-    free(ld);
+    free(ld), free(map);
     if (st != VW_OK) {
         vw_decomp_free(best);
         return st;

@@ -9,7 +9,8 @@
  *                         50%-clustered 1000-sphere scene with 8 cells
  *   divide16              divide (with its extra rounds) reaches lambda <= 1.06 on the
  *                         counted work of a 100%-clustered 1000-sphere scene, 16 cells
- *   rotate                the principal-axis frame of an oblique line of load is the line
+ *   rotate                the principal-axis frame of an oblique line of load is the line;
+ *                         with unequal worker speeds, the frame of lowest lambda by speed
  *   map                   every cell mapped once; block keeps a hand layout's neighbour
  *                         share; weighted gives speeds 1,1,2,4 proportional load; bad
  *                         speeds and speed lists refused; lambda never NaN
@@ -431,6 +432,46 @@ static int t_rotate(void)
         double lamr = vw_balance_imbalance(lr, ident, 4, 4, NULL);
         printf("rotate: 2x2x1 on an oblique line: tensor %.3f, rotate %.3f\n", lamt, lamr);
         EXPECT(lamr <= 1.10 && lamt >= 1.5, "rotate %.3f vs tensor %.3f", lamr, lamt);
+    }
+    vw_decomp_free(t);
+    vw_decomp_free(r);
+    vw_decomp_free(d);
+    vw_load_field_free(f);
+
+    /* Unequal workers (speeds 1 and 3, two cells): the frames are judged by lambda with
+       the speeds (vw__lambda), not by max / mean of the cells. Three masses, 1, 2 and 1,
+       at z = 0.5: the unrotated walls cut 1 | 3, which the fast worker's share fits
+       (lambda 1); a frame along y cuts 2 | 2, max / mean 1, so rotate chose it, and
+       then the fast worker takes both cells while the slow one idles (lambda 4/3). */
+    vw_load_field_create(&f);
+    const double masses[3][4] = {{0.2, 0.2, 0.5, 1}, {0.5, 0.8, 0.5, 2}, {0.8, 0.3, 0.5, 1}};
+    for (int i = 0; i < 3; i++) vw_load_field_add_point(f, masses[i], masses[i][3]);
+    int dims2[3] = {2, 1, 1};
+    vw_decomp_create_grid(&world, dims2, &d);
+    double speeds[2] = {1, 3};
+    vw_balance_params_init(&p);
+    p.gworkers = 2;
+    p.speeds = speeds;
+    p.strategy = VW_BALANCE_TENSOR;
+    t = r = NULL;
+    EXPECT(vw_balance_decompose(d, f, &p, &t, NULL) == VW_OK, "tensor with speeds");
+    p.strategy = VW_BALANCE_ROTATE;
+    EXPECT(vw_balance_decompose(d, f, &p, &r, NULL) == VW_OK, "rotate with speeds");
+    if (t && r) {
+        /* Each plan's lambda as the balancer predicts it: cells mapped by speed. */
+        double lamt = 0, lamr = 0;
+        for (int k = 0; k < 2; k++) {
+            const vw_decomp *x = k ? r : t;
+            double ld[2];
+            int cw[2];
+            vw_load_field_cell_loads(f, x, ld);
+            CHECK_EQ_INT(vw_map_greedy(x, ld, 2, speeds, 0.0, cw), VW_OK);
+            *(k ? &lamr : &lamt) = vw_balance_imbalance(ld, cw, 2, 2, speeds);
+        }
+        printf("rotate: speeds 1,3, masses 1, 2, 1: tensor %.3f, rotate %.3f\n", lamt, lamr);
+        EXPECT(lamr <= lamt + 1e-9, "rotate %.4f predicts worse than tensor %.4f with speeds",
+               lamr, lamt);
+        EXPECT(fabs(lamr - 1.0) < 1e-9, "rotate with speeds 1,3: lambda %.4f, want 1", lamr);
     }
     vw_decomp_free(t);
     vw_decomp_free(r);

@@ -294,9 +294,15 @@ vw_status rt_job_balance(rt_job *j, const rt_balance *b, rt_balance_result *bi, 
             break;
         }
         if (b->strategy == VW_BALANCE_NONE) {
-            /* Mapping only: greedy / weighted by the measured loads. */
+            /* Mapping only: greedy / weighted by the measured loads. The cells were
+               built for the pre-pass, so what the remap moves counts (the world's
+               count, which the stats JSON's "balance" member shows). */
+            uint64_t moved = vw_world_migrated(w);
             st = rt_job_map(j, b->map, load, b->speeds, err, errlen);
             if (st == VW_OK) {
+                moved = vw_world_migrated(w) - moved;
+                bi->migrated += moved;
+                bi->bytes += moved * sizeof(rt_object);
                 /* (the remap replaced the decomposition: d is gone; the walls are
                    the same, so load still has a figure per cell) */
                 int nc = vw_decomp_cell_count(vw_world_decomp(w));

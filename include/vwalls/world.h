@@ -164,6 +164,11 @@ VW_API double vw_world_time(const vw_world *w, const char *phase);
 /* What the balancer did, for the stats JSON "balance" member. */
 VW_API void vw_world_set_balance_info(vw_world *w, const char *strategy, double imbalance_before,
                                       double imbalance_after, uint64_t migrated_objects);
+/* The stats JSON's balance.migrated_objects: the (object, worker) pairs that new
+   decompositions and mappings (vw_world_redecompose, vw_world_remap) made since the world
+   was created, none before its cells were first built; or the count last given to
+   vw_world_set_balance_info, and those made since. The same on every process. */
+VW_API uint64_t vw_world_migrated(const vw_world *w);
 
 /* The stats JSON (docs/runtime.md, Statistics), written by the output process only,
    through vw_outfile (vwalls/outfile.h: complete or absent). extra_json: more

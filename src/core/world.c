@@ -1018,6 +1018,8 @@ void vw_world_set_balance_info(vw_world *w, const char *strategy, double before,
     w->migrated = migrated;
 }
 
+uint64_t vw_world_migrated(const vw_world *w) { return w ? w->migrated : 0; }
+
 /* ---- without MPI: the engine is this one process ------------------------------------ */
 
 #if !VW_HAVE_MPI

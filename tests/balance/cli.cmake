@@ -74,6 +74,16 @@ string(JSON predicted GET "${json}" balance_detail imbalance_predicted)
 if(NOT rc EQUAL 0 OR NOT out MATCHES "lambda before [1-9]" OR before LESS 1 OR predicted LESS 1)
   message(FATAL_ERROR "--map weighted: exit ${rc}, before ${before}, predicted ${predicted}: ${out}${err}")
 endif()
+# ... and the objects its remap moved, as the world counted them ("balance"): the detail
+# said 0 (only the balancers' rounds were counted), here where the remap moves some.
+string(JSON moved GET "${json}" balance_detail migrated_objects)
+string(JSON moved_world GET "${json}" balance migrated_objects)
+string(JSON moved_bytes GET "${json}" balance_detail bytes_moved)
+if(moved_world LESS 1 OR NOT moved EQUAL moved_world OR moved_bytes LESS moved
+   OR NOT out MATCHES " ${moved} objects migrated")
+  message(FATAL_ERROR "--map weighted: balance_detail.migrated_objects ${moved} (${moved_bytes} "
+          "bytes), balance.migrated_objects ${moved_world}: ${out}")
+endif()
 # lambda before a balance is the one the mapping alone measures on the same layout (one
 # definition, vw_balance_imbalance's): with every cell on the fast worker of 1,1000 the
 # balancers' own 'before' said 2 (max / mean), the measurement 1.001.

@@ -9,6 +9,8 @@ set(VW_RT_MIXED ${PROJECT_SOURCE_DIR}/tests/raytrace/mixed.nff)
 
 add_test(NAME raytrace_cone COMMAND vw_test_raytrace cone)
 add_test(NAME raytrace_analytic COMMAND vw_test_raytrace analytic)
+# The eye rays span the NFF angle, up to the reader's limit of 180 degrees.
+add_test(NAME raytrace_view COMMAND vw_test_raytrace view)
 # The same scene 1e4 times its size from the origin: a shadow ray must start clear of its
 # own surface by more than Embree's float error there (eps, rt_job_create).
 add_test(NAME raytrace_analytic_far COMMAND vw_test_raytrace analytic 1e4)

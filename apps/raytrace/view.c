@@ -41,7 +41,9 @@ void rt_view_init(rt_view *v, const vw_camera *cam, int width, int height)
     normalize(v->right);
     cross(v->right, v->fwd, v->up);
     normalize(v->up);
-    double angle = cam->angle > 0 && cam->angle < 179 ? cam->angle : 45.0;
+    /* Every angle the NFF reader accepts, 0 to 180 exclusive, is used as given; 45
+       degrees only for a camera that has none (a zeroed vw_camera). */
+    double angle = cam->angle > 0 && cam->angle < 180 ? cam->angle : 45.0;
     v->tan_half = tan(angle * 0.5 * 3.14159265358979323846 / 180.0);
     v->width = width;
     v->height = height;

@@ -7,6 +7,8 @@
  *   cone                  the cone/cylinder intersection against sampled points
  *   watertight            rays aimed at a mesh's shared edges and vertices hit it
  *   concave SCENE         each polygon's triangle records cover it and nothing else
+ *   view                  the eye rays span the angle an NFF 'v' block gives, all of
+ *                         the range the reader accepts (0..180 degrees)
  *   write SCENE WxH LAYOUT WORKERS OUT.png   (a helper for looking at pictures)
  *   nff SCENE             the scene as NFF on stdout (gen:balls:4 for the benchmark)
  */
@@ -335,6 +337,34 @@ static int test_analytic(double off)
     return vw_test_failures ? 1 : 0;
 }
 
+/* The field of view is the angle the file gives, for every angle the NFF reader
+   accepts: angles from 179 on were once replaced by 45 degrees without a word. */
+static int test_view(void)
+{
+    static const double angles[] = {0.5, 30, 45, 90, 170, 178.9, 179, 179.5, 179.99};
+    for (size_t i = 0; i < sizeof angles / sizeof angles[0]; i++) {
+        char nff[256], err[256];
+        int len = snprintf(nff, sizeof nff, "v from 0 0 10 at 0 0 0 up 0 1 0 angle %.17g\n",
+                           angles[i]);
+        vw_scene *s;
+        CHECK(vw_scene_read_nff("view.nff", nff, (size_t)len, &s, err, sizeof err) == VW_OK);
+        rt_view v;
+        rt_view_init(&v, &s->camera, 2, 2);
+        double th = tan(angles[i] * 0.5 * 3.14159265358979323846 / 180.0);
+        EXPECT(fabs(v.tan_half - th) <= 1e-12 * th, "angle %g: tan_half %.17g, expected %.17g",
+               angles[i], v.tan_half, th);
+        /* The ray through the centre of the top left pixel of a 2x2 image lies half the
+           way to the edges: at (-th/2, th/2) on the screen one unit ahead. */
+        double d[3];
+        rt_view_ray(&v, 0, 0, d);
+        EXPECT(fabs(-d[1] / d[2] - 0.5 * th) <= 1e-9 * th && fabs(d[0] / d[2] - 0.5 * th) <= 1e-9 * th,
+               "angle %g: ray %g %g %g", angles[i], d[0], d[1], d[2]);
+        vw_scene_free(s);
+    }
+    printf("view: %zu angles\n", sizeof angles / sizeof angles[0]);
+    return vw_test_failures ? 1 : 0;
+}
+
 /* Rays aimed at points sampled on a cone's side must hit it there, from outside. */
 static int test_cone(void)
 {
@@ -531,6 +561,7 @@ int main(int argc, char **argv)
     if (argc >= 3 && !strcmp(argv[1], "identical")) return test_identical(argv[2], argc > 3 ? argv[3] : NULL);
     if (argc >= 2 && !strcmp(argv[1], "analytic")) return test_analytic(argc > 2 ? atof(argv[2]) : 0);
     if (argc >= 2 && !strcmp(argv[1], "cone")) return test_cone();
+    if (argc >= 2 && !strcmp(argv[1], "view")) return test_view();
     if (argc >= 2 && !strcmp(argv[1], "watertight")) return test_watertight();
     if (argc >= 3 && !strcmp(argv[1], "concave")) return test_concave(argv[2]);
     if (argc >= 2 && !strcmp(argv[1], "write")) return write_png(argc, argv);

@@ -171,8 +171,10 @@ static vw_status read_num(nff *P, double *out)
     if (r < 0)
         return fail(P, t.line, "NaN or infinite number '%s' in '%s'", show(&t, sb),
                     P->entity);
+    /* A keyword: the entity ran short, and the line to name is the entity's own, not
+       that of the next entity (a good one) whose keyword was read. */
     if (is_keyword(&t))
-        return fail(P, t.line, "wrong number of values for '%s'", P->entity);
+        return fail(P, P->entity_line, "wrong number of values for '%s'", P->entity);
     return fail(P, t.line, "bad number '%s' in '%s'", show(&t, sb), P->entity);
 }
 
@@ -217,7 +219,7 @@ static vw_status read_int(nff *P, const char *what, long lo, long hi, int *out)
     long long vv;
     if (!vw__parse_int(t.s, t.n, 11, &vv)) {
         if (is_keyword(&t))
-            return fail(P, t.line, "wrong number of values for '%s'", P->entity);
+            return fail(P, P->entity_line, "wrong number of values for '%s'", P->entity);
         return fail(P, t.line, "bad %s '%s' in '%s'", what, show(&t, sb), P->entity);
     }
     long v = (long)vv;

@@ -271,7 +271,13 @@ int main(int argc, char **argv)
 
     /* Exact messages and line numbers, also for entities split across lines. */
     expect_error(VIEW "s 0 0\n0\n\n1 foo\n", "t.nff:5: unknown keyword 'foo'");
-    expect_error(VIEW "s 0 0\n0\n\nl 1 1 1\n", "t.nff:5: wrong number of values for 's'");
+    /* An entity that runs short is named by its own line, not by the line of the good
+       entity whose keyword showed it short. */
+    expect_error(VIEW "s 0 0\n0\n\nl 1 1 1\n", "t.nff:2: wrong number of values for 's'");
+    expect_error(VIEW "c\n0 0 0 1\n0 0 1\n\nl 1 1 1\n", "t.nff:2: wrong number of values for 'c'");
+    expect_error(VIEW "p 4\n0 0 0\n1 0 0\n1 1 0\ns 0 0 0 1\n",
+                 "t.nff:2: wrong number of values for 'p'");
+    expect_error(VIEW "l 0 0 5 1 1\n\ns 0 0 0 1\n", "t.nff:2: wrong number of values for 'l'");
     expect_error(VIEW "s 0 0\n0\n\nq\n", "t.nff:5: bad number 'q' in 's'");
     expect_error(VIEW "\n\np 3 0 0 0\n1 0 0\n", "t.nff:4: file ends in the middle of 'p'");
     expect_error(VIEW "p -1\n", "t.nff:2: polygon needs at least 3 vertices");

@@ -509,8 +509,13 @@ static vw_status parse_all(nff *P)
             last = P->entity;
         /* After a 'v' block the last entity read was its last line, e.g. 'resolution'. */
     }
+    /* Named at the file's last line: after a final newline the lexer counts one more,
+       a line no editor shows. */
+    int last_line = P->lx.line;
+    if (last_line > 1 && P->lx.end[-1] == '\n')
+        last_line--;
     if (!P->have_v)
-        return fail(P, P->lx.line, "missing 'v' block (NFF needs a camera)");
+        return fail(P, last_line, "missing 'v' block (NFF needs a camera)");
     /* The classic SPD convention: lights without a colour share a total intensity,
        1/sqrt(number of lights) each. It needs the final count, so it is applied
        after the whole file was read. */

@@ -249,6 +249,17 @@ static vw_status mtl_scalar(obj *O, span *line, const char *key, float *out)
     return VW_OK;
 }
 
+/* Is the statement's first argument the word form? Looks without consuming it (nor
+   counting the lines of continuations it passes). */
+static int mtl_form(obj *O, span line, const char *form)
+{
+    int saved = O->line;
+    span t;
+    int is = next_tok(O, &line, &t) && span_is(t, form);
+    O->line = saved;
+    return is;
+}
+
 static vw_status add_named_material(obj *O, span name)
 {
     if (O->nnames == O->cap_names) {
@@ -345,6 +356,34 @@ static vw_status parse_mtl(obj *O, const char *text, size_t len)
             return fail(O, "'%s' before any 'newmtl'", k);
         vw_status st;
         float v;
+        /* Forms of the MTL specification that vwalls has no use for are valid input, not
+           errors: "Kd spectral file.rfl [factor]" (a spectral curve) and "Kd xyz x [y z]"
+           (CIE XYZ), also for Ks and Ke, leave the colour as it was, and "d -halo f" (a
+           dissolve that grows toward the silhouette) is read as "d f", its value where the
+           surface faces the eye. A warning says so, once per form. */
+        if (k[0] == 'K' && (mtl_form(O, line, "spectral") || mtl_form(O, line, "xyz"))) {
+            const char *form = mtl_form(O, line, "xyz") ? "xyz" : "spectral";
+            char what[16];
+            snprintf(what, sizeof what, "%s %s", k, form);
+            span w = {what, strlen(what)};
+            st = warn_once(O, "form", w, "'%s' (%s) is not supported: the statement is ignored",
+                           what, form[0] == 'x' ? "a CIE XYZ colour" : "a spectral curve");
+            if (st != VW_OK)
+                return fail_status(O, st);
+            continue;
+        }
+        if (!strcmp(k, "d") && mtl_form(O, line, "-halo")) {
+            span halo, w = {"d -halo", 7};
+            next_tok(O, &line, &halo);
+            if ((st = mtl_scalar(O, &line, "d -halo", &v)) != VW_OK)
+                return st;
+            m->transmit = 1.0f - v;
+            st = warn_once(O, "form", w, "'d -halo' (a dissolve that changes with the view) is "
+                           "not supported: it is read as 'd' with its factor");
+            if (st != VW_OK)
+                return fail_status(O, st);
+            continue;
+        }
         if (!strcmp(k, "Kd"))
             st = mtl_color(O, &line, k, m->diffuse);
         else if (!strcmp(k, "Ks"))

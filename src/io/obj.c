@@ -39,6 +39,8 @@ typedef struct obj {
     size_t cap_vn;
     char **mat_names;     /* mat_names[i] names scene material mat_ids[i] */
     int *mat_ids;
+    int *mat_wait;        /* the line of the first usemtl of a name no library has defined
+                             yet (its material waits, 0.8 grey, for a newmtl); 0 once it is */
     size_t nnames, cap_names;
     int cur_mat;          /* -1: the default material, created on first use */
     int default_mat;
@@ -260,7 +262,9 @@ static int mtl_form(obj *O, span line, const char *form)
     return is;
 }
 
-static vw_status add_named_material(obj *O, span name)
+/* A material named name, 0.8 grey until its statements say otherwise; wait_line is
+   the line of a usemtl that names it before any library defined it, else 0. */
+static vw_status add_named_material(obj *O, span name, int wait_line)
 {
     if (O->nnames == O->cap_names) {
         size_t ncap = O->cap_names ? O->cap_names * 2 : 8;
@@ -272,6 +276,10 @@ static vw_status add_named_material(obj *O, span name)
         if (!r)
             return fail_status(O, VW_E_NOMEM);
         O->mat_ids = r;
+        r = realloc(O->mat_wait, ncap * sizeof *r);
+        if (!r)
+            return fail_status(O, VW_E_NOMEM);
+        O->mat_wait = r;
         O->cap_names = ncap;
     }
     char *copy = malloc(name.n + 1);
@@ -290,8 +298,19 @@ static vw_status add_named_material(obj *O, span name)
     }
     O->mat_names[O->nnames] = copy;
     O->mat_ids[O->nnames] = id;
+    O->mat_wait[O->nnames] = wait_line;
     O->nnames++;
     return VW_OK;
+}
+
+/* The newest material called name, or -1: a later library's definition of a name
+   replaces an earlier one for the usemtl statements after it. */
+static long find_named_material(const obj *O, span name)
+{
+    for (size_t i = O->nnames; i-- > 0;)
+        if (strlen(O->mat_names[i]) == name.n && memcmp(O->mat_names[i], name.s, name.n) == 0)
+            return (long)i;
+    return -1;
 }
 
 /* The next statement of [*p, end) (without its final newline) into *line: one line,
@@ -339,7 +358,15 @@ static vw_status parse_mtl(obj *O, const char *text, size_t len)
             span name = rest_of_line(line);
             if (!name.n)
                 return fail(O, "'newmtl' without a name");
-            vw_status st = add_named_material(O, name);
+            /* A name a usemtl gave before any library defined it: the material its
+               faces already use becomes this one. */
+            long i = find_named_material(O, name);
+            if (i >= 0 && O->mat_wait[i]) {
+                O->mat_wait[i] = 0;
+                m = &O->b.s->materials[O->mat_ids[i]];
+                continue;
+            }
+            vw_status st = add_named_material(O, name, 0);
             if (st != VW_OK)
                 return st;
             m = &O->b.s->materials[O->b.s->nmaterials - 1];
@@ -564,22 +591,20 @@ static vw_status parse_obj(obj *O, const char *text, size_t len, const char *dir
                 return st;
         } else if (span_is(key, "usemtl")) {
             span name = rest_of_line(line);
-            O->cur_mat = -1;
-            /* Unknown names fall back to the default material, with a warning (once a
-               name): exporters write usemtl without shipping the library often enough
-               that refusing the mesh would help nobody. Without a directory no
-               library was loaded, on purpose, so no name can be known. */
-            for (size_t i = O->nnames; i-- > 0;)
-                if (strlen(O->mat_names[i]) == name.n &&
-                    memcmp(O->mat_names[i], name.s, name.n) == 0) {
-                    O->cur_mat = O->mat_ids[i];
-                    break;
-                }
-            char sb[48];
-            if (O->cur_mat < 0 && dir &&
-                (st = warn_once(O, "mat", name, "material '%s' is not defined by a material "
-                                "library (the default material is used)", show(name, sb))) != VW_OK)
-                return fail_status(O, st);
+            /* The OBJ specification does not order usemtl after the mtllib that defines
+               its name: a name not defined yet gets a material of its own, 0.8 grey, that
+               a later newmtl of that name fills in. Names still undefined at the end of
+               the file keep the grey, with a warning (once a name, at the line that
+               first used it): exporters write usemtl without shipping the library often
+               enough that refusing the mesh would help nobody. Without a directory no
+               library is loaded, on purpose: every face gets the default material. */
+            long i = find_named_material(O, name);
+            O->cur_mat = i >= 0 ? O->mat_ids[i] : -1;
+            if (i < 0 && dir) {
+                if ((st = add_named_material(O, name, O->line)) != VW_OK)
+                    return st;
+                O->cur_mat = O->mat_ids[O->nnames - 1];
+            }
         } else if (span_is(key, "mtllib")) {
             span fname;
             if (!dir)
@@ -590,6 +615,17 @@ static vw_status parse_obj(obj *O, const char *text, size_t len, const char *dir
         }
         /* o, g, s, l, p and the free-form geometry keys are ignored. */
     }
+    for (size_t i = 0; i < O->nnames; i++)
+        if (O->mat_wait[i]) {
+            char sb[48];
+            span name = {O->mat_names[i], strlen(O->mat_names[i])};
+            O->line = O->mat_wait[i];
+            vw_status st = warn_once(O, "mat", name, "material '%s' is not defined by a "
+                                     "material library (the default material is used)",
+                                     show(name, sb));
+            if (st != VW_OK)
+                return fail_status(O, st);
+        }
     return VW_OK;
 }
 
@@ -626,6 +662,7 @@ VW_API vw_status vw_scene_read_obj(const char *name, const char *text, size_t le
         free(O.warned[i]);
     free(O.warned);
     free(O.mat_ids);
+    free(O.mat_wait);
     free(O.vn);
     if (st != VW_OK) {
         vw__sb_abort(&O.b);

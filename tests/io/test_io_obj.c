@@ -50,8 +50,9 @@ static int matches(const char *text, const char *pattern)
    promise ("# warning: PATTERN", "..." matching anything), in that order. */
 static void warn_corpus(const char *data)
 {
-    const char *names[] = {"obj_missing_mtl.obj", "obj_unknown_usemtl.obj", "mtl_forms.obj"};
-    for (int i = 0; i < 3; i++) {
+    const char *names[] = {"obj_missing_mtl.obj", "obj_unknown_usemtl.obj", "mtl_forms.obj",
+                           "obj_usemtl_first.obj"};
+    for (int i = 0; i < 4; i++) {
         char path[4096], line[1024], want[8][1024], err[512] = "";
         int nwant = 0;
         snprintf(path, sizeof path, "%s/warn/%s", data, names[i]);
@@ -88,7 +89,7 @@ static void warn_corpus(const char *data)
         /* Faces of unknown materials get the default 0.8 grey; known ones their own. */
         for (size_t p = 0; p < s->npolygons; p++) {
             const vw_material *m = &s->materials[s->polygons[p].material];
-            int red = i == 1 && p == 1;
+            int red = (i == 1 && p == 1) || (i == 3 && p < 2);
             CHECK(m->diffuse[0] == 0.8f && m->diffuse[1] == (red ? 0.1f : 0.8f));
         }
         vw_scene_free(s);
@@ -181,8 +182,9 @@ int main(int argc, char **argv)
     CHECK(!strcmp(warnings[1], "m.obj:5: warning: material 'x' is not defined by a material "
                                "library (the default material is used)"));
     CHECK(strstr(warnings[2], "m.obj:10: warning: material 'y' is not") == warnings[2]);
-    CHECK_EQ_INT(n->nmaterials, 1);
-    CHECK(n->materials[0].diffuse[0] == 0.8f);
+    /* Each name has a material of its own, waiting for a newmtl that never came. */
+    CHECK_EQ_INT(n->nmaterials, 2);
+    CHECK(n->materials[0].diffuse[0] == 0.8f && n->materials[1].diffuse[0] == 0.8f);
     vw_scene_free(n);
     nwarnings = 0;
     warn_corpus(argv[1]);

@@ -25,6 +25,16 @@ function(vw_mpi_test name np)
                        ENVIRONMENT "${VW_MPI_ENV};${A_ENV}" PROCESSORS 2)
 endfunction()
 
+# vw_mpi_script_test(NAME NP SCRIPT TIMEOUT args...): sh tests/mpi/SCRIPT args... with the
+# launch command ("mpirun -np NP flags", one word) last; the script starts the job itself.
+function(vw_mpi_script_test name np script timeout)
+  add_test(NAME ${name}
+           COMMAND sh ${PROJECT_SOURCE_DIR}/tests/mpi/${script} ${ARGN}
+                   "${MPIEXEC_EXECUTABLE} ${MPIEXEC_NUMPROC_FLAG} ${np} ${VW_MPI_PREFLAGS}")
+  set_tests_properties(${name} PROPERTIES LABELS "mpi" TIMEOUT ${timeout}
+                       ENVIRONMENT "${VW_MPI_ENV}" PROCESSORS 2)
+endfunction()
+
 foreach(np 1 2 4 8)
   foreach(w 1 2)
     vw_mpi_test(mpi_storm_np${np}_w${w} ${np} COMMAND $<TARGET_FILE:test_mpi_storm> --workers ${w} --seeds 2)
@@ -58,37 +68,21 @@ vw_mpi_test(mpi_agree_np3 3 COMMAND $<TARGET_FILE:test_mpi_storm> --agree)
 # Counters and per-cell messages of the stats JSON equal the threads engine's.
 set(VW_MPI_LAUNCH ${MPIEXEC_EXECUTABLE} ${MPIEXEC_NUMPROC_FLAG})
 foreach(np 2 4)
-  add_test(NAME mpi_pairs_same_stats_np${np}
-           COMMAND sh ${PROJECT_SOURCE_DIR}/tests/mpi/same_stats.sh $<TARGET_FILE:vwalls_tool>
-                   "${MPIEXEC_EXECUTABLE} ${MPIEXEC_NUMPROC_FLAG} ${np} ${VW_MPI_PREFLAGS}")
-  set_tests_properties(mpi_pairs_same_stats_np${np} PROPERTIES LABELS "mpi" TIMEOUT 120
-                       ENVIRONMENT "${VW_MPI_ENV}" PROCESSORS 2)
+  vw_mpi_script_test(mpi_pairs_same_stats_np${np} ${np} same_stats.sh 120 $<TARGET_FILE:vwalls_tool>)
 endforeach()
 
 # Only the first process prints: stdout under mpirun equals the single process's.
-add_test(NAME mpi_print_once
-         COMMAND sh ${PROJECT_SOURCE_DIR}/tests/mpi/print_once.sh $<TARGET_FILE:vwalls_tool>
-                 ${PROJECT_SOURCE_DIR}/tests/data/good/mixed.nff
-                 "${MPIEXEC_EXECUTABLE} ${MPIEXEC_NUMPROC_FLAG} 3 ${VW_MPI_PREFLAGS}")
-set_tests_properties(mpi_print_once PROPERTIES LABELS "mpi" TIMEOUT 120
-                     ENVIRONMENT "${VW_MPI_ENV}" PROCESSORS 2)
+vw_mpi_script_test(mpi_print_once 3 print_once.sh 120
+                   $<TARGET_FILE:vwalls_tool> ${PROJECT_SOURCE_DIR}/tests/data/good/mixed.nff)
 
 # Input only some ranks have (stdin of vwalls edit, a file missing on one host) and
 # outputs only rank 0 writes: no rank is left waiting.
-add_test(NAME mpi_rank_input
-         COMMAND sh ${PROJECT_SOURCE_DIR}/tests/mpi/rank_input.sh $<TARGET_FILE:vwalls_tool>
-                 ${PROJECT_SOURCE_DIR}/tests/data/good/mixed.nff
-                 "${MPIEXEC_EXECUTABLE} ${MPIEXEC_NUMPROC_FLAG} 2 ${VW_MPI_PREFLAGS}")
-set_tests_properties(mpi_rank_input PROPERTIES LABELS "mpi" TIMEOUT 240
-                     ENVIRONMENT "${VW_MPI_ENV}" PROCESSORS 2)
+vw_mpi_script_test(mpi_rank_input 2 rank_input.sh 240
+                   $<TARGET_FILE:vwalls_tool> ${PROJECT_SOURCE_DIR}/tests/data/good/mixed.nff)
 
 # Faults: the job ends within 10 s, non-zero, naming the rank.
 foreach(mode kill exit)
-  add_test(NAME mpi_fault_${mode}
-           COMMAND sh ${PROJECT_SOURCE_DIR}/tests/mpi/fault.sh ${mode} $<TARGET_FILE:test_mpi_storm>
-                   "${MPIEXEC_EXECUTABLE} ${MPIEXEC_NUMPROC_FLAG} 4 ${VW_MPI_PREFLAGS}")
-  set_tests_properties(mpi_fault_${mode} PROPERTIES LABELS "mpi" TIMEOUT 60
-                       ENVIRONMENT "${VW_MPI_ENV}" PROCESSORS 2)
+  vw_mpi_script_test(mpi_fault_${mode} 4 fault.sh 60 ${mode} $<TARGET_FILE:test_mpi_storm>)
 endforeach()
 
 # Two machines: network namespaces joined by a veth pair, TCP only (Open MPI's rsh
@@ -107,27 +101,16 @@ endif()
 # every rank fails that step with the failing rank's message and exits, none waits for
 # the others.
 foreach(step create add update replicas redecompose commit run)
-  add_test(NAME mpi_local_fail_${step}
-           COMMAND sh ${PROJECT_SOURCE_DIR}/tests/mpi/local_fail.sh ${step} 3 $<TARGET_FILE:test_mpi_storm>
-                   "${MPIEXEC_EXECUTABLE} ${MPIEXEC_NUMPROC_FLAG} 3 ${VW_MPI_PREFLAGS}")
-  set_tests_properties(mpi_local_fail_${step} PROPERTIES LABELS "mpi" TIMEOUT 60
-                       ENVIRONMENT "${VW_MPI_ENV}" PROCESSORS 2)
+  vw_mpi_script_test(mpi_local_fail_${step} 3 local_fail.sh 60 ${step} 3 $<TARGET_FILE:test_mpi_storm>)
 endforeach()
 
 # A run that fails on the output process alone (vwalls radiosity's energy ledger, which
 # rank 0 checks): every rank exits with its status, 1, not 0 on the others.
 foreach(np 2 3)
-  add_test(NAME mpi_rank_status_ledger_np${np}
-           COMMAND sh ${PROJECT_SOURCE_DIR}/tests/mpi/rank_status.sh $<TARGET_FILE:vwalls_tool> ${np}
-                   "${MPIEXEC_EXECUTABLE} ${MPIEXEC_NUMPROC_FLAG} ${np} ${VW_MPI_PREFLAGS}")
-  set_tests_properties(mpi_rank_status_ledger_np${np} PROPERTIES LABELS "mpi" TIMEOUT 90
-                       ENVIRONMENT "${VW_MPI_ENV}" PROCESSORS 2)
+  vw_mpi_script_test(mpi_rank_status_ledger_np${np} ${np} rank_status.sh 90
+                     $<TARGET_FILE:vwalls_tool> ${np})
 endforeach()
 
 # A peer whose module has a message kind more (another build): the receiver checks every
 # packet from another process and stops the job, naming the sender.
-add_test(NAME mpi_wire_check
-         COMMAND sh ${PROJECT_SOURCE_DIR}/tests/mpi/wire.sh $<TARGET_FILE:test_mpi_storm>
-                 "${MPIEXEC_EXECUTABLE} ${MPIEXEC_NUMPROC_FLAG} 2 ${VW_MPI_PREFLAGS}")
-set_tests_properties(mpi_wire_check PROPERTIES LABELS "mpi" TIMEOUT 60
-                     ENVIRONMENT "${VW_MPI_ENV}" PROCESSORS 2)
+vw_mpi_script_test(mpi_wire_check 2 wire.sh 60 $<TARGET_FILE:test_mpi_storm>)

@@ -541,8 +541,11 @@ int vw_cmd_render(int argc, char **argv)
     /* Collective: every process calls it, only the output process writes it. */
     vw_traffic traffic;
     vw_world_traffic(w, &traffic);
-    if (strategy != VW_BALANCE_NONE)
-        /* After: measured on the full render (busy time over workers), not predicted. */
+    if (balancing)
+        /* Before: measured by the pre-pass on the layout and mapping the balancer (or, with
+           --map alone, the remap) started from; a mapping alone records no balance
+           itself, and "before" showed the full render's lambda, as "after" does. After:
+           measured on the full render (busy time over workers), not predicted. */
         vw_world_set_balance_info(w, vw_balance_strategy_name(strategy), bi.rep.imbalance_before,
                                   vw_world_imbalance(w), bi.migrated);
     vw_world_add_time(w, "load", t_loaded - t_load0);

@@ -84,6 +84,16 @@ if(moved_world LESS 1 OR NOT moved EQUAL moved_world OR moved_bytes LESS moved
   message(FATAL_ERROR "--map weighted: balance_detail.migrated_objects ${moved} (${moved_bytes} "
           "bytes), balance.migrated_objects ${moved_world}: ${out}")
 endif()
+# ... and in "balance", lambda before the remap as the pre-pass measured it (the
+# detail's): no balancer records it on this path, and "before" showed the full render's
+# lambda, equal to "after".
+string(JSON before_world GET "${json}" balance imbalance_before)
+string(JSON after_world GET "${json}" balance imbalance_after)
+string(JSON after GET "${json}" balance_detail imbalance_after)
+if(NOT before_world STREQUAL before OR NOT after_world STREQUAL after)
+  message(FATAL_ERROR "--map weighted: balance.imbalance_before ${before_world} and _after "
+          "${after_world}, balance_detail's ${before} and ${after}")
+endif()
 # lambda before a balance is the one the mapping alone measures on the same layout (one
 # definition, vw_balance_imbalance's): with every cell on the fast worker of 1,1000 the
 # balancers' own 'before' said 2 (max / mean), the measurement 1.001.

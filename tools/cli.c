@@ -209,6 +209,23 @@ void vw_cli_engine_init(int *argc, char ***argv)
 
 void vw_cli_engine_finish(void) { vw_engine_finish(); }
 
+int vw_cli_job_status(const char *cmd, int rc)
+{
+    if (vw_engine_size() == 1) return rc;
+    /* The agreement carries a status, not a number: the two kinds of failure map onto
+       two statuses and back. */
+    char msg[256];
+    snprintf(msg, sizeof msg, "failed with exit status %d", rc);
+    vw_status all = vw_engine_agree(rc == VW_EXIT_OK      ? VW_OK
+                                    : rc == VW_EXIT_USAGE ? VW_E_INPUT
+                                                          : VW_E_IO,
+                                    msg, sizeof msg);
+    if (all == VW_OK) return VW_EXIT_OK;
+    if (rc == VW_EXIT_OK && vw_cli_is_output())
+        fprintf(stderr, "vwalls%s%s: %s\n", cmd ? " " : "", cmd ? cmd : "", msg);
+    return all == VW_E_INPUT ? VW_EXIT_USAGE : VW_EXIT_FAIL;
+}
+
 /* Rank 0's n values (collective; a copy to free). */
 static double *first_values(const double *v, size_t n)
 {

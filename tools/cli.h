@@ -75,6 +75,16 @@ int vw_cli_same_view(const char *cmd, int width, int height, long depth, const v
    vw_cli_engine_finish finalises what init started. Both are safe to call without MPI. */
 void vw_cli_engine_init(int *argc, char ***argv);
 void vw_cli_engine_finish(void);
+/* The exit status of the whole job, from this process's (collective: every process calls
+   it once, when its command has returned, before vw_cli_engine_finish). Under MPI only
+   the output process writes the outputs and checks results, so it alone may know that
+   the run failed (a --stats file it cannot create); every process now exits with the
+   status of the lowest failing rank, so whatever reads any rank's status (a launcher, a
+   batch system, a script each rank runs) sees the failure. The commands report their
+   own failures (from the output process); when it succeeded and another process did
+   not, it says which: "vwalls CMD: rank R: failed with exit status S". Without MPI, rc
+   as it is. */
+int vw_cli_job_status(const char *cmd, int rc);
 
 /* A progress bar on stderr (see vw_progress_begin): a fraction in [0,1] and
    a short note (e.g. "2.1 Mrays/s"); redrawn at most ten times a second. Safe to call

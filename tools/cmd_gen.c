@@ -8,7 +8,6 @@
 
 #include "cli.h"
 #include "commands.h"
-#include "vwalls/engine.h"
 #include "vwalls/gen.h"
 
 static void gen_usage(FILE *f)
@@ -121,9 +120,9 @@ int vw_cmd_gen(int argc, char **argv)
     }
     if (out) {
         /* Under mpirun only the output process writes the file, as every command writes
-           its outputs (the others wrote the same bytes over it); all return its status. */
+           its outputs (the others wrote the same bytes over it); all exit with its status
+           (vw_cli_job_status). */
         st = vw_cli_is_output() ? vw_scene_write_nff_file(s, out, err, sizeof err) : VW_OK;
-        st = vw_engine_agree(st, err, sizeof err);
     } else {
         st = vw_scene_write_nff(s, stdout);
         if (fflush(stdout) != 0 || ferror(stdout))

@@ -477,6 +477,8 @@ int vw_cmd_radiosity(int argc, char **argv)
     }
     double t4 = vw_cli_now();
     vw_world *w = rad_solver_world(s);
+    /* Only the output process checks the ledger and writes the outputs; every process
+       exits with its status, agreed when the command has returned (vw_cli_job_status). */
     if (vw_world_is_output(w)) {
         rad_ledger L = rad_solver_ledger(s);
         if (vw_cli_fault("ledger")) L.error = INFINITY; /* tests: a run that fails the check */
@@ -486,18 +488,18 @@ int vw_cmd_radiosity(int argc, char **argv)
         if (!(L.error <= 1e-6)) { /* NaN too */
             vw_cli_error(CMD, "energy ledger off by %.3g (relative): no output written", L.error);
             rc = VW_EXIT_FAIL;
-            goto written;
+            goto done;
         }
         if (write_outputs(&r, s)) {
             rc = VW_EXIT_FAIL;
-            goto written;
+            goto done;
         }
         /* Just collected: write, do not collect again (a collect is a run every process
            joins, and the others are past it). */
         if (o.checkpoint && rad_solver_write_checkpoint(s, o.checkpoint, err, sizeof err) != VW_OK) {
             vw_cli_error(CMD, "%s", err);
             rc = VW_EXIT_FAIL;
-            goto written;
+            goto done;
         }
         int64_t sm, sb, fm;
         rad_solver_traffic(s, &sm, &sb, &fm);
@@ -510,7 +512,7 @@ int vw_cmd_radiosity(int argc, char **argv)
         if (trace && vw_outfile_write(trace, r.trace ? r.trace : "", r.ntrace, err, sizeof err) != VW_OK) {
             vw_cli_error(CMD, "%s", err);
             rc = VW_EXIT_FAIL;
-            goto written;
+            goto done;
         }
         if (r.stats) {
             char extra[768], n[7][32];
@@ -532,7 +534,7 @@ int vw_cmd_radiosity(int argc, char **argv)
             if (vw_world_write_stats(w, r.stats, CMD, extra) != VW_OK) {
                 vw_cli_error(CMD, "%s", vw_world_errmsg(w));
                 rc = VW_EXIT_FAIL;
-                goto written;
+                goto done;
             }
         }
         if (!o.quiet) {
@@ -554,11 +556,6 @@ int vw_cmd_radiosity(int argc, char **argv)
                             "patch holds sf = %g of the emitted power (the emitters are meshed "
                             "finer); give a smaller --sf or a larger --patch-size\n", o.sf);
     }
-written:
-    /* Only the output process checks the ledger and writes the outputs; every process
-       exits with its status (the others exited 0 while it exited 1, and a launcher that
-       reports one rank's status, or a script that reads the others', saw success). */
-    if (vw_world_agree(w, rc == VW_EXIT_OK ? VW_OK : VW_E_IO, NULL, 0) != VW_OK) rc = VW_EXIT_FAIL;
 done:
     free(r.trace);
     rad_solver_free(s);

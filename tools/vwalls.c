@@ -118,7 +118,9 @@ static int run(int argc, char **argv)
 int main(int argc, char **argv)
 {
     vw_cli_engine_init(&argc, &argv);
-    int rc = run(argc, argv);
+    /* Every command ends here on every process, past its last collective call: the
+       place where all take the job's status (only the output process writes files). */
+    int rc = vw_cli_job_status(argc > 1 ? argv[1] : NULL, run(argc, argv));
     vw_cli_engine_finish();
     return rc;
 }

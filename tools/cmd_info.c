@@ -76,10 +76,14 @@ int vw_cmd_info(int argc, char **argv)
         return VW_EXIT_USAGE;
     }
     char err[1024] = "";
-    vw_scene *s;
-    vw_status st = vw_scene_read_file(path, &s, err, sizeof err);
+    vw_scene *s = NULL;
+    /* Under MPI every process reads the scene, as every command does; all stop if one
+       cannot (a file missing on one host), and the output process says which and why:
+       the others' messages are not printed, and it printed the description. */
+    vw_status st = vw_engine_agree(vw_scene_read_file(path, &s, err, sizeof err), err, sizeof err);
     if (st != VW_OK) {
         vw_cli_error(cmd, "%s", err);
+        vw_scene_free(s);
         return st == VW_E_INPUT || st == VW_E_INVAL ? VW_EXIT_USAGE : VW_EXIT_FAIL;
     }
     double lo[3], hi[3];

@@ -112,11 +112,6 @@ int vw_cmd_info(int argc, char **argv)
         for (size_t id = 0; id < n; id++)
             print_object(s, (int)id);
     }
-    int bad = fflush(stdout) != 0 || ferror(stdout);
     vw_scene_free(s);
-    if (bad) {
-        vw_cli_error(cmd, "cannot write to stdout");
-        return VW_EXIT_FAIL;
-    }
-    return VW_EXIT_OK;
+    return VW_EXIT_OK; /* a failed write shows at the flush: main checks standard output */
 }

@@ -1,6 +1,7 @@
 /* vwalls.c - the vwalls command: dispatches to one subcommand per file (cmd_*.c).
  * The same binary runs alone (threads engine) and under mpirun (MPI engine).
  */
+#include <errno.h>
 #include <signal.h>
 #include <stdio.h>
 #include <string.h>
@@ -115,12 +116,29 @@ static int run(int argc, char **argv)
     return c->run(argc - 1, argv + 1);
 }
 
+/* A command's answers on standard output that never arrived (a full disk, a closed
+   pipe's reader gone) fail the command: edit's and animate's answers, render's summary,
+   gen's scene, info's description. Checked once here for every command, after the
+   last printf, as the C library only reports it when the buffer is written. */
+static int stdout_status(const char *cmd, int rc)
+{
+    errno = 0;
+    int failed = fflush(stdout) != 0;
+    int err = errno;
+    failed |= ferror(stdout) != 0;
+    if (!failed) return rc;
+    fprintf(stderr, "vwalls%s%s: cannot write to standard output%s%s\n", cmd ? " " : "",
+            cmd ? cmd : "", err ? ": " : "", err ? strerror(err) : "");
+    return rc == VW_EXIT_OK ? VW_EXIT_FAIL : rc;
+}
+
 int main(int argc, char **argv)
 {
     vw_cli_engine_init(&argc, &argv);
     /* Every command ends here on every process, past its last collective call: the
        place where all take the job's status (only the output process writes files). */
-    int rc = vw_cli_job_status(argc > 1 ? argv[1] : NULL, run(argc, argv));
+    const char *cmd = argc > 1 && argv[1][0] != '-' ? argv[1] : NULL; /* not --help */
+    int rc = vw_cli_job_status(cmd, stdout_status(cmd, run(argc, argv)));
     vw_cli_engine_finish();
     return rc;
 }

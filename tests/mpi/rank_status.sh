@@ -78,9 +78,9 @@ must_agree "edit --stats into a missing directory" 1 "nodir/s.json" \
     "\"$vwalls\" edit \"$dir/balls.nff\" --stats \"$missing/s.json\" $small"
 must_agree "gen -o into a missing directory" 1 "nodir/g.nff" \
     "\"$vwalls\" gen balls --size 1 -o \"$missing/g.nff\""
-must_agree "gen to a full stdout" 1 "cannot write to stdout" \
+must_agree "gen to a full stdout" 1 "cannot write to standard output" \
     "\"$vwalls\" gen balls --size 1 >/dev/full"
-must_agree "info to a full stdout" 1 "cannot write to stdout" \
+must_agree "info to a full stdout" 1 "cannot write to standard output" \
     "\"$vwalls\" info \"$dir/balls.nff\" >/dev/full"
 must_agree "example-pairs --stats into a missing directory" 1 "nodir/s.json" \
     "\"$vwalls\" example-pairs --spheres 300 --workers 1 --quiet --stats \"$missing/s.json\""

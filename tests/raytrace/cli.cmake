@@ -199,4 +199,19 @@ execute_process(COMMAND ${VWALLS} render ${SCENE} -o ${WORK}/x.jpg RESULT_VARIAB
 if(NOT rc EQUAL 2)
   message(FATAL_ERROR "-o x.jpg: exit ${rc}, expected 2")
 endif()
+# Standard output that cannot be written (a full disk): every command that prints fails,
+# once, saying so; the render's image is still written (it is not standard output).
+if(EXISTS /dev/full)
+  file(WRITE ${WORK}/edits.txt "move 0 0.01 0 0\n")
+  foreach(cmd "render;${SCENE};-o;${WORK}/full.png;--size;16x12" "gen;balls" "info;${SCENE}"
+              "example-pairs;--spheres;50" "edit;${SCENE}" "--help")
+    execute_process(COMMAND ${VWALLS} ${cmd} INPUT_FILE ${WORK}/edits.txt OUTPUT_FILE /dev/full
+                    RESULT_VARIABLE rc ERROR_VARIABLE err)
+    string(REGEX MATCHALL "cannot write to standard output" said "${err}")
+    list(LENGTH said nsaid)
+    if(NOT rc EQUAL 1 OR NOT nsaid EQUAL 1)
+      message(FATAL_ERROR "${cmd} > /dev/full: exit ${rc} (expected 1), said it ${nsaid} times: ${err}")
+    endif()
+  endforeach()
+endif()
 message(STATUS "raytrace_cli: all images identical")

@@ -76,7 +76,9 @@ static void trace(bench *b, const double org[3], const double dir[3], int depth,
         if (!rt_cell_geo_occluded(&b->geo, p, l, b->eps, dist)) b->sink += wsum * ndl * m->diffuse[0];
     }
     if (depth >= b->max_depth) return;
-    if (m->specular[0] > 0) trace(b, p, refl, depth + 1, wsum * m->specular[0]);
+    /* A mirror ray where the ray tracer makes one (shade, apps/raytrace/module.c). */
+    if (m->reflect[0] > 0 || m->reflect[1] > 0 || m->reflect[2] > 0)
+        trace(b, p, refl, depth + 1, wsum * m->reflect[0]);
     if (m->transmit > 0) {
         double ior = m->ior > 0 ? m->ior : 1.0, eta = entering ? 1.0 / ior : ior;
         double c1 = -dot3(dir, n), k2 = 1 - eta * eta * (1 - c1 * c1), t[3];

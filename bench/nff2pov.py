@@ -1,7 +1,9 @@
 #!/usr/bin/env python3
 """nff2pov.py - converts an NFF scene to POV-Ray 3.7 SDL for bench/raytrace.sh, matching
 vwalls render's conventions: no ambient, diffuse = colour * Kd, Phong highlight Ks with
-exponent Shine, mirror reflection Ks, transmission T with ior, lights without colour at
+exponent Shine, mirror reflection Ks (per channel from the extension lines '#vw Ks r g b'
+and '#vw Kr r g b' that vwalls writes after an 'f'; the highlight keeps the 'f' line's
+Ks, and '#vw Ke' is not converted), transmission T with ior, lights without colour at
 1/sqrt(#lights), linear output (assumed_gamma 1), the same camera (NFF angle is the
 vertical field of view; POV's is horizontal) and a right-handed image. Polygons of more
 than three corners become POV-Ray polygons (drawn concave or not), pp ones smooth
@@ -17,9 +19,14 @@ import sys
 def main():
     path, width, height, depth = sys.argv[1], int(sys.argv[2]), int(sys.argv[3]), int(sys.argv[4])
     # NFF is read by tokens, not lines; '#' starts a comment to the end of the line.
+    # The extension lines become a token of their own ('#vwKs', '#vwKr') and their numbers.
     toks = []
     with open(path) as f:
         for line in f:
+            w = line.split()
+            if len(w) == 5 and w[0] == '#vw' and w[1] in ('Ks', 'Kr'):
+                toks.extend(['#vw' + w[1]] + w[2:])
+                continue
             toks.extend(line.split('#', 1)[0].split())
     pos = 0
 
@@ -36,7 +43,7 @@ def main():
 
     cam = {'from': (0, 0, 5), 'at': (0, 0, 0), 'up': (0, 1, 0), 'angle': 45.0}
     bg = (0, 0, 0)
-    lights, objects, out_mats = [], [], []
+    lights, objects, out_mats, mirror = [], [], [], []
     mat = None
     while pos < len(toks):
         t = nxt()
@@ -63,6 +70,12 @@ def main():
             r, g, b, kd, ks, shine, tr, ior = (num() for _ in range(8))
             mat = len(out_mats)
             out_mats.append((r, g, b, kd, ks, shine, tr, ior))
+            mirror.append((ks, ks, ks))
+        elif t in ('#vwKs', '#vwKr'):
+            # Ks sets the mirror weight too (NFF's Ks weights both); Kr, after it, alone.
+            rgb = vec()
+            if mat is not None:
+                mirror[mat] = rgb
         elif t == 's':
             c = vec()
             objects.append('sphere { %s, %r @M%d@ }' % (_v(c), num(), mat))
@@ -110,9 +123,11 @@ def main():
         c = col if col else (default, default, default)
         o.append('light_source { %s color rgb %s }' % (_v(p), _v(c)))
     for i, (r, g, b, kd, ks, shine, tr, ior) in enumerate(out_mats):
+        mr = mirror[i]
+        refl = '%r' % mr[0] if mr[0] == mr[1] == mr[2] else 'rgb %s' % _v(mr)
         o.append('#declare M%d = texture { pigment { rgbt <%r,%r,%r,%r> } '
-                 'finish { ambient 0 emission 0 diffuse %r phong %r phong_size %r reflection %r } }'
-                 % (i, r, g, b, tr, kd, ks, max(shine, 1e-6), ks))
+                 'finish { ambient 0 emission 0 diffuse %r phong %r phong_size %r reflection %s } }'
+                 % (i, r, g, b, tr, kd, ks, max(shine, 1e-6), refl))
     # Interiors (the ior) belong to objects, not textures.
     for ob in objects:
         head, m, tail = ob.rsplit('@', 2)[0], None, None

@@ -16,6 +16,10 @@ add_test(NAME raytrace_view COMMAND vw_test_raytrace view)
 add_test(NAME raytrace_analytic_far COMMAND vw_test_raytrace analytic 1e4)
 # Rays aimed at the edges and vertices a mesh's triangles share do not slip through.
 add_test(NAME raytrace_watertight COMMAND vw_test_raytrace watertight)
+# MTL illum: Ks weights the mirror ray from illum 3 on (and without an illum), not for
+# illum 2, which exporters write for a plain material with a highlight.
+add_test(NAME raytrace_illum COMMAND vw_test_raytrace illum
+         ${PROJECT_SOURCE_DIR}/tests/data/good/illum.obj)
 # Concave polygons (the SPD gears' faces) become triangles inside them, not a fan.
 add_test(NAME raytrace_concave COMMAND vw_test_raytrace concave
          ${PROJECT_SOURCE_DIR}/tests/data/good/concave.nff)

@@ -40,9 +40,10 @@ static void print_object(const vw_scene *s, int id)
            m);
     if (m >= 0 && (size_t)m < s->nmaterials) {
         const vw_material *t = &s->materials[m];
-        printf(" (diffuse %g %g %g, specular %g %g %g, shine %g, transmit %g, ior %g",
-               t->diffuse[0], t->diffuse[1], t->diffuse[2], t->specular[0], t->specular[1],
-               t->specular[2], t->shine, t->transmit, t->ior);
+        printf(" (diffuse %g %g %g, specular %g %g %g, reflect %g %g %g, shine %g, transmit %g, "
+               "ior %g", t->diffuse[0], t->diffuse[1], t->diffuse[2], t->specular[0],
+               t->specular[1], t->specular[2], t->reflect[0], t->reflect[1], t->reflect[2],
+               t->shine, t->transmit, t->ior);
         if (t->emission[0] || t->emission[1] || t->emission[2])
             printf(", emission %g %g %g", t->emission[0], t->emission[1], t->emission[2]);
         printf(")");

@@ -226,7 +226,8 @@ static void normals(const rt_hit *h, const double p[3], double ng[3], double ns[
 }
 
 /* Whitted shading at a hit: shadow rays to the lights that face the surface, a mirror
-   ray weighted by Ks and a transmitted ray weighted by T. Reads only the ray, the hit
+   ray weighted by the material's reflect (NFF: Ks; MTL: Ks by illum) and a transmitted
+   ray weighted by T. Reads only the ray, the hit
    record and the shared lights: never the cell. */
 static void shade(vw_ctx *ctx, rt_cell *c, const rt_ray *r, const rt_hit *h)
 {
@@ -287,11 +288,11 @@ static void shade(vw_ctx *ctx, rt_cell *c, const rt_ray *r, const rt_hit *h)
     }
     if (r->depth >= sh->max_depth) return;
 
-    if (has_spec) {
+    if (m->reflect[0] > 0 || m->reflect[1] > 0 || m->reflect[2] > 0) {
         rt_ray s;
         memcpy(s.org, p, sizeof s.org);
         memcpy(s.dir, refl, sizeof s.dir);
-        for (int k = 0; k < 3; k++) s.weight[k] = r->weight[k] * m->specular[k];
+        for (int k = 0; k < 3; k++) s.weight[k] = r->weight[k] * m->reflect[k];
         s.tmax = INFINITY;
         s.pixel = r->pixel;
         s.depth = r->depth + 1;

@@ -18,10 +18,14 @@ extern "C" {
 
 typedef struct vw_material {
     float diffuse[3];   /* NFF: colour*Kd; MTL: Kd */
-    float specular[3];  /* NFF: Ks,Ks,Ks; MTL: Ks. Weights highlights and mirror rays. */
+    float specular[3];  /* NFF: Ks,Ks,Ks; MTL: Ks. Weights the Phong highlight. */
+    float reflect[3];   /* weights the mirror ray. NFF: Ks, Ks, Ks (its one Ks weights
+                           highlight and mirror alike). MTL: Ks when illum asks for
+                           ray-traced reflection (3 to 7) or no illum is given, else 0. */
     float shine;        /* Phong exponent (NFF Shine, MTL Ns) */
     float transmit;     /* NFF T; MTL 1-d or Tr */
-    float ior;          /* index of refraction (NFF ior, MTL Ni); 1 when absent */
+    float ior;          /* index of refraction (NFF ior, MTL Ni); 1 when absent, and
+                           for an MTL illum other than 6 or 7 (no refraction) */
     float emission[3];  /* MTL Ke, NFF '#vw Ke' after an 'f'; zero otherwise */
 } vw_material;
 
@@ -103,10 +107,13 @@ VW_API void vw_scene_free(vw_scene *s);
 /* Writers. The NFF written reads back to the same scene, bit for bit (numbers are
    printed with 17 significant digits). Two things NFF cannot say are handled so:
    a scene without a camera (OBJ) gets the vw_scene_default_camera() view, and
-   per-channel specular colours and emission are written as extension comments,
-       #vw Ks r g b        #vw Ke r g b
+   per-channel specular colours, a mirror weight other than the specular colour (an
+   MTL illum without reflection) and emission are written as extension comments,
+       #vw Ks r g b        #vw Kr r g b        #vw Ke r g b
    right after the 'f' they belong to. Other NFF readers skip them as comments;
-   ours applies them to the current material. Returns VW_E_IO if writing fails (f is
+   ours applies them to the current material: #vw Ks sets the specular colour and
+   the mirror weight (NFF's one Ks weights both), #vw Kr the mirror weight alone (so
+   it follows any #vw Ks), #vw Ke the emission. Returns VW_E_IO if writing fails (f is
    flushed, so this includes what would otherwise wait in its buffer). */
 VW_API vw_status vw_scene_write_nff(const vw_scene *s, FILE *f);
 /* The same into a file, atomically: a failure leaves no file (nor a partial one). */

@@ -101,7 +101,9 @@ static vw_material mat(float r, float g, float b, float ks, float shine)
     m.diffuse[0] = r;
     m.diffuse[1] = g;
     m.diffuse[2] = b;
+    /* The scenes are NFF's: Ks weights the highlight and the mirror ray alike. */
     m.specular[0] = m.specular[1] = m.specular[2] = ks;
+    m.reflect[0] = m.reflect[1] = m.reflect[2] = ks;
     m.shine = shine;
     return m;
 }

@@ -4,9 +4,10 @@
  * split across lines parses exactly like one on a single line; the lexer counts
  * lines only to name them in messages. '#' comments out the rest of its line, also
  * right after a number ("1# radius"): as soon as one is seen, says the format. One
- * extension rides in comments: "#vw Ks r g b" and "#vw Ke r g b" set the specular
- * colour and emission of the current material (see vw_scene_write_nff), which other
- * NFF readers ignore.
+ * extension rides in comments: "#vw Ks r g b", "#vw Kr r g b" and "#vw Ke r g b" set
+ * the specular colour (and mirror weight), the mirror weight alone and the emission of
+ * the current material (see vw_scene_write_nff), which other NFF readers ignore. NFF's
+ * own Ks weights both the highlight and the mirror ray.
  */
 #include <float.h>
 #include <limits.h>
@@ -352,6 +353,7 @@ static vw_status parse_fill(nff *P)
         (st = to_float(P, v[7], &m.ior)) != VW_OK)
         return st;
     m.specular[1] = m.specular[2] = m.specular[0];
+    memcpy(m.reflect, m.specular, sizeof m.reflect);
     P->cur = m;
     P->cur_index = -1;
     P->have_f = 1;
@@ -367,13 +369,18 @@ static vw_status parse_ext(nff *P, const token *t)
     token key;
     if (!lex_next(&sub.lx, &key, 0))
         return VW_OK;
+    /* Ks is NFF's Ks per channel, so it sets the mirror weight too; Kr (written after
+       it) the mirror weight alone. */
+    static const char *const names[] = {"#vw Ks", "#vw Kr", "#vw Ke"};
     float *dst = tok_is(&key, "Ks") ? P->cur.specular
+               : tok_is(&key, "Kr") ? P->cur.reflect
                : tok_is(&key, "Ke") ? P->cur.emission : NULL;
     if (!dst)
         return VW_OK;   /* an extension from a later version: a comment to us */
+    const char *entity = names[dst == P->cur.specular ? 0 : dst == P->cur.reflect ? 1 : 2];
     if (!P->have_f)
-        return fail(P, t->line, "'#vw %s' before any 'f'", key.s[1] == 's' ? "Ks" : "Ke");
-    begin(&sub, key.s[1] == 's' ? "#vw Ks" : "#vw Ke", t->line);
+        return fail(P, t->line, "'%s' before any 'f'", entity);
+    begin(&sub, entity, t->line);
     float col[3];
     vw_status st = read_floats(&sub, col, 3);
     if (st != VW_OK)
@@ -382,6 +389,8 @@ static vw_status parse_ext(nff *P, const token *t)
     if (lex_next(&sub.lx, &extra, 0))
         return fail(P, t->line, "wrong number of values for '%s'", sub.entity);
     memcpy(dst, col, sizeof col);
+    if (dst == P->cur.specular)
+        memcpy(P->cur.reflect, col, sizeof col);
     P->cur_index = -1;
     return VW_OK;
 }

@@ -262,6 +262,55 @@ static int mtl_form(obj *O, span line, const char *form)
     return is;
 }
 
+/* An illum statement's model into *illum. Not an integer is an error; an integer the
+   specification does not define (0 to 10) is a warning, once per value, and leaves
+   *illum as it was. */
+static vw_status mtl_illum(obj *O, span *line, int *illum)
+{
+    char sb[48];
+    span t;
+    long long v;
+    if (!next_tok(O, line, &t))
+        return fail(O, "wrong number of values for 'illum'");
+    if (!vw__parse_int(t.s, t.n, 11, &v))
+        return fail(O, "bad illumination model '%s'", show(t, sb));
+    if (v >= 0 && v <= 10) {
+        *illum = (int)v;
+        return VW_OK;
+    }
+    vw_status st = warn_once(O, "illum", t, "'illum %s' is not an illumination model of the "
+                             "MTL specification (0 to 10): it is ignored", show(t, sb));
+    return st == VW_OK ? VW_OK : fail_status(O, st);
+}
+
+/* Gives a material what its illumination model (-1: the material gave none) means to
+   the ray tracer, once all its statements are read: they come in any order. The models
+   (the MTL specification's list) and what the ray tracer has for them:
+     0, 1   colour, no highlight, no reflection (0, constant colour, is lit as 1)
+     2      Phong highlight weighted by Ks (10, the shadow matte, is read as 2)
+     3      highlight and ray-traced reflection, both weighted by Ks
+     4      as 3 for glass: the dissolve (d, Tr) lets light through unbent
+     5      as 3 (the Fresnel term is not modelled)
+     6, 7   as 3, and the transmitted ray refracts by Ni (7: Fresnel not modelled)
+     8, 9   as 2 and 4 without reflection: their mirror is a reflection map, not a
+            ray, and vwalls reads no maps (Blender writes 9 for a transparent material)
+   Only 6 and 7 refract: any other model's transmitted ray goes straight on (ior 1), a
+   dissolve. Without illum, Ks weights highlight and mirror alike and Ni refracts, as
+   in NFF (and in vwalls before it read illum). */
+static void mtl_apply_illum(vw_material *m, int illum)
+{
+    int reflects = illum < 0 || (illum >= 3 && illum <= 7);
+    int refracts = illum < 0 || illum == 6 || illum == 7;
+    if (illum == 0 || illum == 1)
+        memset(m->specular, 0, sizeof m->specular);
+    if (reflects)
+        memcpy(m->reflect, m->specular, sizeof m->reflect);
+    else
+        memset(m->reflect, 0, sizeof m->reflect);
+    if (!refracts)
+        m->ior = 1.0f;
+}
+
 /* A material named name, 0.8 grey until its statements say otherwise; wait_line is
    the line of a usemtl that names it before any library defined it, else 0. */
 static vw_status add_named_material(obj *O, span name, int wait_line)
@@ -348,6 +397,7 @@ static vw_status parse_mtl(obj *O, const char *text, size_t len)
 {
     const char *p = text, *end = text + len;
     vw_material *m = NULL;
+    int illum = -1;   /* m's illumination model; -1 until an illum statement gives one */
     O->line = 0;
     O->next_no = 1;
     span line, key;
@@ -358,6 +408,10 @@ static vw_status parse_mtl(obj *O, const char *text, size_t len)
             span name = rest_of_line(line);
             if (!name.n)
                 return fail(O, "'newmtl' without a name");
+            /* The material before is complete (and m may move when one is added). */
+            if (m)
+                mtl_apply_illum(m, illum);
+            illum = -1;
             /* A name a usemtl gave before any library defined it: the material its
                faces already use becomes this one. */
             long i = find_named_material(O, name);
@@ -372,17 +426,22 @@ static vw_status parse_mtl(obj *O, const char *text, size_t len)
             m = &O->b.s->materials[O->b.s->nmaterials - 1];
             continue;
         }
-        static const char *const known[] = {"Kd", "Ks", "Ke", "Ns", "d", "Tr", "Ni"};
+        static const char *const known[] = {"Kd", "Ks", "Ke", "Ns", "d", "Tr", "Ni", "illum"};
         const char *k = NULL;
         for (size_t i = 0; i < sizeof known / sizeof known[0]; i++)
             if (span_is(key, known[i]))
                 k = known[i];
         if (!k)
-            continue;   /* Ka, illum, maps...: not used by vwalls */
+            continue;   /* Ka, Tf, maps...: not used by vwalls */
         if (!m)
             return fail(O, "'%s' before any 'newmtl'", k);
         vw_status st;
         float v;
+        if (!strcmp(k, "illum")) {
+            if ((st = mtl_illum(O, &line, &illum)) != VW_OK)
+                return st;
+            continue;
+        }
         /* Forms of the MTL specification that vwalls has no use for are valid input, not
            errors: "Kd spectral file.rfl [factor]" (a spectral curve) and "Kd xyz x [y z]"
            (CIE XYZ), also for Ks and Ke, leave the colour as it was, and "d -halo f" (a
@@ -426,6 +485,8 @@ static vw_status parse_mtl(obj *O, const char *text, size_t len)
         if (st != VW_OK)
             return st;
     }
+    if (m)
+        mtl_apply_illum(m, illum);
     return VW_OK;
 }
 

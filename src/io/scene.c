@@ -720,6 +720,12 @@ static void write_material(FILE *f, const vw_material *m)
     if (bits_differ(m->specular[1], m->specular[0]) || bits_differ(m->specular[2], m->specular[0]))
         fprintf(f, "#vw Ks %.17g %.17g %.17g\n", (double)m->specular[0],
                 (double)m->specular[1], (double)m->specular[2]);
+    /* The reader sets the mirror weight to Ks (by the 'f' and by #vw Ks): only one that
+       differs (an MTL illum without reflection) needs a line, after those. */
+    if (bits_differ(m->reflect[0], m->specular[0]) || bits_differ(m->reflect[1], m->specular[1]) ||
+        bits_differ(m->reflect[2], m->specular[2]))
+        fprintf(f, "#vw Kr %.17g %.17g %.17g\n", (double)m->reflect[0],
+                (double)m->reflect[1], (double)m->reflect[2]);
     if (bits_differ(m->emission[0], 0.0f) || bits_differ(m->emission[1], 0.0f) ||
         bits_differ(m->emission[2], 0.0f))
         fprintf(f, "#vw Ke %.17g %.17g %.17g\n", (double)m->emission[0],

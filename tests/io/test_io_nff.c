@@ -200,6 +200,31 @@ int main(int argc, char **argv)
         vw_scene_free(b);
     }
 
+    /* NFF's Ks weights highlight and mirror alike: the 'f' and '#vw Ks' set both, '#vw Kr'
+       (after them) the mirror weight alone, and the writer gives a mirror weight that
+       differs (an MTL illum 2) that line, so it survives the round trip. */
+    {
+        const char *t = VIEW "f 1 1 1 1 0.25 10 0 1\ns 0 0 0 1\n"
+                             "f 1 1 1 1 0.25 10 0 1\n#vw Ks 0.1 0.2 0.3\ns 1 0 0 1\n"
+                             "f 1 1 1 1 0.25 10 0 1\n#vw Ks 0.1 0.2 0.3\n#vw Kr 0 0.5 -0\n"
+                             "s 2 0 0 1\n";
+        vw_scene *a = read_text("kr.nff", t);
+        CHECK_EQ_INT(a->nmaterials, 3);
+        const vw_material *f0 = &a->materials[0], *f1 = &a->materials[1], *f2 = &a->materials[2];
+        CHECK(f0->specular[2] == 0.25f && f0->reflect[0] == 0.25f && f0->reflect[2] == 0.25f);
+        CHECK(f1->specular[2] == 0.3f && f1->reflect[0] == 0.1f && f1->reflect[2] == 0.3f);
+        CHECK(f2->specular[2] == 0.3f && f2->reflect[0] == 0.0f && f2->reflect[1] == 0.5f &&
+              signbit(f2->reflect[2]));
+        char *w = nff_string(a, NULL);
+        const char *kr = w ? strstr(w, "#vw Kr") : NULL;   /* one, for the third alone */
+        CHECK(kr != NULL && strstr(kr + 1, "#vw Kr") == NULL);
+        vw_scene *b = read_text("kr2.nff", w);
+        CHECK(scene_equal(a, b));
+        free(w);
+        vw_scene_free(a);
+        vw_scene_free(b);
+    }
+
     /* Unused 'f' leaves no material; equal 'f's share one. */
     {
         const char *t = VIEW "f 1 0 0 1 0 0 0 1\nf 0 1 0 1 0 0 0 1\ns 0 0 0 1\n"

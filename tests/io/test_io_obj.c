@@ -7,6 +7,7 @@
 #define _GNU_SOURCE
 #include <stdio.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "io_test_util.h"
 #include "vw_test.h"
@@ -51,8 +52,8 @@ static int matches(const char *text, const char *pattern)
 static void warn_corpus(const char *data)
 {
     const char *names[] = {"obj_missing_mtl.obj", "obj_unknown_usemtl.obj", "mtl_forms.obj",
-                           "obj_usemtl_first.obj"};
-    for (int i = 0; i < 4; i++) {
+                           "obj_usemtl_first.obj", "mtl_illum.obj"};
+    for (int i = 0; i < 5; i++) {
         char path[4096], line[1024], want[8][1024], err[512] = "";
         int nwant = 0;
         snprintf(path, sizeof path, "%s/warn/%s", data, names[i]);
@@ -86,6 +87,13 @@ static void warn_corpus(const char *data)
             vw_scene_free(s);
             continue;
         }
+        /* mtl_illum.mtl: an illum out of range leaves the material as without one. */
+        if (i == 4) {
+            const vw_material *m = &s->materials[s->polygons[0].material];
+            CHECK(m->specular[0] == 0.5f && m->reflect[2] == 0.5f && m->ior == 1.5f);
+            vw_scene_free(s);
+            continue;
+        }
         /* Faces of unknown materials get the default 0.8 grey; known ones their own. */
         for (size_t p = 0; p < s->npolygons; p++) {
             const vw_material *m = &s->materials[s->polygons[p].material];
@@ -94,6 +102,69 @@ static void warn_corpus(const char *data)
         }
         vw_scene_free(s);
     }
+}
+
+/* What each MTL illumination model gives the ray tracer (obj.c, mtl_apply_illum): Ks
+   weights the highlight except for 0 and 1, the mirror ray for 3 to 7 and without an
+   illum; Ni refracts for 6 and 7 and without an illum. The statements come in any order
+   (illum first for the odd models). The materials go through NFF unchanged. */
+static void illum_models(void)
+{
+    char dir[] = "/tmp/vw_illum_XXXXXX", path[256];
+    CHECK(mkdtemp(dir) != NULL);
+    snprintf(path, sizeof path, "%s/m.mtl", dir);
+    FILE *f = fopen(path, "w");
+    CHECK(f != NULL);
+    char obj[4096];
+    int n = snprintf(obj, sizeof obj, "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\n");
+    for (int model = -1; model <= 10; model++) {
+        const char *vals = "Ks 0.5 0.25 0.125\nNs 20\nNi 1.5\nd 0.75\n";
+        fprintf(f, "newmtl m%d\n", model);
+        if (model >= 0 && model % 2)
+            fprintf(f, "illum %d\n%s", model, vals);
+        else if (model >= 0)
+            fprintf(f, "%sillum %d\n", vals, model);
+        else
+            fprintf(f, "%s", vals);
+        n += snprintf(obj + n, sizeof obj - (size_t)n, "usemtl m%d\nf 1 2 3\n", model);
+    }
+    CHECK(fclose(f) == 0);
+    char err[512];
+    vw_scene *s;
+    vw_status st = vw_scene_read_obj("m.obj", obj, (size_t)n, dir, &s, err, sizeof err);
+    if (st != VW_OK)
+        fprintf(stderr, "%s\n", err);
+    CHECK_EQ_INT(st, VW_OK);
+    CHECK_EQ_INT(s->npolygons, 12);
+    const float ks[3] = {0.5f, 0.25f, 0.125f};
+    for (int model = -1; model <= 10; model++) {
+        const vw_material *m = &s->materials[s->polygons[model + 1].material];
+        int highlight = model < 0 || model >= 2;
+        int mirror = model < 0 || (model >= 3 && model <= 7);
+        int refracts = model < 0 || model == 6 || model == 7;
+        for (int k = 0; k < 3; k++) {
+            EXPECT(m->specular[k] == (highlight ? ks[k] : 0.0f), "illum %d: specular[%d] %g",
+                   model, k, m->specular[k]);
+            EXPECT(m->reflect[k] == (mirror ? ks[k] : 0.0f), "illum %d: reflect[%d] %g", model,
+                   k, m->reflect[k]);
+        }
+        EXPECT(m->ior == (refracts ? 1.5f : 1.0f), "illum %d: ior %g", model, m->ior);
+        EXPECT(m->transmit == 0.25f && m->shine == 20.0f, "illum %d: transmit %g, shine %g",
+               model, m->transmit, m->shine);
+    }
+    char *w = nff_string(s, NULL);
+    CHECK(w != NULL);
+    vw_scene *b;
+    CHECK_EQ_INT(vw_scene_read_nff("m.nff", w, strlen(w), &b, err, sizeof err), VW_OK);
+    CHECK_EQ_INT(b->npolygons, s->npolygons);   /* NFF shares equal materials: by face */
+    for (size_t i = 0; i < s->npolygons; i++)
+        CHECK(memcmp(&b->materials[b->polygons[i].material],
+                     &s->materials[s->polygons[i].material], sizeof *s->materials) == 0);
+    vw_scene_free(b);
+    free(w);
+    vw_scene_free(s);
+    remove(path);
+    rmdir(dir);
 }
 
 int main(int argc, char **argv)
@@ -134,6 +205,7 @@ int main(int argc, char **argv)
     const vw_material *glow = &s->materials[s->polygons[5].material];
     CHECK(red->diffuse[0] == 0.8f && red->diffuse[1] == 0.1f && red->specular[2] == 0.4f &&
           red->shine == 25.0f);
+    CHECK(red->reflect[0] == 0.0f && red->reflect[2] == 0.0f);      /* illum 2: no mirror */
     CHECK(white->diffuse[0] == 0.7f && white->diffuse[2] == 0.7f);   /* "Kd 0.7" = grey */
     CHECK(white->transmit == 0.25f && white->ior == 1.33f);          /* d 0.75 */
     CHECK(glow->emission[0] == 4.0f && glow->emission[2] == 2.0f && glow->transmit == 0.1f);
@@ -188,6 +260,7 @@ int main(int argc, char **argv)
     vw_scene_free(n);
     nwarnings = 0;
     warn_corpus(argv[1]);
+    illum_models();
     /* A library that is there but wrong is still an error. */
     snprintf(path, sizeof path, "%s/bad/obj_mtl_error.obj", argv[1]);
     CHECK_EQ_INT(vw_scene_read_file(path, &n, err, sizeof err), VW_E_INPUT);

@@ -9,6 +9,9 @@
  *   concave SCENE         each polygon's triangle records cover it and nothing else
  *   view                  the eye rays span the angle an NFF 'v' block gives, all of
  *                         the range the reader accepts (0..180 degrees)
+ *   illum SCENE.obj       MTL illum decides the mirror ray: tests/data/good/illum.obj's
+ *                         strips reflect the glowing wall by Ks with illum 3 or no
+ *                         illum, not with illum 2
  *   write SCENE WxH LAYOUT WORKERS OUT.png   (a helper for looking at pictures)
  *   nff SCENE             the scene as NFF on stdout (gen:balls:4 for the benchmark)
  */
@@ -365,6 +368,69 @@ static int test_view(void)
     return vw_test_failures ? 1 : 0;
 }
 
+/* tests/data/good/illum.obj: strips on the floor y = 0 (x in [-3,-1]: illum 2, [-1,1]:
+   illum 3, [1,3]: no illum; each Kd 0, Ks 0.5) before a wall at z = -5 that glows 1 and
+   reflects nothing. A floor pixel whose mirror ray meets the wall shows 0.5 where the
+   strip reflects, 0 where it does not (the highlight of the one default light, behind
+   the mirror rays, adds nothing there). Exported materials (Blender: illum 2, Ks 0.5)
+   once rendered as half mirrors. */
+static int test_illum(const char *path)
+{
+    vw_scene *s = load(path);
+    vw_camera *cam = &s->camera;
+    const double from[3] = {0, 3, 8};
+    memcpy(cam->from, from, sizeof cam->from);
+    cam->at[0] = cam->at[1] = cam->at[2] = 0;
+    cam->up[0] = cam->up[2] = 0;
+    cam->up[1] = 1;
+    cam->angle = 50;
+    cam->hither = 0;
+    cam->valid = 1;
+    int W = 96, H = 72, dims[3] = {2, 1, 2};
+    int64_t c[RT_NCOUNTERS];
+    int64_t *sums = render(s, W, H, dims, 2, c, NULL);
+    rt_view v;
+    rt_view_init(&v, cam, W, H);
+    int seen[3] = {0, 0, 0}, bad[3] = {0, 0, 0}, first[3][3];
+    for (int y = 0; y < H; y++)
+        for (int x = 0; x < W; x++) {
+            double d[3];
+            rt_view_ray(&v, x, y, d);
+            if (d[1] >= 0) continue;
+            double t = -from[1] / d[1], p[3];
+            for (int a = 0; a < 3; a++) p[a] = from[a] + t * d[a];
+            /* Well inside a strip, and its mirror ray well inside the wall. */
+            double fx = p[0] + 3, cell = floor(fx / 2);
+            if (cell < 0 || cell > 2 || fabs(fx - 2 * cell - 1) > 0.8 || fabs(p[2]) > 2.3) continue;
+            if (d[2] >= 0) continue;
+            double t2 = (-5 - p[2]) / d[2], wx = p[0] + t2 * d[0], wy = p[1] - t2 * d[1];
+            if (fabs(wx) > 19 || wy < 0.5 || wy > 19) continue;
+            int strip = (int)cell;
+            int want = strip == 0 ? 0 : 128;   /* 0.5 of 255, rounded */
+            int got = rt_fix_to_u8(sums[((size_t)y * W + x) * 3]);
+            for (int k = 1; k < 3; k++)
+                if (abs(rt_fix_to_u8(sums[((size_t)y * W + x) * 3 + k]) - want) > abs(got - want))
+                    got = rt_fix_to_u8(sums[((size_t)y * W + x) * 3 + k]);
+            if (abs(got - want) > 1 && !bad[strip]++) {
+                first[strip][0] = x;
+                first[strip][1] = y;
+                first[strip][2] = got;
+            }
+            seen[strip]++;
+        }
+    static const char *const name[] = {"illum 2", "illum 3", "no illum"};
+    for (int k = 0; k < 3; k++)
+        EXPECT(!bad[k], "%s strip: %d of %d pixels wrong, first (%d,%d): %d, expected %d",
+               name[k], bad[k], seen[k], first[k][0], first[k][1], first[k][2], k ? 128 : 0);
+    printf("illum: %d, %d and %d pixels checked on the illum 2, illum 3 and no-illum strips\n",
+           seen[0], seen[1], seen[2]);
+    EXPECT(seen[0] > 50 && seen[1] > 50 && seen[2] > 50, "too few pixels checked");
+    EXPECT(c[RT_C_REFLECT] > 0, "no mirror rays");
+    free(sums);
+    vw_scene_free(s);
+    return vw_test_failures ? 1 : 0;
+}
+
 /* Rays aimed at points sampled on a cone's side must hit it there, from outside. */
 static int test_cone(void)
 {
@@ -562,6 +628,7 @@ int main(int argc, char **argv)
     if (argc >= 2 && !strcmp(argv[1], "analytic")) return test_analytic(argc > 2 ? atof(argv[2]) : 0);
     if (argc >= 2 && !strcmp(argv[1], "cone")) return test_cone();
     if (argc >= 2 && !strcmp(argv[1], "view")) return test_view();
+    if (argc >= 3 && !strcmp(argv[1], "illum")) return test_illum(argv[2]);
     if (argc >= 2 && !strcmp(argv[1], "watertight")) return test_watertight();
     if (argc >= 3 && !strcmp(argv[1], "concave")) return test_concave(argv[2]);
     if (argc >= 2 && !strcmp(argv[1], "write")) return write_png(argc, argv);

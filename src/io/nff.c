@@ -2,7 +2,7 @@
  *
  * NFF is read as a stream of whitespace-separated tokens, not lines, so an entity
  * split across lines parses exactly like one on a single line; the lexer counts
- * lines only to name them in messages. '#' comments out the rest of its line, also
+ * lines (ended by LF, CRLF or a lone CR) only to name them in messages. '#' comments out the rest of its line, also
  * right after a number ("1# radius"): as soon as one is seen, says the format. One
  * extension rides in comments: "#vw Ks r g b", "#vw Kr r g b" and "#vw Ke r g b" set
  * the specular colour (and mirror weight), the mirror weight alone and the emission of
@@ -58,18 +58,20 @@ static int is_space(char c)
 static int lex_next(lexer *lx, token *t, int want_ext)
 {
     for (;;) {
+        /* A line ends at LF, at CRLF (one line end) or at a lone CR (classic Mac OS). */
         while (lx->p < lx->end && is_space(*lx->p)) {
-            if (*lx->p == '\n')
+            if (*lx->p == '\r' && lx->end - lx->p > 1 && lx->p[1] == '\n')
+                lx->p++;
+            if (*lx->p == '\n' || *lx->p == '\r')
                 lx->line++;
             lx->p++;
         }
         if (lx->p >= lx->end)
             return 0;
         if (*lx->p == '#') {
-            const char *q = lx->p;
-            const char *eol = memchr(q, '\n', (size_t)(lx->end - q));
-            if (!eol)
-                eol = lx->end;
+            const char *q = lx->p, *eol = q;
+            while (eol < lx->end && *eol != '\n' && *eol != '\r')
+                eol++;
             lx->p = eol;
             if (want_ext && eol - q >= 4 && memcmp(q, "#vw", 3) == 0 && is_space(q[3])) {
                 t->s = q + 3;
@@ -521,7 +523,7 @@ static vw_status parse_all(nff *P)
     /* Named at the file's last line: after a final newline the lexer counts one more,
        a line no editor shows. */
     int last_line = P->lx.line;
-    if (last_line > 1 && P->lx.end[-1] == '\n')
+    if (last_line > 1 && (P->lx.end[-1] == '\n' || P->lx.end[-1] == '\r'))
         last_line--;
     if (!P->have_v)
         return fail(P, last_line, "missing 'v' block (NFF needs a camera)");

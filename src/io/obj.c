@@ -1,8 +1,9 @@
 /* src/io/obj.c - reader for Wavefront OBJ meshes and their MTL material libraries.
  *
- * OBJ is line-oriented; a backslash that ends a line joins the next one to it (the
- * OBJ and MTL specifications' continuation), and messages name the physical line of
- * the token they are about. Faces stay polygons (consumers triangulate) over the shared
+ * OBJ is line-oriented (a line ends at LF, CRLF or a lone CR, as old Mac OS files
+ * have it); a backslash that ends a line joins the next one to it (the OBJ and MTL
+ * specifications' continuation), and messages name the physical line of the token
+ * they are about. Faces stay polygons (consumers triangulate) over the shared
  * vertex array; texture coordinates, groups, objects and smoothing are accepted and
  * ignored. OBJ has no camera and no lights: camera.valid is 0. A material library
  * that cannot be read and a usemtl name no library defines are warnings (once each),
@@ -53,15 +54,30 @@ static int is_space(char c)
     return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f';
 }
 
-/* The length of the line continuation at s[0..n): a backslash that ends its line (a
-   CR before the newline allowed) or the text; 0 when s does not start with one. */
+/* The length of the line continuation at s[0..n): a backslash that ends its line (LF,
+   CRLF or a lone CR) or the text; 0 when s does not start with one. */
 static size_t continuation(const char *s, size_t n)
 {
     if (!n || s[0] != '\\')
         return 0;
     if (n == 1 || s[1] == '\n')
         return n == 1 ? 1 : 2;
-    return n >= 3 && s[1] == '\r' && s[2] == '\n' ? 3 : 0;
+    if (s[1] == '\r')
+        return n >= 3 && s[2] == '\n' ? 3 : 2;
+    return 0;
+}
+
+/* The end of the physical line that starts at p: its first LF or CR, or end; *next gets
+   the start of the line after it. A line ends at LF, at CRLF (one line end, so line
+   numbers stay right) or at a lone CR (classic Mac OS files, which would otherwise read
+   as one statement). */
+static const char *line_end(const char *p, const char *end, const char **next)
+{
+    const char *q = p;
+    while (q < end && *q != '\n' && *q != '\r')
+        q++;
+    *next = q + (q < end) + (q + 1 < end && q[0] == '\r' && q[1] == '\n');
+    return q;
 }
 
 /* Next whitespace-separated token of a statement; a '#' starting a token ends it.
@@ -371,25 +387,18 @@ static int next_line(obj *O, const char **p, const char *end, span *line)
     if (*p >= end)
         return 0;
     O->line = O->next_no++;
-    const char *eol = memchr(*p, '\n', (size_t)(end - *p)), *first = *p;
-    if (!eol)
-        eol = end;
+    const char *next, *eol = line_end(*p, end, &next), *first = *p;
     while (first < eol && is_space(*first))
         first++;
-    for (int comment = first < eol && *first == '#'; !comment;) {
-        const char *q = eol;
-        if (q > *p && q[-1] == '\r')
-            q--;
-        if (eol == end || q == *p || q[-1] != '\\')
-            break;
-        O->next_no++;
-        eol = memchr(eol + 1, '\n', (size_t)(end - (eol + 1)));
-        if (!eol)
-            eol = end;
-    }
+    /* eol[-1] of an empty continued line is the line end before it, never a backslash. */
+    if (!(first < eol && *first == '#'))
+        while (eol < end && eol > *p && eol[-1] == '\\') {
+            O->next_no++;
+            eol = line_end(next, end, &next);
+        }
     line->s = *p;
     line->n = (size_t)(eol - *p);
-    *p = eol + (eol < end);
+    *p = next;
     return 1;
 }
 

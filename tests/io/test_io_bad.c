@@ -1,5 +1,6 @@
 /* test_io_bad.c - every file in tests/data/bad must be rejected with VW_E_INPUT, a
- * "name:LINE: " prefix and the message its first line promises ("# expect: ...").
+ * "name:LINE: " prefix and the message its first line promises ("# expect: ..."); and
+ * with its line ends made CR alone or CRLF, with the same message (the same line).
  * Usage: test_io_bad DATA_DIR
  */
 #define _GNU_SOURCE
@@ -8,6 +9,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "io_test_util.h"
 #include "vw_test.h"
 #include "vwalls/scene.h"
 
@@ -36,6 +38,48 @@ static int good_prefix(const char *err, const char *path)
     while (*p >= '0' && *p <= '9')
         p++;
     return p[0] == ':' && p[1] == ' ';
+}
+
+/* The text with every LF made CR (crlf 0: classic Mac OS) or CRLF (crlf 1: Windows). */
+static char *line_ends(const char *t, size_t n, int crlf, size_t *out_n)
+{
+    char *o = malloc(2 * n + 1);
+    size_t k = 0;
+    CHECK(o != NULL);
+    for (size_t i = 0; i < n; i++) {
+        if (t[i] == '\n') {
+            o[k++] = '\r';
+            if (!crlf)
+                continue;
+        }
+        o[k++] = t[i];
+    }
+    o[k] = '\0';
+    *out_n = k;
+    return o;
+}
+
+/* The file read as text with other line ends (a library an OBJ names keeps its own)
+   fails with the message err, word for word: a lone CR ends a line, CRLF is one line
+   end. A CR-only OBJ used to read as one statement, and every NFF error named line 1. */
+static void same_with_line_ends(const char *path, const char *dir, const char *err)
+{
+    size_t n;
+    char *text = slurp(path, &n);
+    CHECK(text != NULL && !memchr(text, '\r', n));
+    for (int crlf = 0; crlf < 2; crlf++) {
+        size_t m;
+        char *t = line_ends(text, n, crlf, &m), err2[1024] = "";
+        vw_scene *s = (vw_scene *)1;
+        vw_status st = has_ext(path, ".obj")
+                     ? vw_scene_read_obj(path, t, m, dir, &s, err2, sizeof err2)
+                     : vw_scene_read_nff(path, t, m, &s, err2, sizeof err2);
+        EXPECT(st == VW_E_INPUT && s == NULL && !strcmp(err, err2),
+               "%s with %s line ends: status %d\n  message:  '%s'\n  with LF:  '%s'", path,
+               crlf ? "CRLF" : "CR", (int)st, err2, err);
+        free(t);
+    }
+    free(text);
 }
 
 int main(int argc, char **argv)
@@ -72,6 +116,7 @@ int main(int argc, char **argv)
                     path, (int)st, (int)VW_E_INPUT, (void *)s, err, expect);
             return 1;
         }
+        same_with_line_ends(path, dirpath, err);
         files++;
     }
     closedir(d);

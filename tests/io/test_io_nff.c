@@ -65,14 +65,40 @@ static vw_scene *read_text(const char *name, const char *text)
     return s;
 }
 
+/* The text with every LF made CR (crlf 0: classic Mac OS) or CRLF (crlf 1: Windows). */
+static char *line_ends(const char *t, int crlf)
+{
+    size_t n = strlen(t), k = 0;
+    char *o = malloc(2 * n + 1);
+    CHECK(o != NULL);
+    for (size_t i = 0; i < n; i++) {
+        if (t[i] == '\n') {
+            o[k++] = '\r';
+            if (!crlf)
+                continue;
+        }
+        o[k++] = t[i];
+    }
+    o[k] = '\0';
+    return o;
+}
+
+/* The text fails with want, and so does it with CR or CRLF line ends (a text that has
+   a CR already is read as it is): a lone CR ends a line, CRLF is one line end (every
+   error in a CR-only file was named at line 1). */
 static void expect_error(const char *text, const char *want)
 {
-    char err[512] = "";
-    vw_scene *s = (vw_scene *)1;
-    vw_status st = vw_scene_read_nff("t.nff", text, strlen(text), &s, err, sizeof err);
-    if (st != VW_E_INPUT || s || strcmp(err, want) != 0) {
-        fprintf(stderr, "got  '%s' (status %d)\nwant '%s'\n", err, (int)st, want);
-        exit(1);
+    for (int form = 0; form < (strchr(text, '\r') ? 1 : 3); form++) {
+        char err[512] = "", *t = form ? line_ends(text, form - 1) : NULL;
+        vw_scene *s = (vw_scene *)1;
+        vw_status st = vw_scene_read_nff("t.nff", t ? t : text, strlen(t ? t : text), &s, err,
+                                         sizeof err);
+        free(t);
+        if (st != VW_E_INPUT || s || strcmp(err, want) != 0) {
+            fprintf(stderr, "%s line ends: got  '%s' (status %d)\nwant '%s'\n",
+                    form == 0 ? "LF" : form == 1 ? "CR" : "CRLF", err, (int)st, want);
+            exit(1);
+        }
     }
 }
 
@@ -151,6 +177,15 @@ int main(int argc, char **argv)
     for (int mode = 0; mode < 2; mode++) {
         char *t2 = reflow(text, mode);
         vw_scene *s2 = read_text("reflowed.nff", t2);
+        CHECK(scene_equal(s, s2));
+        vw_scene_free(s2);
+        free(t2);
+    }
+
+    /* Line ends: CR alone (classic Mac OS) or CRLF read like LF. */
+    for (int crlf = 0; crlf < 2; crlf++) {
+        char *t2 = line_ends(text, crlf);
+        vw_scene *s2 = read_text(crlf ? "crlf.nff" : "cr.nff", t2);
         CHECK(scene_equal(s, s2));
         vw_scene_free(s2);
         free(t2);
@@ -310,6 +345,10 @@ int main(int argc, char **argv)
     expect_error(VIEW "b 1 2 3e39\n",
                  "t.nff:2: number '3e39' out of range in 'b' (at most 3.40282e+38 in size)");
     expect_error("", "t.nff:1: missing 'v' block (NFF needs a camera)");
+    /* Line ends mixed in one file: LF, CR, CRLF, and a comment ended by a lone CR. */
+    expect_error(VIEW "s 0 0 0 1\r\ns 0 0 0 1\r# x 1 2\rs 0 0 0 1\nq\n",
+                 "t.nff:6: unknown keyword 'q'");
+    expect_error(VIEW "s 0 0 0 1\r\r\n\rs 0 0 0\r", "t.nff:5: file ends in the middle of 's'");
     expect_error(VIEW "s 0 0 0 1\n7\n", "t.nff:3: wrong number of values for 's'");
     expect_error(VIEW "s 0 0 0 1\x01\n", "t.nff:2: bad number '1?' in 's'");
 

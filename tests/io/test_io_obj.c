@@ -167,6 +167,70 @@ static void illum_models(void)
     rmdir(dir);
 }
 
+/* The text with every LF made CR (crlf 0: classic Mac OS) or CRLF (crlf 1: Windows). */
+static char *line_ends(const char *t, size_t n, int crlf, size_t *out_n)
+{
+    char *o = malloc(2 * n + 1);
+    size_t k = 0;
+    CHECK(o != NULL);
+    for (size_t i = 0; i < n; i++) {
+        if (t[i] == '\n') {
+            o[k++] = '\r';
+            if (!crlf)
+                continue;
+        }
+        o[k++] = t[i];
+    }
+    o[k] = '\0';
+    *out_n = k;
+    return o;
+}
+
+/* cube.obj and cube.mtl with CR (classic Mac OS) or CRLF line ends read as with LF: the
+   same scene bit for bit, so the same picture. A CR-only OBJ used to read as one
+   statement (one vertex, no faces). */
+static void cr_line_ends(const char *data, const vw_scene *lf)
+{
+    char dir[] = "/tmp/vw_cr_XXXXXX", path[4096];
+    CHECK(mkdtemp(dir) != NULL);
+    for (int crlf = 0; crlf < 2; crlf++) {
+        const char *names[] = {"cube.mtl", "cube.obj"};
+        char *obj = NULL;
+        size_t obj_n = 0;
+        for (int i = 0; i < 2; i++) {
+            size_t n, m;
+            snprintf(path, sizeof path, "%s/good/%s", data, names[i]);
+            char *text = slurp(path, &n);
+            CHECK(text != NULL && !memchr(text, '\r', n));
+            char *t = line_ends(text, n, crlf, &m);
+            free(text);
+            snprintf(path, sizeof path, "%s/%s", dir, names[i]);
+            FILE *f = fopen(path, "wb");
+            CHECK(f != NULL && fwrite(t, 1, m, f) == m && fclose(f) == 0);
+            if (i == 1) {
+                obj = t;
+                obj_n = m;
+            } else {
+                free(t);
+            }
+        }
+        char err[512];
+        vw_scene *s;
+        vw_status st = vw_scene_read_obj("cube.obj", obj, obj_n, dir, &s, err, sizeof err);
+        if (st != VW_OK)
+            fprintf(stderr, "%s\n", err);
+        CHECK_EQ_INT(st, VW_OK);
+        EXPECT(scene_equal(lf, s), "cube.obj with %s line ends", crlf ? "CRLF" : "CR");
+        vw_scene_free(s);
+        free(obj);
+        for (int i = 0; i < 2; i++) {
+            snprintf(path, sizeof path, "%s/%s", dir, names[i]);
+            remove(path);
+        }
+    }
+    rmdir(dir);
+}
+
 int main(int argc, char **argv)
 {
     CHECK(argc == 2);
@@ -212,6 +276,8 @@ int main(int argc, char **argv)
     double lo[3], hi[3];
     vw_scene_bounds(s, lo, hi);
     CHECK(lo[0] == 0 && lo[1] == 0 && lo[2] == 0 && hi[0] == 1 && hi[1] == 1 && hi[2] == 1);
+
+    cr_line_ends(argv[1], s);
 
     /* OBJ -> NFF: the camera is invented (valid then), and the geometry and materials,
        including per-channel Ks and Ke, survive; vertices are no longer shared. */
@@ -285,6 +351,18 @@ int main(int argc, char **argv)
     t = "v 0 0 \\\n0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nv 1 1\n";
     CHECK_EQ_INT(vw_scene_read_obj("c.obj", t, strlen(t), NULL, &n, err, sizeof err), VW_E_INPUT);
     CHECK(!strcmp(err, "c.obj:6: wrong number of values for 'v'"));
+    /* A lone CR ends a line (classic Mac OS), CRLF is one line end, in one file mixed;
+       a backslash continues a line before either. */
+    t = "v 0 0 0\rv 1 0 0\r\n# comment \\\rv 1 1 0\n\r\nv 0 \\\r1 0\rf 1 2 \\\r\n3 4\r";
+    CHECK_EQ_INT(vw_scene_read_obj("c.obj", t, strlen(t), NULL, &n, err, sizeof err), VW_OK);
+    CHECK_EQ_INT(n->nvertices, 4);
+    CHECK_EQ_INT(n->npolygons, 1);
+    CHECK_EQ_INT(n->polygons[0].count, 4);
+    CHECK(n->vertices[3][1] == 1.0 && n->vertices[3][2] == 0.0);
+    vw_scene_free(n);
+    t = "v 0 0 0\rv 1 0 0\r\n\r# comment \\\rf 1 \\\r 2 \\\r\n\\\r 3\r";
+    CHECK_EQ_INT(vw_scene_read_obj("c.obj", t, strlen(t), NULL, &n, err, sizeof err), VW_E_INPUT);
+    CHECK(!strcmp(err, "c.obj:8: vertex index 3 out of range (2 vertices)"));
     /* Meshes far from the origin, huge or degenerate, still get a usable default
        camera when written as NFF (the reader rejects 'from' equal to 'at'). */
     const char *far[] = {"v 1e20 1e20 1e20\nv 1e20 1e20 1e20\nv 1e20 1e20 1e20\nf 1 2 3\n",

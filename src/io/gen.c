@@ -130,10 +130,11 @@ static vw_status light(vw__sb *b, double x, double y, double z, float intensity)
     return vw__sb_add_light(b, pos, col);
 }
 
-/* A planar quad whose normal (right-hand rule over the vertex order) points to the
-   side of `ref` given by toward (+1) or away from it (-1). Radiosity shoots from the
-   front side, so orientation matters there. */
-static vw_status quad(vw__sb *b, int m, const double q[4][3], const double ref[3],
+/* A planar polygon of nc (3 or 4) corners whose normal (right-hand rule over the
+   vertex order) points to the side of `ref` given by toward (+1) or away from it (-1).
+   Radiosity shoots from the front side, so orientation matters there. The corners must
+   lie in one plane: the radiosity mesher warns about (and flattens) any that do not. */
+static vw_status face(vw__sb *b, int m, int nc, const double (*q)[3], const double ref[3],
                       int toward)
 {
     double e1[3], e2[3], n[3], d = 0;
@@ -145,10 +146,18 @@ static vw_status quad(vw__sb *b, int m, const double q[4][3], const double ref[3
     for (int k = 0; k < 3; k++)
         d += n[k] * (ref[k] - q[0][k]);
     if ((d > 0) == (toward > 0))
-        return vw__sb_add_polygon(b, m, 4, q);
-    const double r[4][3] = {{q[3][0], q[3][1], q[3][2]}, {q[2][0], q[2][1], q[2][2]},
-                            {q[1][0], q[1][1], q[1][2]}, {q[0][0], q[0][1], q[0][2]}};
-    return vw__sb_add_polygon(b, m, 4, r);
+        return vw__sb_add_polygon(b, m, nc, q);
+    double r[4][3];
+    for (int i = 0; i < nc; i++)
+        memcpy(r[i], q[nc - 1 - i], sizeof r[i]);
+    return vw__sb_add_polygon(b, m, nc, (const double(*)[3])r);
+}
+
+/* A quad, as face(). */
+static vw_status quad(vw__sb *b, int m, const double q[4][3], const double ref[3],
+                      int toward)
+{
+    return face(b, m, 4, q, ref, toward);
 }
 
 enum { SKIP_XLO = 1, SKIP_XHI = 2, SKIP_YLO = 4, SKIP_YHI = 8, SKIP_ZLO = 16,
@@ -513,8 +522,12 @@ static vw_status gen_cornell(vw__sb *b, const vw_gen_params *p)
     const double back[4][3] = {{549.6, 0, 559.2}, {0, 0, 559.2}, {0, 548.8, 559.2},
                                {556, 548.8, 559.2}};
     const double right[4][3] = {{0, 0, 559.2}, {0, 0, 0}, {0, 548.8, 0}, {0, 548.8, 559.2}};
-    const double left[4][3] = {{552.8, 0, 0}, {549.6, 0, 559.2}, {556, 548.8, 559.2},
-                               {556, 548.8, 0}};
+    /* The red wall's published corners are not coplanar (0.8 mm off: its floor edge
+       runs from x = 552.8 to 549.6, its ceiling edge stays at 556), and both edges are
+       shared with the floor and the ceiling, so no planar quad closes the box. It is
+       written as two triangles, each planar, with the published corners. */
+    const double left_a[3][3] = {{552.8, 0, 0}, {549.6, 0, 559.2}, {556, 548.8, 559.2}};
+    const double left_b[3][3] = {{552.8, 0, 0}, {556, 548.8, 559.2}, {556, 548.8, 0}};
     const double lamp_q[4][3] = {{343, 548.8, 227}, {343, 548.8, 332}, {213, 548.8, 332},
                                  {213, 548.8, 227}};
     TRY(quad(b, white, floor_q, inside, 1));
@@ -530,7 +543,8 @@ static vw_status gen_cornell(vw__sb *b, const vw_gen_params *p)
     TRY(quad(b, lamp, lamp_q, inside, 1));
     TRY(quad(b, white, back, inside, 1));
     TRY(quad(b, green, right, inside, 1));
-    TRY(quad(b, red, left, inside, 1));
+    TRY(face(b, red, 3, left_a, inside, 1));
+    TRY(face(b, red, 3, left_b, inside, 1));
     /* The two blocks: top outlines (published), sides down to the floor. */
     const double blocks[2][4][2] = {{{130, 65}, {82, 225}, {240, 272}, {290, 114}},
                                     {{423, 247}, {265, 296}, {314, 456}, {472, 406}}};

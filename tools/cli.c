@@ -72,6 +72,25 @@ int vw_cli_double(const char *cmd, const char *opt, const char *s, double lo, do
     return 0;
 }
 
+int vw_cli_fov_ok(double deg)
+{
+    return deg > 0 && deg < 180;
+}
+
+int vw_cli_angle(const char *cmd, const char *opt, const char *s, double *out)
+{
+    char *end;
+    errno = 0;
+    double v = strtod(s ? s : "", &end);
+    if (!s || !*s || *end || errno || !vw_cli_fov_ok(v)) {
+        vw_cli_error(cmd, "%s: bad value '%s' (expected degrees above 0 and below 180)", opt,
+                     s ? s : "");
+        return -1;
+    }
+    *out = v;
+    return 0;
+}
+
 int vw_cli_numbers(const char *cmd, const char *opt, const char *s, const char *shape,
                    double *out, int min, int max, int *n)
 {

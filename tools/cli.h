@@ -20,6 +20,10 @@ int vw_cli_int(const char *cmd, const char *opt, const char *s, long lo, long hi
 int vw_cli_double(const char *cmd, const char *opt, const char *s, double lo, double hi,
                   double *out);
 int vw_cli_size(const char *cmd, const char *opt, const char *s, int *w, int *h);  /* WxH */
+/* A field of view in degrees: above 0 and below 180, the range of an NFF 'angle'
+   (src/io/nff.c), so an option takes every angle a scene file may give and no other. */
+int vw_cli_fov_ok(double deg);
+int vw_cli_angle(const char *cmd, const char *opt, const char *s, double *out);
 /* Between min and max comma-separated numbers (shape names them in the message, like
    "X,Y,Z"), each finite and at most FLT_MAX in size, the scene files' range; *n (when
    not NULL) gets their count. */

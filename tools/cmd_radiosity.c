@@ -48,7 +48,8 @@ static void help(void)
            "  --image FILE         picture from the scene's camera (or --view): .png (tone\n"
            "                       mapped) or .pfm (float: radiosity, not tone mapped)\n"
            "  --view F,A[,FOV]     camera: from x,y,z, at x,y,z, vertical angle (degrees,\n"
-           "                       0.001-179, default 45); +y up (+z for a vertical view)\n"
+           "                       above 0 and below 180, default 45); +y up (+z for a\n"
+           "                       vertical view)\n"
            "  --size WxH           picture size (default: the camera's, or 512x512)\n"
            "  --snapshot-every N   rewrite the outputs every N shots while solving\n"
            "  --stats FILE.json    stats JSON (radiosity: shots, unshot_ratio, energy_error)\n"
@@ -188,9 +189,9 @@ static int parse_view(const char *v, vw_camera *cam)
     if (vw_cli_numbers(CMD, "--view", v, "fx,fy,fz,ax,ay,az[,fov]", x, 6, 7, &n)) return -1;
     for (int k = 0; k < 3; k++) cam->from[k] = x[k], cam->at[k] = x[3 + k];
     cam->angle = n == 7 ? x[6] : 45;
-    if (!(cam->angle >= 0.001 && cam->angle <= 179)) { /* the range of render --angle */
-        vw_cli_error(CMD, "--view: field of view %g out of range (0.001 to 179 degrees)",
-                     cam->angle);
+    if (!vw_cli_fov_ok(cam->angle)) { /* the range of render --angle and of an NFF file */
+        vw_cli_error(CMD, "--view: field of view %g out of range (above 0 and below 180 "
+                     "degrees)", cam->angle);
         return -1;
     }
     int vertical = cam->from[0] == cam->at[0] && cam->from[2] == cam->at[2];

@@ -34,7 +34,8 @@ static void help(void)
            "  --size WxH       image size (default: the scene's, else 512x512)\n"
            "  --depth D        maximum ray depth, eye rays being depth 1 (default 5)\n"
            "  --from X,Y,Z --at X,Y,Z --up X,Y,Z --angle DEG\n"
-           "                   override the camera (angle: full vertical field of view)\n"
+           "                   override the camera (angle: full vertical field of view,\n"
+           "                   above 0 and below 180 degrees, as in an NFF file)\n"
            "  --light X,Y,Z[,R,G,B]  replace the scene's lights: each --light adds one point\n"
            "                   light (up to 64); without a colour, 1/sqrt(lights) each,\n"
            "                   as NFF gives a light without one\n"
@@ -311,8 +312,8 @@ int vw_cmd_render(int argc, char **argv)
                 L->color[k] = n == 6 ? (float)l[3 + k] : -1.0f; /* -1: not given */
             }
         } else if (!strcmp(a, "--angle")) {
-            if (!(v = vw_cli_value(CMD, argc, argv, &i)) ||
-                vw_cli_double(CMD, a, v, 1e-3, 179, &angle))
+            /* Any angle an NFF file may give, which the ray tracer takes as given. */
+            if (!(v = vw_cli_value(CMD, argc, argv, &i)) || vw_cli_angle(CMD, a, v, &angle))
                 return VW_EXIT_USAGE;
             has_angle = 1;
         } else if (a[0] == '-' && a[1]) {

@@ -28,7 +28,9 @@ grep -q "nonplanar.obj:7: polygon (id 0) is not planar" "$T/err" || fail "non-pl
 # --view that gives no view: exit 2, the reason, no picture (a NaN, a field of view
 # out of range or 'from' equal to 'at' used to be taken as they came, or made 45).
 for bad in "1,2,nan,0,0,0:finite numbers" "0,0,0,0,0,0:the same point" \
-           "1,1,1,0,0,0,200:field of view 200 out of range" "1,1,1,0,0,0,30,5:finite numbers"; do
+           "1,1,1,0,0,0,200:field of view 200 out of range" "1,1,1,0,0,0,30,5:finite numbers" \
+           "1,1,1,0,0,0,0:field of view 0 out of range (above 0 and below 180 degrees)" \
+           "1,1,1,0,0,0,180:field of view 180 out of range"; do
   val=${bad%%:*} want=${bad#*:}
   "$V" radiosity "$T/cornell.nff" --image "$T/v.png" --view "$val" --max-shots 4 --quiet \
     2>"$T/err"; rc=$?
@@ -36,6 +38,10 @@ for bad in "1,2,nan,0,0,0:finite numbers" "0,0,0,0,0,0:the same point" \
   grep -q "$want" "$T/err" || fail "--view $val: message: $(cat "$T/err")"
   [ ! -e "$T/v.png" ] || fail "--view $val: picture written"
 done
+# The field of view of an NFF file's range, as render --angle takes it (179 was the most).
+"$V" radiosity "$T/cornell.nff" --image "$T/v.png" --view 278,273,-800,278,273,0,179.5 --size 8x8 \
+  --max-shots 4 --quiet 2>"$T/err" && [ -s "$T/v.png" ] || fail "--view FOV 179.5: $(cat "$T/err")"
+rm -f "$T/v.png"
 # A patch size far below the scene's: refused before meshing (it used to overflow the
 # patch indices and report "no polygon to mesh").
 "$V" radiosity "$T/cornell.nff" -o "$T/p.ply" --patch-size 1e-9 --quiet 2>"$T/err"; rc=$?

@@ -145,6 +145,42 @@ foreach(case "--from;1,2,nan;--from: bad value '1,2,nan'"
     message(FATAL_ERROR "${opt} ${val}: exit ${rc}, expected 2, '${want}' and no file (${err})")
   endif()
 endforeach()
+# --angle takes what an NFF 'angle' may be, above 0 and below 180 degrees (it stopped at
+# 179, and a file's 179.5 could not be given on the command line): 0 and 180 are
+# refused, 1e-4 and 179.99 render, and --angle 179.99 over a file's 30 renders the bytes
+# of the file that says 179.99.
+foreach(case "0;2" "180;2" "-1;2" "180.0001;2" "1e-4;0" "179.99;0")
+  list(GET case 0 a)
+  list(GET case 1 want)
+  file(REMOVE ${WORK}/angle.png)
+  execute_process(COMMAND ${VWALLS} render ${SCENE} -o ${WORK}/angle.png --size 8x6 --quiet
+                          --angle ${a}
+                  RESULT_VARIABLE rc ERROR_VARIABLE err)
+  if(want EQUAL 2)
+    string(FIND "${err}" "--angle: bad value '${a}' (expected degrees above 0 and below 180)" at)
+    if(NOT rc EQUAL 2 OR at LESS 0 OR EXISTS ${WORK}/angle.png)
+      message(FATAL_ERROR "--angle ${a}: exit ${rc}, expected 2, the range and no file (${err})")
+    endif()
+  elseif(NOT rc EQUAL 0 OR NOT EXISTS ${WORK}/angle.png)
+    message(FATAL_ERROR "--angle ${a}: exit ${rc}, expected an image (${err})")
+  endif()
+endforeach()
+foreach(a 30 179.99)
+  file(WRITE ${WORK}/angle${a}.nff "v\nfrom 0 0 5\nat 0 0 0\nup 0 1 0\nangle ${a}\n"
+       "resolution 16 12\nl 3 4 5\nf 1 0.5 0.25 0.8 0 0 0 1\ns 0 0 0 1\n"
+       "p 4 -90 -90 -2 90 -90 -2 90 90 -2 -90 90 -2\n")
+endforeach()
+execute_process(COMMAND ${VWALLS} render ${WORK}/angle179.99.nff -o ${WORK}/angle_file.png --quiet
+                RESULT_VARIABLE rc1 ERROR_VARIABLE err)
+execute_process(COMMAND ${VWALLS} render ${WORK}/angle30.nff -o ${WORK}/angle_opt.png --quiet
+                        --angle 179.99
+                RESULT_VARIABLE rc2 ERROR_VARIABLE err2)
+execute_process(COMMAND ${CMAKE_COMMAND} -E compare_files ${WORK}/angle_file.png
+                        ${WORK}/angle_opt.png RESULT_VARIABLE same)
+if(NOT rc1 EQUAL 0 OR NOT rc2 EQUAL 0 OR NOT same EQUAL 0)
+  message(FATAL_ERROR "--angle 179.99: exit ${rc2}, file ${rc1}, PNG same as the file's: "
+                      "${same} (0: yes) (${err}${err2})")
+endif()
 # Scales: one sphere, its eye and its light multiplied by S. Up to 1e17 and down to 1e-14
 # the same rays as at S = 1; at 1e18 the eye is beyond Embree's limit (1.8e18, where it
 # used to assert and abort the process), at 1e-16 the scene too small for its floats

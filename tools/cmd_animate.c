@@ -534,9 +534,19 @@ int vw_anim_main(const char *cmd, int argc, char **argv)
         fflush(stdout); /* a program driving edit waits for it */
     }
     int read_error = 0;
-    while ((len = next_line(in, in == stdin, &line, &cap, &read_error)) > 0) {
-        lineno++;
-        if (session_line(s, line, (size_t)len, lineno)) break;
+    int stop = 0;
+    while (!stop && (len = next_line(in, in == stdin, &line, &cap, &read_error)) > 0) {
+        /* A lone CR ends a line too (classic Mac OS files), as in the NFF and OBJ
+           readers; CRLF is one line end. The parser stops at the CR, so each piece is
+           handed over in place. */
+        const char *p = line, *end = line + len;
+        while (!stop && p < end) {
+            const char *q = p;
+            while (q < end && !(*q == '\r' && (q + 1 == end || q[1] != '\n'))) q++;
+            lineno++;
+            stop = session_line(s, p, (size_t)(q - p), lineno);
+            p = q + 1;
+        }
         if (s->interactive) fflush(stdout);
     }
     free(line);
@@ -558,7 +568,7 @@ int vw_anim_main(const char *cmd, int argc, char **argv)
             vw_cli_error(cmd, "out of memory for the stats");
             if (!s->failed) s->failed = 1;
         } else if (vw_world_write_stats(w, stats, cmd, extra) != VW_OK) {
-            vw_cli_error(cmd, "cannot write '%s'", stats);
+            vw_cli_error(cmd, "%s", vw_world_errmsg(w));
             if (!s->failed) s->failed = 1;
         }
         free(extra);

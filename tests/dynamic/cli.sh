@@ -199,5 +199,24 @@ grep -q 'remove 1: accepted' eout.txt || fail "edit: no answer"
 grep -q '^stdin:2: unknown command' eerr.txt || fail "edit: bad line message"
 grep -q '^stdin:4: no object 1' eerr.txt || fail "edit: removed id message"
 [ -s e00.png ] || fail "edit: frame missing"
+# Line ends: LF, CRLF and a lone CR (classic Mac OS) run the same edits, and a bad
+# line is named by the same number.
+for ends in lf crlf cr; do
+  case $ends in lf) e='\n' ;; crlf) e='\r\n' ;; cr) e='\r' ;; esac
+  printf "move 0 0.05 0 0${e}bogus${e}remove 1${e}frame${e}" > "ends_$ends.txt"
+  "$V" animate scene.nff "ends_$ends.txt" -o "ends_$ends%02d.png" --workers 1 --keep-going \
+    > "ends_$ends.out" 2> "ends_$ends.err"
+  rc=$?
+  [ $rc -eq 2 ] || fail "$ends line ends: status $rc, expected 2"
+  grep -q "^ends_$ends.txt:2: unknown command" "ends_$ends.err" ||
+    fail "$ends line ends: line 2 not named: $(cat "ends_$ends.err")"
+  grep -q '2 accepted' "ends_$ends.out" || fail "$ends line ends: $(tail -1 "ends_$ends.out")"
+done
+cmp -s ends_lf00.png ends_cr00.png && cmp -s ends_lf00.png ends_crlf00.png ||
+  fail "the frames differ between LF, CRLF and CR line ends"
+# --stats that cannot be written says why.
+"$V" animate scene.nff "$E/good_moves.edits" -o 'st%02d.png' --workers 1 --quiet \
+  --stats nodir/s.json 2> sterr.txt && fail "--stats into a missing directory: status 0"
+grep -q 'nodir/s.json: cannot create: No such file' sterr.txt || fail "--stats: no reason: $(cat sterr.txt)"
 "$V" animate scene.nff 2> /dev/null; [ $? -eq 2 ] || fail "usage status"
 echo "cli ok"

@@ -177,7 +177,7 @@ int main(void)
             }
         EXPECT(worst <= 1e-12, "%s: polygon (id %d) is %.3g of its size off its plane", name,
                a->polygons[at].id, worst);
-        size_t n;
+        size_t n = 0;
         char *t = nff_string(a, &n);
         nwarnings = 0;
         CHECK_EQ_INT(vw_scene_read_nff(name, t, n, &r, err, sizeof err), VW_OK);

@@ -80,6 +80,10 @@ vw_mpi_script_test(mpi_print_once 3 print_once.sh 120
 vw_mpi_script_test(mpi_rank_input 2 rank_input.sh 240
                    $<TARGET_FILE:vwalls_tool> ${PROJECT_SOURCE_DIR}/tests/data/good/mixed.nff)
 
+# A check one rank alone fails (its own copy of the scene, its memory) stops every rank.
+vw_mpi_script_test(mpi_rank_alone 2 rank_alone.sh 150
+                   $<TARGET_FILE:vwalls_tool> ${PROJECT_SOURCE_DIR}/tests/data/good/mixed.nff)
+
 # Faults: the job ends within 10 s, non-zero, naming the rank.
 foreach(mode kill exit)
   vw_mpi_script_test(mpi_fault_${mode} 4 fault.sh 60 ${mode} $<TARGET_FILE:test_mpi_storm>)

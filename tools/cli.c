@@ -245,6 +245,41 @@ int vw_cli_job_status(const char *cmd, int rc)
     return all == VW_E_INPUT ? VW_EXIT_USAGE : VW_EXIT_FAIL;
 }
 
+int vw_cli_fail(const char *cmd, int rc, char *msg, size_t len, const char *fmt, ...)
+{
+    int k = snprintf(msg, len, "vwalls %s: ", cmd);
+    if (k >= 0 && (size_t)k < len) {
+        va_list ap;
+        va_start(ap, fmt);
+        vsnprintf(msg + k, len - (size_t)k, fmt, ap);
+        va_end(ap);
+    }
+    return rc;
+}
+
+int vw_cli_agree(const char *cmd, int rc, char *msg, size_t len)
+{
+    /* A status carries the kind of failure, as in vw_cli_job_status. */
+    vw_status all = vw_engine_agree(rc == VW_EXIT_OK      ? VW_OK
+                                    : rc == VW_EXIT_USAGE ? VW_E_INPUT
+                                                          : VW_E_IO,
+                                    msg, len);
+    if (all == VW_OK) return VW_EXIT_OK;
+    if (vw_cli_is_output() && len && *msg) {
+        /* "rank R: vwalls CMD: what" becomes "vwalls CMD: rank R: what", the order of
+           every other message naming a rank. */
+        char pre[64];
+        int n = snprintf(pre, sizeof pre, "vwalls %s: ", cmd);
+        const char *colon = strstr(msg, ": ");
+        if (!strncmp(msg, "rank ", 5) && colon && n > 0 && (size_t)n < sizeof pre &&
+            !strncmp(colon + 2, pre, (size_t)n))
+            fprintf(stderr, "%s%.*s%s\n", pre, (int)(colon + 2 - msg), msg, colon + 2 + n);
+        else
+            fprintf(stderr, "%s\n", msg);
+    }
+    return all == VW_E_INPUT ? VW_EXIT_USAGE : VW_EXIT_FAIL;
+}
+
 /* Rank 0's n values (collective; a copy to free). */
 static double *first_values(const double *v, size_t n)
 {

@@ -90,6 +90,23 @@ void vw_cli_engine_finish(void);
    as it is. */
 int vw_cli_job_status(const char *cmd, int rc);
 
+/* The agreement that ends one phase of a command (collective: every process calls it at
+   the same point, before the phase's next collective call). A check whose answer can
+   differ between processes (a file on its host, its memory, a check only the output
+   process makes) must end in one: a process that returned at once would wait in the
+   job's final agreement while the others wait for it in the next collective call.
+   rc is this process's exit status so far (VW_EXIT_OK, or how it failed) and msg (of
+   size len) its line when it failed, as the single process prints it: "vwalls CMD:
+   what" (vw_cli_fail) or a file's own "file:line: what". Returns the status of the
+   lowest failing rank, on every process (VW_EXIT_OK when none failed); the output
+   process has then printed that rank's line, naming it under MPI as vw_engine_agree
+   does: "vwalls CMD: rank R: what", "rank R: file:line: what". */
+int vw_cli_agree(const char *cmd, int rc, char *msg, size_t len);
+/* Writes "vwalls CMD: " and the printf output into msg (of size len), a line for
+   vw_cli_agree, and returns rc: rc = vw_cli_fail(CMD, VW_EXIT_USAGE, msg, len, ...). */
+int vw_cli_fail(const char *cmd, int rc, char *msg, size_t len, const char *fmt, ...)
+    __attribute__((format(printf, 5, 6)));
+
 /* A progress bar on stderr (see vw_progress_begin): a fraction in [0,1] and
    a short note (e.g. "2.1 Mrays/s"); redrawn at most ten times a second. Safe to call
    from one thread at a time. */

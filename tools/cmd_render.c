@@ -344,78 +344,73 @@ int vw_cmd_render(int argc, char **argv)
     /* Workers of the whole job, for --speeds and --slow (the world's own default when
        --workers is not given: one per core). */
     int gw = vw_cli_job_workers(workers);
+    /* Up to the world's creation, each process checks what it has itself (its memory,
+       its scene file: every process reads its own copy) and all agree at the end of
+       each phase: one that stopped alone would leave the others waiting in the next
+       collective call. */
+    int rc = VW_EXIT_OK;
+    char err[1024] = "";
     double *speeds = NULL, *slowdown = NULL;
     if (speeds_s) {
-        speeds = malloc(sizeof(double) * (size_t)gw);
-        if (!speeds || vw_map_parse_speeds(speeds_s, speeds, gw) != VW_OK) {
-            vw_cli_error(CMD, "--speeds: bad value '%s' (expected %d positive numbers, one per worker)",
-                         speeds_s, gw);
-            free(speeds);
-            return VW_EXIT_USAGE;
-        }
+        speeds = vw_cli_fault("speeds-nomem") ? NULL : malloc(sizeof(double) * (size_t)gw);
+        if (!speeds)
+            rc = vw_cli_fail(CMD, VW_EXIT_FAIL, err, sizeof err, "out of memory for --speeds");
+        else if (vw_map_parse_speeds(speeds_s, speeds, gw) != VW_OK)
+            rc = vw_cli_fail(CMD, VW_EXIT_USAGE, err, sizeof err, "--speeds: bad value '%s' "
+                             "(expected %d positive numbers, one per worker)", speeds_s, gw);
     }
-    if (slow_s) {
+    if (rc == VW_EXIT_OK && slow_s) {
         slowdown = malloc(sizeof(double) * (size_t)gw);
-        if (!slowdown) {
-            free(speeds);
-            return VW_EXIT_FAIL;
-        }
-        for (int g = 0; g < gw; g++) slowdown[g] = 1.0;
-        const char *q = slow_s;
-        while (*q) {
+        if (!slowdown) rc = vw_cli_fail(CMD, VW_EXIT_FAIL, err, sizeof err, "out of memory for --slow");
+        for (int g = 0; slowdown && g < gw; g++) slowdown[g] = 1.0;
+        for (const char *q = slow_s; slowdown && *q;) {
             char *end;
             long wk = strtol(q, &end, 10);
             double k = 0;
             if (end != q && *end == ':') k = strtod(end + 1, &end);
             if (wk < 0 || wk >= gw || !(k >= 1) || k > 1000 || (*end && *end != ',')) {
-                vw_cli_error(CMD, "--slow: bad value '%s' (expected W:K with worker W < %d and K "
-                                  "from 1 to 1000)", slow_s, gw);
-                free(speeds);
-                free(slowdown);
-                return VW_EXIT_USAGE;
+                rc = vw_cli_fail(CMD, VW_EXIT_USAGE, err, sizeof err, "--slow: bad value '%s' "
+                                 "(expected W:K with worker W < %d and K from 1 to 1000)", slow_s, gw);
+                break;
             }
             slowdown[wk] = k;
             q = *end ? end + 1 : end;
         }
         /* A known slow-down is the calibration: its speed is 1/K. */
-        if (!speeds) {
+        if (rc == VW_EXIT_OK && !speeds) {
             speeds = malloc(sizeof(double) * (size_t)gw);
-            if (!speeds) {
-                free(slowdown);
-                return VW_EXIT_FAIL;
-            }
-            for (int g = 0; g < gw; g++) speeds[g] = 1.0 / slowdown[g];
+            if (!speeds) rc = vw_cli_fail(CMD, VW_EXIT_FAIL, err, sizeof err, "out of memory for --slow");
+            for (int g = 0; speeds && g < gw; g++) speeds[g] = 1.0 / slowdown[g];
         }
     }
 
     double t_load0 = vw_cli_now();
-    char err[1024];
     vw_scene *scene = NULL;
     /* Under MPI every process reads the scene; all stop if one cannot (a file missing on
        one host), and the output process says which and why (the parser's
        "file:line: message", as it is, after "rank R: " under MPI). */
-    if (vw_engine_agree(vw_scene_read_file(scene_path, &scene, err, sizeof err), err, sizeof err) != VW_OK) {
-        if (vw_cli_is_output()) fprintf(stderr, "%s\n", err);
+    if (rc == VW_EXIT_OK && vw_scene_read_file(scene_path, &scene, err, sizeof err) != VW_OK)
+        rc = VW_EXIT_USAGE;
+    if ((rc = vw_cli_agree(CMD, rc, err, sizeof err)) != VW_EXIT_OK) {
         vw_scene_free(scene);
         free(speeds), free(slowdown);
-        return VW_EXIT_USAGE;
+        return rc;
     }
     if (nlights) { /* --light: these lights instead of the scene's */
         vw_light *L = malloc(sizeof *L * (size_t)nlights);
-        if (!L) {
-            vw_scene_free(scene);
-            free(speeds), free(slowdown);
-            return VW_EXIT_FAIL;
+        if (L) {
+            /* The NFF reader's rule (nff.c) for lights without a colour. */
+            float dflt = (float)(1.0 / sqrt((double)nlights));
+            for (int k = 0; k < nlights; k++) {
+                L[k] = lights[k];
+                if (L[k].color[0] < 0) L[k].color[0] = L[k].color[1] = L[k].color[2] = dflt;
+            }
+            free(scene->lights);
+            scene->lights = L;
+            scene->nlights = (size_t)nlights;
+        } else {
+            rc = vw_cli_fail(CMD, VW_EXIT_FAIL, err, sizeof err, "out of memory for the lights");
         }
-        /* The NFF reader's rule (nff.c) for lights without a colour. */
-        float dflt = (float)(1.0 / sqrt((double)nlights));
-        for (int k = 0; k < nlights; k++) {
-            L[k] = lights[k];
-            if (L[k].color[0] < 0) L[k].color[0] = L[k].color[1] = L[k].color[2] = dflt;
-        }
-        free(scene->lights);
-        scene->lights = L;
-        scene->nlights = (size_t)nlights;
     }
     vw_camera cam = scene->camera;
     if (!cam.valid) {
@@ -426,18 +421,17 @@ int vw_cmd_render(int argc, char **argv)
     if (has_at) memcpy(cam.at, at, sizeof at);
     if (has_up) memcpy(cam.up, up, sizeof up);
     if (has_angle) cam.angle = angle;
+    /* A file's own camera was checked by its parser; the options are checked against it
+       here, on every process's own copy of the file (--at at the scene's eye on one
+       host only). */
     const char *camera_problem = vw_camera_problem(&cam);
-    if (camera_problem) { /* a file's own camera was checked by its parser */
-        vw_cli_error(CMD, "--from/--at/--up: %s", camera_problem);
+    if (camera_problem && rc == VW_EXIT_OK)
+        rc = vw_cli_fail(CMD, VW_EXIT_USAGE, err, sizeof err, "--from/--at/--up: %s", camera_problem);
+    if ((rc = vw_cli_agree(CMD, rc, err, sizeof err)) != VW_EXIT_OK ||
+        vw_cli_same_view(CMD, width, height, depth, &cam, scene)) {
         vw_scene_free(scene);
         free(speeds), free(slowdown);
-        return VW_EXIT_USAGE;
-    }
-
-    if (vw_cli_same_view(CMD, width, height, depth, &cam, scene)) {
-        vw_scene_free(scene);
-        free(speeds), free(slowdown);
-        return VW_EXIT_USAGE;
+        return rc != VW_EXIT_OK ? rc : VW_EXIT_USAGE;
     }
 
     rt_params p;
@@ -463,7 +457,6 @@ int vw_cmd_render(int argc, char **argv)
         return st == VW_E_INVAL ? VW_EXIT_USAGE : VW_EXIT_FAIL;
     }
     vw_world *w = rt_job_world(job);
-    int rc = VW_EXIT_OK;
     /* The mapping of the initial cells (greedy and weighted refine it by load after the
        pre-pass, when there is one). */
     int balancing = strategy != VW_BALANCE_NONE || map != VW_MAP_BLOCK;
@@ -494,11 +487,16 @@ int vw_cmd_render(int argc, char **argv)
         vw_world_add_time(w, "balance", vw_cli_now() - tb0 - vw_world_time(w, "balance"));
     }
     double t_build0 = vw_cli_now();
-    if (overlay && by_worker && rt_job_record_eye_workers(job) != VW_OK) {
-        vw_cli_error(CMD, "out of memory for the overlay's worker map");
+    /* The worker map is the output process's alone: all stop if it has no room for it,
+       or the others would wait for it in the farming and the commit. */
+    if (overlay && by_worker &&
+        (vw_cli_fault("eye-workers-nomem") && rt_job_is_output(job) ? VW_E_NOMEM
+                                                                     : rt_job_record_eye_workers(job)) != VW_OK)
+        rc = vw_cli_fail(CMD, VW_EXIT_FAIL, err, sizeof err, "out of memory for the overlay's worker map");
+    if ((rc = vw_cli_agree(CMD, rc, err, sizeof err)) != VW_EXIT_OK) {
         rt_job_free(job);
         free(speeds), free(slowdown);
-        return VW_EXIT_FAIL;
+        return rc;
     }
     if (rt_job_farm(job, (rt_farm)farm, &farm_copies, err, sizeof err) != VW_OK ||
         rt_job_commit(job, err, sizeof err) != VW_OK) {

@@ -395,27 +395,26 @@ int vw_cmd_radiosity(int argc, char **argv)
         vw_scene_free(sc);
         return rst == VW_E_NOMEM ? VW_EXIT_FAIL : VW_EXIT_USAGE;
     }
+    /* Every process makes its own cells and mesh from its own copy of the scene, and
+       checks the picture's size against that copy's camera: all agree before the
+       solver's world is made, or one that stopped alone would leave the others waiting
+       for it there. */
+    int rc = VW_EXIT_OK;
     vw_box world = rad_world_box(sc);
     vw_decomp *d = NULL;
-    vw_status st = vw_decomp_create_grid(&world, o.dims, &d);
-    if (st != VW_OK) {
-        vw_cli_error(CMD, "cannot make the decomposition: %s", vw_status_message(st));
-        vw_scene_free(sc);
-        return VW_EXIT_FAIL;
-    }
     rad_mesh mesh;
+    memset(&mesh, 0, sizeof mesh);
+    vw_status st = vw_decomp_create_grid(&world, o.dims, &d);
+    if (st != VW_OK)
+        rc = vw_cli_fail(CMD, VW_EXIT_FAIL, err, sizeof err, "cannot make the decomposition: %s",
+                         vw_status_message(st));
     double t1 = vw_cli_now();
     /* Every process meshes the whole scene; only the output process warns, --quiet
        or not (it silences the progress bar and the summary, never a warning). */
     rad_options mo = o;
     mo.quiet = !vw_cli_is_output();
-    st = rad_mesh_build(sc, scene_path, d, &mo, &mesh, err, sizeof err);
-    if (st != VW_OK) {
-        if (vw_cli_is_output()) fprintf(stderr, "%s\n", err);
-        vw_decomp_free(d);
-        vw_scene_free(sc);
-        return st == VW_E_INPUT || st == VW_E_LIMIT ? VW_EXIT_USAGE : VW_EXIT_FAIL;
-    }
+    if (rc == VW_EXIT_OK && (st = rad_mesh_build(sc, scene_path, d, &mo, &mesh, err, sizeof err)) != VW_OK)
+        rc = st == VW_E_INPUT || st == VW_E_LIMIT ? VW_EXIT_USAGE : VW_EXIT_FAIL;
     r.scene = sc;
     r.mesh = &mesh;
     r.sf = o.sf;
@@ -429,19 +428,19 @@ int vw_cmd_radiosity(int argc, char **argv)
     if (r.cam.width <= 0) r.cam.width = 512, r.cam.height = 512;
     /* A scene file's own resolution may be larger than --size allows: refused here, as
        render refuses it, not found out by an allocation after the whole solve. */
-    if (r.image && (r.cam.width > 16384 || r.cam.height > 16384)) {
-        vw_cli_error(CMD, "--image: picture size %dx%d too large (at most 16384 on a side; give "
-                          "--size)", r.cam.width, r.cam.height);
+    if (rc == VW_EXIT_OK && r.image && (r.cam.width > 16384 || r.cam.height > 16384))
+        rc = vw_cli_fail(CMD, VW_EXIT_USAGE, err, sizeof err, "--image: picture size %dx%d too "
+                         "large (at most 16384 on a side; give --size)", r.cam.width, r.cam.height);
+    if ((rc = vw_cli_agree(CMD, rc, err, sizeof err)) != VW_EXIT_OK) {
         rad_mesh_free(&mesh);
         vw_decomp_free(d);
         vw_scene_free(sc);
-        return VW_EXIT_USAGE;
+        return rc;
     }
 
     rad_solver *s = NULL;
     double t2 = vw_cli_now();
     st = rad_solver_create(&mesh, d, &o, &s, err, sizeof err);
-    int rc = VW_EXIT_OK;
     if (st != VW_OK) {
         vw_cli_error(CMD, "%s", err);
         rc = st == VW_E_INPUT || st == VW_E_INVAL || st == VW_E_IO ? VW_EXIT_USAGE : VW_EXIT_FAIL;

@@ -6,6 +6,7 @@
 #     that copy's eye);
 #   * memory for --speeds that one rank lacks (VW_FAULT=speeds-nomem there alone);
 #   * memory for --overlay-by worker's map, kept by rank 0 alone (VW_FAULT=eye-workers-nomem);
+#   * a radiosity --image larger than allowed by one host's copy of the scene.
 # Each job ends within 30 s with the single process's status and the failing rank's
 # message, printed once.
 # usage: rank_alone.sh VWALLS SCENE "MPIEXEC -n 2 [flags]"
@@ -58,4 +59,10 @@ run "render, no memory for the worker map (rank 0 alone keeps it)" 1 \
     --overlay-by worker $common
 [ ! -e "$dir/r.png" ] || { echo "FAIL: render, worker map: output written"; fail=1; }
 
+"$vwalls" gen cornell -o "$dir/c0.nff" || fail=1
+sed 's/^resolution .*/resolution 20000 20000/' "$dir/c0.nff" >"$dir/c1.nff"
+run "radiosity --image, a picture too large for rank 1's scene" 2 \
+    "^vwalls radiosity: rank 1: --image: picture size 20000x20000 too large" \
+    sh -c "exec \"$vwalls\" radiosity \"$dir/c$rank.nff\" -o \"$dir/rad.ply\" --image \"$dir/rad.png\" --cells 2x2x2 --workers 1 --max-shots 8 --quiet"
+[ ! -e "$dir/rad.ply" ] || { echo "FAIL: radiosity --image: output written"; fail=1; }
 exit $fail

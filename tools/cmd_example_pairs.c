@@ -41,20 +41,24 @@ int vw_cmd_example_pairs(int argc, char **argv)
     double rmax = o.radius;
     int *dims = o.dims, check = o.check, quiet = o.quiet;
     const char *stats = o.stats;
+    /* Every process makes the spheres and the cells itself; all agree before the world
+       is made, or one out of memory alone would leave the others waiting for it there. */
+    char err[256] = "";
+    int rc = VW_EXIT_OK;
     ex_sphere *s = malloc(sizeof *s * (size_t)(n ? n : 1));
-    if (!s) {
-        vw_cli_error(CMD, "out of memory for %ld spheres", n);
-        return VW_EXIT_FAIL;
-    }
+    if (!s) rc = vw_cli_fail(CMD, VW_EXIT_FAIL, err, sizeof err, "out of memory for %ld spheres", n);
     double t0 = vw_cli_now();
-    ex_pairs_generate(s, (size_t)n, rmax, (uint64_t)seed);
+    if (s) ex_pairs_generate(s, (size_t)n, rmax, (uint64_t)seed);
     vw_box unit = {{0, 0, 0}, {1, 1, 1}};
-    vw_decomp *d;
-    vw_status st = vw_decomp_create_grid(&unit, dims, &d);
-    if (st != VW_OK) {
-        vw_cli_error(CMD, "cannot make the decomposition: %s", vw_status_message(st));
+    vw_decomp *d = NULL;
+    vw_status st = rc == VW_EXIT_OK ? vw_decomp_create_grid(&unit, dims, &d) : VW_OK;
+    if (st != VW_OK)
+        rc = vw_cli_fail(CMD, VW_EXIT_FAIL, err, sizeof err, "cannot make the decomposition: %s",
+                         vw_status_message(st));
+    if ((rc = vw_cli_agree(CMD, rc, err, sizeof err)) != VW_EXIT_OK) {
+        vw_decomp_free(d);
         free(s);
-        return VW_EXIT_FAIL;
+        return rc;
     }
     vw_config cfg;
     vw_config_init(&cfg);
@@ -64,7 +68,6 @@ int vw_cmd_example_pairs(int argc, char **argv)
     double t1 = vw_cli_now();
     st = ex_pairs_count(s, (size_t)n, rmax, d, &cfg, &pairs, &w);
     double t2 = vw_cli_now();
-    int rc = VW_EXIT_OK;
     if (st != VW_OK) {
         /* With w NULL, vw_world_errmsg says why the world was not made. */
         vw_cli_error(CMD, "run failed: %s", vw_world_errmsg(w));

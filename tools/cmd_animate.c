@@ -41,6 +41,9 @@ struct vw_anim_session {
     FILE *log;                   /* its stream: every edit's outcome */
     vw_edit batch[MAX_BATCH];
     size_t nbatch;
+    vw_result res[MAX_BATCH];    /* the batch's outcomes: made with the session, since a
+                                    process out of memory alone at a flush would leave the
+                                    others waiting for it in the query */
     rt_anim_stats acc;           /* since the last frame */
     size_t total_acc, total_coll, total_sweep, total_invalid;
     int frame, failed;           /* failed: 2 bad input, 1 other */
@@ -82,14 +85,13 @@ static const char *op_name(vw_edit_op op)
 static int flush(vw_anim_session *s)
 {
     if (!s->nbatch) return 0;
-    vw_result *res = calloc(s->nbatch, sizeof *res);
-    if (!res) return s->failed = 1;
+    vw_result *res = s->res;
+    memset(res, 0, s->nbatch * sizeof *res);
     rt_anim_stats st;
     memset(&st, 0, sizeof st);
     vw_status rc = rt_anim_apply(s->anim, s->batch, s->nbatch, s->check, s->sweep, res, &st);
     if (rc != VW_OK) {
         vw_cli_error(s->cmd, "applying edits: %s", vw_status_message(rc));
-        free(res);
         s->nbatch = 0;
         return s->failed = 1;
     }
@@ -127,7 +129,6 @@ static int flush(vw_anim_session *s)
             break;
         }
     }
-    free(res);
     s->nbatch = 0;
     return s->failed;
 }
@@ -148,7 +149,20 @@ static int do_frame(vw_anim_session *s)
     /* Without -o (vwalls edit) a frame still renders; its times are reported. */
     vw_status wst = VW_OK;
     err[0] = 0;
-    if (vw_cli_is_output() && s->pattern) {
+    /* The frame's record, on every process; made room for before the agreement below,
+       which all stop at if one has none. */
+    if (s->nframes == s->capframes) {
+        size_t cap = s->capframes ? 2 * s->capframes : 16;
+        frame_rec *f = realloc(s->frames, cap * sizeof *f);
+        if (f) {
+            s->frames = f;
+            s->capframes = cap;
+        } else {
+            snprintf(err, sizeof err, "frame %d: %s", s->frame, vw_status_message(VW_E_NOMEM));
+            wst = VW_E_NOMEM;
+        }
+    }
+    if (wst == VW_OK && vw_cli_is_output() && s->pattern) {
         char path[4096];
         uint8_t *rgb = NULL;
         /* The pattern has exactly one integer conversion (vw_cli_frame_pattern). */
@@ -167,18 +181,12 @@ static int do_frame(vw_anim_session *s)
             free(rgb);
         }
     }
-    /* Only the output process writes; all stop when it cannot (a missing directory), or
-       the others would wait for it in the next edit's collective calls forever. */
+    /* Only the output process writes; all stop when it cannot (a missing directory) or
+       one has no room for the record, or the others would wait for it in the next
+       edit's collective calls forever. */
     if (vw_engine_agree(wst, err, sizeof err) != VW_OK) {
         vw_cli_error(s->cmd, "%s", err);
         return s->failed = 1;
-    }
-    if (s->nframes == s->capframes) {
-        size_t cap = s->capframes ? 2 * s->capframes : 16;
-        frame_rec *f = realloc(s->frames, cap * sizeof *f);
-        if (!f) return s->failed = 1;
-        s->frames = f;
-        s->capframes = cap;
     }
     frame_rec *f = &s->frames[s->nframes++];
     memset(f, 0, sizeof *f);
@@ -389,7 +397,13 @@ int vw_anim_main(const char *cmd, int argc, char **argv)
 {
     const char *scene_path = NULL, *edits_path = NULL, *stats = NULL, *log_path = NULL;
     vw_anim_session *s = calloc(1, sizeof *s);
-    if (!s) return VW_EXIT_FAIL;
+    /* Before the options are read: this process cannot know where the others will next
+       agree (a usage error returns before any collective call), so it ends the job. */
+    if (!s) {
+        char msg[96];
+        snprintf(msg, sizeof msg, "vwalls %s: out of memory for the session", cmd);
+        vw_engine_abort(VW_EXIT_FAIL, msg);
+    }
     s->cmd = cmd;
     s->check = 1;
     s->threshold = 0.1;

@@ -153,7 +153,7 @@ static int do_frame(vw_anim_session *s)
        which all stop at if one has none. */
     if (s->nframes == s->capframes) {
         size_t cap = s->capframes ? 2 * s->capframes : 16;
-        frame_rec *f = realloc(s->frames, cap * sizeof *f);
+        frame_rec *f = vw_cli_fault("frames-nomem") ? NULL : realloc(s->frames, cap * sizeof *f);
         if (f) {
             s->frames = f;
             s->capframes = cap;

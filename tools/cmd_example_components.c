@@ -59,7 +59,7 @@ int vw_cmd_example_components(int argc, char **argv)
     char err[256] = "";
     int rc = VW_EXIT_OK;
     size_t ns = (size_t)(n ? n : 1);
-    ex_sphere *s = malloc(sizeof *s * ns);
+    ex_sphere *s = vw_cli_fault("spheres-nomem") ? NULL : malloc(sizeof *s * ns);
     int64_t *labels = malloc(sizeof *labels * ns), *ref = check ? malloc(sizeof *ref * ns) : NULL;
     if (!s || !labels || (check && !ref))
         rc = vw_cli_fail(CMD, VW_EXIT_FAIL, err, sizeof err, "out of memory for %ld spheres", n);

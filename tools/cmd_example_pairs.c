@@ -45,7 +45,7 @@ int vw_cmd_example_pairs(int argc, char **argv)
        is made, or one out of memory alone would leave the others waiting for it there. */
     char err[256] = "";
     int rc = VW_EXIT_OK;
-    ex_sphere *s = malloc(sizeof *s * (size_t)(n ? n : 1));
+    ex_sphere *s = vw_cli_fault("spheres-nomem") ? NULL : malloc(sizeof *s * (size_t)(n ? n : 1));
     if (!s) rc = vw_cli_fail(CMD, VW_EXIT_FAIL, err, sizeof err, "out of memory for %ld spheres", n);
     double t0 = vw_cli_now();
     if (s) ex_pairs_generate(s, (size_t)n, rmax, (uint64_t)seed);

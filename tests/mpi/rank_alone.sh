@@ -6,7 +6,9 @@
 #     that copy's eye);
 #   * memory for --speeds that one rank lacks (VW_FAULT=speeds-nomem there alone);
 #   * memory for --overlay-by worker's map, kept by rank 0 alone (VW_FAULT=eye-workers-nomem);
-#   * a radiosity --image larger than allowed by one host's copy of the scene.
+#   * a radiosity --image larger than allowed by one host's copy of the scene;
+#   * memory for the spheres of example-pairs and example-components on rank 1
+#     (VW_FAULT=spheres-nomem), for animate's frame records (VW_FAULT=frames-nomem).
 # Each job ends within 30 s with the single process's status and the failing rank's
 # message, printed once.
 # usage: rank_alone.sh VWALLS SCENE "MPIEXEC -n 2 [flags]"
@@ -65,4 +67,14 @@ run "radiosity --image, a picture too large for rank 1's scene" 2 \
     "^vwalls radiosity: rank 1: --image: picture size 20000x20000 too large" \
     sh -c "exec \"$vwalls\" radiosity \"$dir/c$rank.nff\" -o \"$dir/rad.ply\" --image \"$dir/rad.png\" --cells 2x2x2 --workers 1 --max-shots 8 --quiet"
 [ ! -e "$dir/rad.ply" ] || { echo "FAIL: radiosity --image: output written"; fail=1; }
+
+for ex in pairs components; do
+    run "example-$ex, no memory for the spheres on rank 1" 1 \
+        "^vwalls example-$ex: rank 1: out of memory for 500 spheres" \
+        sh -c "[ $rank = 1 ] && export VW_FAULT=spheres-nomem; exec \"$vwalls\" example-$ex --spheres 500 --workers 1"
+done
+printf 'move 0 0.01 0 0\nframe\nmove 1 0 0.01 0\nframe\n' >"$dir/edits"
+run "animate, no memory for the frame records on rank 1" 1 \
+    "^vwalls animate: rank 1: frame 0: out of memory" \
+    sh -c "[ $rank = 1 ] && export VW_FAULT=frames-nomem; exec \"$vwalls\" animate \"$scene\" \"$dir/edits\" -o \"$dir/a%d.png\" $common"
 exit $fail

@@ -36,12 +36,14 @@ int vw_cli_job_workers(long workers)
 void vw_cli_error(const char *cmd, const char *fmt, ...)
 {
     if (!vw_cli_is_output()) return;
+    /* The line in one write: a launcher that merges the processes' streams (MPICH's
+       Hydra) put another stream's output between the pieces of a line written in three. */
+    char msg[8192];
     va_list ap;
     va_start(ap, fmt);
-    fprintf(stderr, "vwalls %s: ", cmd);
-    vfprintf(stderr, fmt, ap);
-    fputc('\n', stderr);
+    vsnprintf(msg, sizeof msg, fmt, ap);
     va_end(ap);
+    fprintf(stderr, "vwalls %s: %s\n", cmd, msg);
 }
 
 int vw_cli_int(const char *cmd, const char *opt, const char *s, long lo, long hi, long *out)

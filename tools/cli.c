@@ -230,21 +230,26 @@ void vw_cli_engine_init(int *argc, char ***argv)
 
 void vw_cli_engine_finish(void) { vw_engine_finish(); }
 
-int vw_cli_job_status(const char *cmd, int rc)
+/* vw_engine_agree on an exit status: the agreement carries a status, not a number, so
+   the two kinds of failure map onto two statuses and back. */
+static int agree_exit(int rc, char *msg, size_t len)
 {
-    if (vw_engine_size() == 1) return rc;
-    /* The agreement carries a status, not a number: the two kinds of failure map onto
-       two statuses and back. */
-    char msg[256];
-    snprintf(msg, sizeof msg, "failed with exit status %d", rc);
     vw_status all = vw_engine_agree(rc == VW_EXIT_OK      ? VW_OK
                                     : rc == VW_EXIT_USAGE ? VW_E_INPUT
                                                           : VW_E_IO,
-                                    msg, sizeof msg);
-    if (all == VW_OK) return VW_EXIT_OK;
-    if (rc == VW_EXIT_OK && vw_cli_is_output())
+                                    msg, len);
+    return all == VW_OK ? VW_EXIT_OK : all == VW_E_INPUT ? VW_EXIT_USAGE : VW_EXIT_FAIL;
+}
+
+int vw_cli_job_status(const char *cmd, int rc)
+{
+    if (vw_engine_size() == 1) return rc;
+    char msg[256];
+    snprintf(msg, sizeof msg, "failed with exit status %d", rc);
+    int all = agree_exit(rc, msg, sizeof msg);
+    if (all != VW_EXIT_OK && rc == VW_EXIT_OK && vw_cli_is_output())
         fprintf(stderr, "vwalls%s%s: %s\n", cmd ? " " : "", cmd ? cmd : "", msg);
-    return all == VW_E_INPUT ? VW_EXIT_USAGE : VW_EXIT_FAIL;
+    return all;
 }
 
 int vw_cli_fail(const char *cmd, int rc, char *msg, size_t len, const char *fmt, ...)
@@ -261,12 +266,8 @@ int vw_cli_fail(const char *cmd, int rc, char *msg, size_t len, const char *fmt,
 
 int vw_cli_agree(const char *cmd, int rc, char *msg, size_t len)
 {
-    /* A status carries the kind of failure, as in vw_cli_job_status. */
-    vw_status all = vw_engine_agree(rc == VW_EXIT_OK      ? VW_OK
-                                    : rc == VW_EXIT_USAGE ? VW_E_INPUT
-                                                          : VW_E_IO,
-                                    msg, len);
-    if (all == VW_OK) return VW_EXIT_OK;
+    int all = agree_exit(rc, msg, len);
+    if (all == VW_EXIT_OK) return VW_EXIT_OK;
     if (vw_cli_is_output() && len && *msg) {
         /* "rank R: vwalls CMD: what" becomes "vwalls CMD: rank R: what", the order of
            every other message naming a rank. */
@@ -279,7 +280,7 @@ int vw_cli_agree(const char *cmd, int rc, char *msg, size_t len)
         else
             fprintf(stderr, "%s\n", msg);
     }
-    return all == VW_E_INPUT ? VW_EXIT_USAGE : VW_EXIT_FAIL;
+    return all;
 }
 
 /* Rank 0's n values (collective; a copy to free). */

@@ -67,4 +67,26 @@ static int vw_test_failures __attribute__((unused));
         return 0;                                                                       \
     } while (0)
 
+/* The n bytes of text t with every LF made CR (crlf 0: classic Mac OS) or CRLF (crlf 1:
+   Windows), NUL-terminated, malloc'ed; its length in *out_n (may be NULL). For the
+   readers' tests: every line end reads alike. */
+static char *vw_test_line_ends(const char *t, size_t n, int crlf, size_t *out_n)
+    __attribute__((unused));
+static char *vw_test_line_ends(const char *t, size_t n, int crlf, size_t *out_n)
+{
+    char *o = malloc(2 * n + 1);
+    size_t k = 0;
+    CHECK(o != NULL);
+    for (size_t i = 0; i < n; i++) {
+        if (t[i] == '\n') {
+            o[k++] = '\r';
+            if (!crlf) continue;
+        }
+        o[k++] = t[i];
+    }
+    o[k] = '\0';
+    if (out_n) *out_n = k;
+    return o;
+}
+
 #endif

@@ -50,32 +50,21 @@ int vw_cmd_example_components(int argc, char **argv)
                          .dims = {2, 2, 2}};
     int rc0 = vw_example_opts_parse(CMD, argc, argv, &o, help);
     if (rc0 >= 0) return rc0;
-    long n = o.spheres, seed = o.seed, workers = o.workers;
+    long n = o.spheres, workers = o.workers;
     double rmax = o.radius;
-    int *dims = o.dims, check = o.check, quiet = o.quiet;
+    int check = o.check, quiet = o.quiet;
     const char *stats = o.stats;
-    /* Every process makes the spheres and the cells itself; all agree before the world
-       is made, or one out of memory alone would leave the others waiting for it there. */
-    char err[256] = "";
-    int rc = VW_EXIT_OK;
     size_t ns = (size_t)(n ? n : 1);
-    ex_sphere *s = vw_cli_fault("spheres-nomem") ? NULL : malloc(sizeof *s * ns);
     int64_t *labels = malloc(sizeof *labels * ns), *ref = check ? malloc(sizeof *ref * ns) : NULL;
-    if (!s || !labels || (check && !ref))
-        rc = vw_cli_fail(CMD, VW_EXIT_FAIL, err, sizeof err, "out of memory for %ld spheres", n);
     double t0 = vw_cli_now();
-    if (s) ex_pairs_generate(s, (size_t)n, rmax, (uint64_t)seed);
-    vw_box unit = {{0, 0, 0}, {1, 1, 1}};
-    vw_decomp *d = NULL;
-    vw_status st = rc == VW_EXIT_OK ? vw_decomp_create_grid(&unit, dims, &d) : VW_OK;
-    if (st != VW_OK)
-        rc = vw_cli_fail(CMD, VW_EXIT_FAIL, err, sizeof err, "cannot make the decomposition: %s",
-                         vw_status_message(st));
-    if ((rc = vw_cli_agree(CMD, rc, err, sizeof err)) != VW_EXIT_OK) {
-        vw_decomp_free(d);
-        free(s), free(labels), free(ref);
+    ex_sphere *s;
+    vw_decomp *d;
+    int rc = vw_example_spheres(CMD, &o, labels && (!check || ref), &s, &d);
+    if (rc != VW_EXIT_OK) {
+        free(labels), free(ref);
         return rc;
     }
+    vw_status st;
     vw_config cfg;
     vw_config_init(&cfg);
     cfg.workers = (int)workers;

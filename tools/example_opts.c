@@ -1,9 +1,36 @@
 /* example_opts.c - parsing of the options the example subcommands share. */
 #include "example_opts.h"
 
+#include <stdlib.h>
 #include <string.h>
 
 #include "cli.h"
+#include "pairs.h"
+
+int vw_example_spheres(const char *cmd, const vw_example_opts *o, int others_ok, ex_sphere **s,
+                       vw_decomp **d)
+{
+    char err[256] = "";
+    int rc = VW_EXIT_OK;
+    long n = o->spheres;
+    *d = NULL;
+    *s = vw_cli_fault("spheres-nomem") ? NULL : malloc(sizeof **s * (size_t)(n ? n : 1));
+    if (!*s || !others_ok)
+        rc = vw_cli_fail(cmd, VW_EXIT_FAIL, err, sizeof err, "out of memory for %ld spheres", n);
+    if (*s) ex_pairs_generate(*s, (size_t)n, o->radius, (uint64_t)o->seed);
+    vw_box unit = {{0, 0, 0}, {1, 1, 1}};
+    vw_status st = rc == VW_EXIT_OK ? vw_decomp_create_grid(&unit, o->dims, d) : VW_OK;
+    if (st != VW_OK)
+        rc = vw_cli_fail(cmd, VW_EXIT_FAIL, err, sizeof err, "cannot make the decomposition: %s",
+                         vw_status_message(st));
+    if ((rc = vw_cli_agree(cmd, rc, err, sizeof err)) != VW_EXIT_OK) {
+        vw_decomp_free(*d);
+        free(*s);
+        *d = NULL;
+        *s = NULL;
+    }
+    return rc;
+}
 
 int vw_example_opts_parse(const char *cmd, int argc, char **argv, vw_example_opts *o,
                           void (*help)(void))

@@ -40,25 +40,6 @@ static int good_prefix(const char *err, const char *path)
     return p[0] == ':' && p[1] == ' ';
 }
 
-/* The text with every LF made CR (crlf 0: classic Mac OS) or CRLF (crlf 1: Windows). */
-static char *line_ends(const char *t, size_t n, int crlf, size_t *out_n)
-{
-    char *o = malloc(2 * n + 1);
-    size_t k = 0;
-    CHECK(o != NULL);
-    for (size_t i = 0; i < n; i++) {
-        if (t[i] == '\n') {
-            o[k++] = '\r';
-            if (!crlf)
-                continue;
-        }
-        o[k++] = t[i];
-    }
-    o[k] = '\0';
-    *out_n = k;
-    return o;
-}
-
 /* The file read as text with other line ends (a library an OBJ names keeps its own)
    fails with the message err, word for word: a lone CR ends a line, CRLF is one line
    end. A CR-only OBJ used to read as one statement, and every NFF error named line 1. */
@@ -69,7 +50,7 @@ static void same_with_line_ends(const char *path, const char *dir, const char *e
     CHECK(text != NULL && !memchr(text, '\r', n));
     for (int crlf = 0; crlf < 2; crlf++) {
         size_t m;
-        char *t = line_ends(text, n, crlf, &m), err2[1024] = "";
+        char *t = vw_test_line_ends(text, n, crlf, &m), err2[1024] = "";
         vw_scene *s = (vw_scene *)1;
         vw_status st = has_ext(path, ".obj")
                      ? vw_scene_read_obj(path, t, m, dir, &s, err2, sizeof err2)

@@ -65,31 +65,13 @@ static vw_scene *read_text(const char *name, const char *text)
     return s;
 }
 
-/* The text with every LF made CR (crlf 0: classic Mac OS) or CRLF (crlf 1: Windows). */
-static char *line_ends(const char *t, int crlf)
-{
-    size_t n = strlen(t), k = 0;
-    char *o = malloc(2 * n + 1);
-    CHECK(o != NULL);
-    for (size_t i = 0; i < n; i++) {
-        if (t[i] == '\n') {
-            o[k++] = '\r';
-            if (!crlf)
-                continue;
-        }
-        o[k++] = t[i];
-    }
-    o[k] = '\0';
-    return o;
-}
-
 /* The text fails with want, and so does it with CR or CRLF line ends (a text that has
    a CR already is read as it is): a lone CR ends a line, CRLF is one line end (every
    error in a CR-only file was named at line 1). */
 static void expect_error(const char *text, const char *want)
 {
     for (int form = 0; form < (strchr(text, '\r') ? 1 : 3); form++) {
-        char err[512] = "", *t = form ? line_ends(text, form - 1) : NULL;
+        char err[512] = "", *t = form ? vw_test_line_ends(text, strlen(text), form - 1, NULL) : NULL;
         vw_scene *s = (vw_scene *)1;
         vw_status st = vw_scene_read_nff("t.nff", t ? t : text, strlen(t ? t : text), &s, err,
                                          sizeof err);
@@ -184,7 +166,7 @@ int main(int argc, char **argv)
 
     /* Line ends: CR alone (classic Mac OS) or CRLF read like LF. */
     for (int crlf = 0; crlf < 2; crlf++) {
-        char *t2 = line_ends(text, crlf);
+        char *t2 = vw_test_line_ends(text, strlen(text), crlf, NULL);
         vw_scene *s2 = read_text(crlf ? "crlf.nff" : "cr.nff", t2);
         CHECK(scene_equal(s, s2));
         vw_scene_free(s2);

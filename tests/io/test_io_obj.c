@@ -167,25 +167,6 @@ static void illum_models(void)
     rmdir(dir);
 }
 
-/* The text with every LF made CR (crlf 0: classic Mac OS) or CRLF (crlf 1: Windows). */
-static char *line_ends(const char *t, size_t n, int crlf, size_t *out_n)
-{
-    char *o = malloc(2 * n + 1);
-    size_t k = 0;
-    CHECK(o != NULL);
-    for (size_t i = 0; i < n; i++) {
-        if (t[i] == '\n') {
-            o[k++] = '\r';
-            if (!crlf)
-                continue;
-        }
-        o[k++] = t[i];
-    }
-    o[k] = '\0';
-    *out_n = k;
-    return o;
-}
-
 /* cube.obj and cube.mtl with CR (classic Mac OS) or CRLF line ends read as with LF: the
    same scene bit for bit, so the same picture. A CR-only OBJ used to read as one
    statement (one vertex, no faces). */
@@ -202,7 +183,7 @@ static void cr_line_ends(const char *data, const vw_scene *lf)
             snprintf(path, sizeof path, "%s/good/%s", data, names[i]);
             char *text = slurp(path, &n);
             CHECK(text != NULL && !memchr(text, '\r', n));
-            char *t = line_ends(text, n, crlf, &m);
+            char *t = vw_test_line_ends(text, n, crlf, &m);
             free(text);
             snprintf(path, sizeof path, "%s/%s", dir, names[i]);
             FILE *f = fopen(path, "wb");

@@ -334,6 +334,20 @@ static void free_built(void *state, void *user)
     free(state);
 }
 
+/* A world of module m on four cells in a row (*d, to free after the world). */
+static vw_world *four_cells(const vw_module *m, shared *sh, int workers, vw_decomp **d)
+{
+    vw_box box = {{0, 0, 0}, {1, 1, 1}};
+    int dims[3] = {4, 1, 1};
+    CHECK_EQ_INT(vw_decomp_create_grid(&box, dims, d), VW_OK);
+    vw_config cfg;
+    vw_config_init(&cfg);
+    cfg.workers = workers;
+    vw_world *w;
+    CHECK_EQ_INT(vw_world_create(m, sh, *d, &cfg, &w), VW_OK);
+    return w;
+}
+
 static int test_build_fail(void)
 {
     vw_module m = module;
@@ -342,16 +356,9 @@ static int test_build_fail(void)
     m.step = NULL;
     for (int workers = 1; workers <= 2; workers++) {
         atomic_store(&built_ok, 0), atomic_store(&freed, 0), atomic_store(&built_calls, 0);
-        vw_box box = {{0, 0, 0}, {1, 1, 1}};
-        int dims[3] = {4, 1, 1};
-        vw_decomp *d;
-        CHECK_EQ_INT(vw_decomp_create_grid(&box, dims, &d), VW_OK);
-        vw_config cfg;
-        vw_config_init(&cfg);
-        cfg.workers = workers;
         shared sh = {0};
-        vw_world *w;
-        CHECK_EQ_INT(vw_world_create(&m, &sh, d, &cfg, &w), VW_OK);
+        vw_decomp *d;
+        vw_world *w = four_cells(&m, &sh, workers, &d);
         fail_mask = 1 << 1 | 1 << 3;
         CHECK_EQ_INT(vw_world_commit(w), VW_E_INPUT);
         /* The message names the lowest failing cell, whichever worker failed first. */
@@ -380,16 +387,9 @@ static int test_build_fail(void)
     indep[MSG_PING].flags = VW_MSG_INDEPENDENT;
     m.kinds = indep;
     for (int failing = 0; failing <= 1; failing++) {
-        vw_box box = {{0, 0, 0}, {1, 1, 1}};
-        int dims[3] = {4, 1, 1};
-        vw_decomp *d;
-        CHECK_EQ_INT(vw_decomp_create_grid(&box, dims, &d), VW_OK);
-        vw_config cfg;
-        vw_config_init(&cfg);
-        cfg.workers = 2;
         shared sh = {0};
-        vw_world *w;
-        CHECK_EQ_INT(vw_world_create(&m, &sh, d, &cfg, &w), VW_OK);
+        vw_decomp *d;
+        vw_world *w = four_cells(&m, &sh, 2, &d);
         for (int c = 0; c <= 2; c += 2) {
             int other = 1 - vw_world_cell_worker(w, c);
             CHECK_EQ_INT(vw_world_set_replicas(w, c, &other, 1), VW_OK);

@@ -101,13 +101,19 @@ typedef struct rad_cell {
     double absorbed[3], shot[3], won[3];
 } rad_cell;
 
+/* Out of memory while the solve runs: the runtime has no way to stop a run part-way,
+   so the process ends here (docs/known-issues.md). The build (cell_build) fails
+   cleanly instead, and most of a cell's memory is taken there. */
+static void out_of_memory(size_t n)
+{
+    fprintf(stderr, "vwalls radiosity: out of memory (%zu bytes)\n", n);
+    abort();
+}
+
 static void *xrealloc(void *p, size_t n)
 {
     void *q = realloc(p, n ? n : 1);
-    if (!q) {
-        fprintf(stderr, "vwalls radiosity: out of memory (%zu bytes)\n", n);
-        abort();
-    }
+    if (!q) out_of_memory(n);
     return q;
 }
 
@@ -122,24 +128,34 @@ static uint64_t hkey(int32_t poly, int32_t level, int32_t gi, int32_t gj)
     return h ^ (h >> 29);
 }
 
-static void ht_insert(rad_cell *c, int e);
-
-static void ht_grow(rad_cell *c)
+/* Room for the hash of elements [0, n): the table doubles, and its elements are
+   re-inserted, when n would fill more than half of it. -1 when out of memory (the old
+   table is kept). */
+static int ht_reserve(rad_cell *c, int n)
 {
+    if (2 * n <= c->htcap) return 0;
+    int cap = c->htcap ? 2 * c->htcap : 64;
+    while (2 * n > cap) cap *= 2;
+    int *ht = malloc(sizeof(int) * (size_t)cap);
+    if (!ht) return -1;
     free(c->ht);
-    c->htcap = c->htcap ? 2 * c->htcap : 64;
-    c->ht = xrealloc(NULL, sizeof(int) * (size_t)c->htcap);
-    for (int i = 0; i < c->htcap; i++) c->ht[i] = -1;
+    c->ht = ht;
+    c->htcap = cap;
+    for (int i = 0; i < cap; i++) c->ht[i] = -1;
     c->htused = 0;
-    for (int e = 0; e < c->nel; e++) ht_insert(c, e);
+    for (int e = 0; e < c->nel; e++) {
+        const rad_elem *x = &c->el[e];
+        size_t i = hkey(c->patches[x->patch].pc.poly, x->level, x->gi, x->gj) & (size_t)(cap - 1);
+        while (c->ht[i] >= 0) i = (i + 1) & (size_t)(cap - 1);
+        c->ht[i] = e;
+        c->htused++;
+    }
+    return 0;
 }
 
+/* Enters element e, the last one (the table has room: ht_reserve). */
 static void ht_insert(rad_cell *c, int e)
 {
-    if (2 * (c->htused + 1) > c->htcap) {
-        ht_grow(c); /* re-inserts every element up to nel, e included */
-        return;
-    }
     const rad_elem *x = &c->el[e];
     size_t i = hkey(c->patches[x->patch].pc.poly, x->level, x->gi, x->gj) & (size_t)(c->htcap - 1);
     while (c->ht[i] >= 0) i = (i + 1) & (size_t)(c->htcap - 1);
@@ -164,6 +180,8 @@ static int ht_find(const rad_cell *c, int32_t poly, int64_t piece, int32_t level
     return -1;
 }
 
+/* Adds the element of patch at (level, gi, gj): its index, -1 when the square holds
+   no element (no area), -2 when out of memory (nothing is changed then). */
 static int add_elem(rad_cell *c, int patch, int level, int gi, int gj, const double B[3])
 {
     rad_poly poly;
@@ -172,13 +190,21 @@ static int add_elem(rad_cell *c, int patch, int level, int gi, int gj, const dou
     double area = rad_poly_area(&poly, NULL, NULL);
     if (!(area > 1e-14 * pc->area)) return -1;
     if (c->nel == c->capel) {
-        c->capel = c->capel ? 2 * c->capel : 64;
-        c->el = xrealloc(c->el, sizeof *c->el * (size_t)c->capel);
+        int cap = c->capel ? 2 * c->capel : 64;
+        rad_elem *el = realloc(c->el, sizeof *c->el * (size_t)cap);
+        if (!el) return -2;
+        c->el = el;
+        c->capel = cap;
     }
     if (c->nvp + poly.n > c->capvp) {
-        while (c->nvp + poly.n > c->capvp) c->capvp = c->capvp ? 2 * c->capvp : 256;
-        c->vp = xrealloc(c->vp, sizeof *c->vp * (size_t)c->capvp);
+        int cap = c->capvp ? c->capvp : 256;
+        while (c->nvp + poly.n > cap) cap *= 2;
+        double(*vp)[3] = realloc(c->vp, sizeof *c->vp * (size_t)cap);
+        if (!vp) return -2;
+        c->vp = vp;
+        c->capvp = cap;
     }
+    if (ht_reserve(c, c->nel + 1) < 0) return -2;
     rad_elem *e = &c->el[c->nel];
     memset(e, 0, sizeof *e);
     e->patch = patch, e->level = level, e->gi = gi, e->gj = gj;
@@ -236,6 +262,7 @@ static void split_elem(rad_cell *c, int e)
     for (int a = 0; a < 2; a++)
         for (int b = 0; b < 2; b++) {
             int k = add_elem(c, par.patch, par.level + 1, 2 * par.gi + a, 2 * par.gj + b, par.B);
+            if (k == -2) out_of_memory(sizeof *c->el * (size_t)c->capel);
             if (k < 0) continue;
             rad_elem *x = &c->el[k];
             x->root = par.root;
@@ -360,6 +387,8 @@ static int in_range(const vw_box *b, const double q[3], const double v[3], doubl
 
 /* ---- building ---- */
 
+static void cell_free(void *state, void *user);
+
 static vw_status cell_build(vw_ctx *ctx, const void *objects, size_t n, void **state)
 {
     rad_solver *S = vw_ctx_user(ctx);
@@ -374,7 +403,7 @@ static vw_status cell_build(vw_ctx *ctx, const void *objects, size_t n, void **s
     c->cell = vw_ctx_cell(ctx);
     c->box = vw_ctx_cell_box(ctx);
     const rad_piece *pcs = objects;
-    c->patches = xrealloc(NULL, sizeof *c->patches * (n ? n : 1));
+    if (!(c->patches = malloc(sizeof *c->patches * (n ? n : 1)))) goto nomem;
     for (size_t i = 0; i < n; i++) {
         /* The runtime hands a piece to every cell its box touches; its owner keeps it. */
         if (vw_decomp_locate(d, pcs[i].centroid, pcs[i].normal) != c->cell) continue;
@@ -387,7 +416,8 @@ static vw_status cell_build(vw_ctx *ctx, const void *objects, size_t n, void **s
         int lo[2], hi[2];
         rad_piece_grid(&c->patches[p].pc, lo, hi);
         for (int i = lo[0]; i <= hi[0]; i++)
-            for (int j = lo[1]; j <= hi[1]; j++) add_elem(c, p, 0, i, j, c->patches[p].pc.emit);
+            for (int j = lo[1]; j <= hi[1]; j++)
+                if (add_elem(c, p, 0, i, j, c->patches[p].pc.emit) == -2) goto nomem;
     }
     if (S->opt.subdivide > 0 && S->opt.max_level > 0) {
         c->fine = S->opt.max_level < RAD_MAX_LEVEL ? S->opt.max_level : RAD_MAX_LEVEL;
@@ -395,15 +425,15 @@ static vw_status cell_build(vw_ctx *ctx, const void *objects, size_t n, void **s
         c->nsub = c->side * c->side;
         c->nroot = c->nel;
         size_t nf = (size_t)c->nroot * (size_t)c->nsub;
-        c->scc = xrealloc(NULL, sizeof *c->scc * (nf ? nf : 1));
-        c->sca = xrealloc(NULL, sizeof *c->sca * (nf ? nf : 1));
+        if (!(c->scc = malloc(sizeof *c->scc * (nf ? nf : 1)))) goto nomem;
+        if (!(c->sca = malloc(sizeof *c->sca * (nf ? nf : 1)))) goto nomem;
         c->sci = calloc(nf ? nf : 1, sizeof *c->sci);
-        c->scl = xrealloc(NULL, sizeof *c->scl * (nf ? nf : 1));
-        if (!c->sci) abort();
+        if (!(c->scl = malloc(sizeof *c->scl * (nf ? nf : 1)))) goto nomem;
+        if (!c->sci) goto nomem;
         /* Roots of one polygon are consecutive (patches come in mesh order, polygon by
            polygon); a polygon seen twice would only make two groups. */
-        c->gfirst = xrealloc(NULL, sizeof(int) * (size_t)(c->nroot + 1));
-        c->rgrp = xrealloc(NULL, sizeof(int) * (size_t)(c->nroot ? c->nroot : 1));
+        if (!(c->gfirst = malloc(sizeof(int) * (size_t)(c->nroot + 1)))) goto nomem;
+        if (!(c->rgrp = malloc(sizeof(int) * (size_t)(c->nroot ? c->nroot : 1)))) goto nomem;
         size_t maxg = 1;
         for (int e = 0; e < c->nroot; e++) {
             if (!e || c->patches[c->el[e].patch].pc.poly != c->patches[c->el[e - 1].patch].pc.poly)
@@ -412,18 +442,18 @@ static vw_status cell_build(vw_ctx *ctx, const void *objects, size_t n, void **s
         }
         c->gfirst[c->ngrp] = c->nroot;
         /* Their patches: [gpatch[g], gpatch[g + 1]). */
-        c->gpatch = xrealloc(NULL, sizeof(int) * (size_t)(c->ngrp + 1));
+        if (!(c->gpatch = malloc(sizeof(int) * (size_t)(c->ngrp + 1)))) goto nomem;
         for (int g = 0; g < c->ngrp; g++) c->gpatch[g] = c->el[c->gfirst[g]].patch;
         c->gpatch[c->ngrp] = c->npatches;
-        c->gpoly = xrealloc(NULL, sizeof(int32_t) * (size_t)(c->ngrp ? c->ngrp : 1));
+        if (!(c->gpoly = malloc(sizeof(int32_t) * (size_t)(c->ngrp ? c->ngrp : 1)))) goto nomem;
         for (int g = 0; g < c->ngrp; g++) c->gpoly[g] = c->patches[c->gpatch[g]].pc.poly;
         for (int g = 0; g < c->ngrp; g++)
             if ((size_t)(c->gfirst[g + 1] - c->gfirst[g]) > maxg) maxg = (size_t)(c->gfirst[g + 1] - c->gfirst[g]);
-        c->scw = xrealloc(NULL, sizeof *c->scw * 2 * maxg * (size_t)c->nsub);
-        c->glist = xrealloc(NULL, sizeof(int) * (size_t)(c->ngrp ? c->ngrp : 1));
+        if (!(c->scw = malloc(sizeof *c->scw * 2 * maxg * (size_t)c->nsub))) goto nomem;
+        if (!(c->glist = malloc(sizeof(int) * (size_t)(c->ngrp ? c->ngrp : 1)))) goto nomem;
         c->gtouched = calloc((size_t)(c->ngrp ? c->ngrp : 1), 1);
         c->gpow = calloc((size_t)(c->ngrp ? c->ngrp : 1), sizeof *c->gpow);
-        if (!c->gtouched || !c->gpow) abort();
+        if (!c->gtouched || !c->gpow) goto nomem;
         for (int e = 0; e < c->nroot; e++) {
             const rad_elem *x = &c->el[e];
             for (int a = 0; a < c->side; a++)
@@ -441,16 +471,20 @@ static vw_status cell_build(vw_ctx *ctx, const void *objects, size_t n, void **s
     }
     int maxnb = vw_decomp_max_neighbours(d);
     for (int f = 0; f < 6; f++) {
-        int *ids = xrealloc(NULL, sizeof(int) * (size_t)(maxnb > 0 ? maxnb : 1));
+        int *ids = malloc(sizeof(int) * (size_t)(maxnb > 0 ? maxnb : 1));
+        if (!ids) goto nomem;
         int k = vw_decomp_neighbours(d, c->cell, f, ids, maxnb);
         c->nnb[f] = k < maxnb ? k : maxnb;
         c->nb[f] = ids;
-        c->nbbox[f] = xrealloc(NULL, sizeof(vw_box) * (size_t)(c->nnb[f] ? c->nnb[f] : 1));
+        if (!(c->nbbox[f] = malloc(sizeof(vw_box) * (size_t)(c->nnb[f] ? c->nnb[f] : 1)))) goto nomem;
         for (int i = 0; i < c->nnb[f]; i++) c->nbbox[f][i] = vw_decomp_cell_box(d, ids[i]);
     }
-    c->pvis = xrealloc(NULL, (size_t)(c->npatches ? c->npatches : 1));
+    if (!(c->pvis = malloc((size_t)(c->npatches ? c->npatches : 1)))) goto nomem;
     *state = c;
     return VW_OK;
+nomem: /* the build frees what it made (the runtime calls no cell_free for it) */
+    cell_free(c, S);
+    return VW_E_NOMEM;
 }
 
 static void cell_free(void *state, void *user)

@@ -326,6 +326,68 @@ static int is_convex(const double (*v)[3], int nv, const double n[3])
     return 1;
 }
 
+/* An edge of a polygon in its plane's (u, v) coordinates, for crosses_itself. */
+typedef struct flat_edge {
+    double a[2], b[2];
+    double ulo, uhi, vlo, vhi;
+    int i; /* from corner i to corner i + 1 */
+} flat_edge;
+
+static int by_ulo(const void *x, const void *y)
+{
+    double p = ((const flat_edge *)x)->ulo, q = ((const flat_edge *)y)->ulo;
+    return (p > q) - (p < q);
+}
+
+/* The side of line a->b that c is on: 1 left, -1 right, 0 on it (within rounding). */
+static int side2(const double a[2], const double b[2], const double c[2])
+{
+    double e[2] = {b[0] - a[0], b[1] - a[1]}, f[2] = {c[0] - a[0], c[1] - a[1]};
+    double x = e[0] * f[1] - e[1] * f[0];
+    double tol = 1e-12 * (fabs(e[0]) + fabs(e[1])) * (fabs(f[0]) + fabs(f[1]));
+    return x > tol ? 1 : x < -tol ? -1 : 0;
+}
+
+/* Do two edges of the polygon (corners v on its plane, axes ua, va) cross, each passing
+   strictly through the other? Then it has no one inside: a pentagram turns left at
+   every corner, passes as convex, and fanned covers its centre twice; a bow tie is
+   ear-clipped into nonsense. Edges that only touch (a corner on another edge, a
+   keyhole's two sides of one cut) do not count. The edges are swept by their least u,
+   so a polygon with many corners costs about n log n. *e1, *e2: the corners (from 1)
+   where the two edges start. -1 when out of memory. */
+static int crosses_itself(const double (*v)[3], int nv, const double ua[3], const double va[3],
+                          int *e1, int *e2)
+{
+    if (nv < 4) return 0;
+    flat_edge *e = malloc(sizeof *e * (size_t)nv);
+    if (!e) return -1;
+    for (int i = 0; i < nv; i++) {
+        const double *p = v[i], *q = v[(i + 1) % nv];
+        flat_edge *x = &e[i];
+        x->a[0] = rad_dot(p, ua), x->a[1] = rad_dot(p, va);
+        x->b[0] = rad_dot(q, ua), x->b[1] = rad_dot(q, va);
+        x->ulo = fmin(x->a[0], x->b[0]), x->uhi = fmax(x->a[0], x->b[0]);
+        x->vlo = fmin(x->a[1], x->b[1]), x->vhi = fmax(x->a[1], x->b[1]);
+        x->i = i;
+    }
+    qsort(e, (size_t)nv, sizeof *e, by_ulo);
+    int found = 0;
+    for (int i = 0; i < nv && !found; i++)
+        for (int j = i + 1; j < nv && e[j].ulo <= e[i].uhi && !found; j++) {
+            const flat_edge *x = &e[i], *y = &e[j];
+            int d = abs(x->i - y->i);
+            if (d == 1 || d == nv - 1 || y->vlo > x->vhi || y->vhi < x->vlo) continue;
+            if (side2(x->a, x->b, y->a) * side2(x->a, x->b, y->b) < 0 &&
+                side2(y->a, y->b, x->a) * side2(y->a, y->b, x->b) < 0) {
+                found = 1;
+                *e1 = 1 + (x->i < y->i ? x->i : y->i);
+                *e2 = 1 + (x->i < y->i ? y->i : x->i);
+            }
+        }
+    free(e);
+    return found;
+}
+
 /* A convex part of a concave polygon, as corner numbers in the polygon's winding. */
 typedef struct part {
     int n;
@@ -503,6 +565,22 @@ vw_status rad_mesh_build(const vw_scene *s, const char *path, const vw_decomp *d
             rad_sub(flat[i], cen, q);
             double dd = rad_dot(q, normal);
             for (int c = 0; c < 3; c++) flat[i][c] -= dd * normal[c];
+        }
+        int c1 = 0, c2 = 0, crossed = crosses_itself((const double (*)[3])flat, nv, ua, va, &c1, &c2);
+        if (crossed < 0) {
+            free(flat);
+            st = VW_E_NOMEM;
+            break;
+        }
+        if (crossed) {
+            where(at, sizeof at, path, k);
+            snprintf(err, errlen,
+                     "%s: polygon (id %d) crosses itself (its edges from corners %d and %d): "
+                     "radiosity takes simple polygons only; split it",
+                     at, pg->id, c1, c2);
+            free(flat);
+            st = VW_E_INPUT;
+            break;
         }
         if (is_convex(flat, nv, normal)) {
             /* Large polygons are fanned into chunks that fit RAD_MAXV after clipping. */

@@ -18,6 +18,18 @@ cp "$SRC/nonplanar.obj" "$SRC/light.mtl" "$T/"
 grep -q "nonplanar.obj:7: polygon (id 0) is not planar" "$T/err" || fail "non-planar: message: $(cat "$T/err")"
 [ ! -e "$T/b.ply" ] || fail "non-planar: output written"
 
+# Polygons that cross themselves: no one inside to mesh (a star was fanned over its
+# centre twice).
+cp "$SRC/star.obj" "$SRC/bowtie.obj" "$T/"
+for case in "star.obj:11:corners 2 and 4" "bowtie.obj:10:corners 1 and 3"; do
+  f=${case%%:*} rest=${case#*:}
+  "$V" radiosity "$T/$f" -o "$T/s.ply" 2>"$T/err"; rc=$?
+  [ $rc -eq 2 ] || fail "$f: exit $rc"
+  grep -q "$f:${rest%%:*}: polygon (id 0) crosses itself (its edges from ${rest#*:})" "$T/err" \
+    || fail "$f: message: $(cat "$T/err")"
+  [ ! -e "$T/s.ply" ] || fail "$f: output written"
+done
+
 "$V" radiosity "$T/missing.obj" -o "$T/c.ply" 2>"$T/err"; rc=$?
 [ $rc -eq 2 ] || fail "missing file: exit $rc"
 "$V" radiosity "$T/nonplanar.obj" -o "$T/c.ply" --hemicube 7 2>"$T/err"; rc=$?

@@ -306,7 +306,8 @@ static void help(const char *cmd)
         printf("usage: vwalls animate SCENE EDITS -o 'frames/%%04d.png' [options]\n"
                "\nRuns the edit script EDITS (docs/edit-language.md) on SCENE: moves are checked\n"
                "for collisions at their destination (and along their path with 'sweep on') by\n"
-               "cells of the decomposition; every 'frame' renders a PNG.\n");
+               "cells of the decomposition; every 'frame' renders a PNG. Under MPI the first\n"
+               "process reads EDITS and hands it to the others.\n");
     printf("  -o PATTERN       frame file names: a .png name with one %%d (like %%04d) for the\n"
            "                   frame number (from 0), %%%% for a percent sign\n"
            "  --cells L        layout of cells, like 4, 2x4, 2x2x2 (default 1)\n"
@@ -364,31 +365,101 @@ static char *frames_json(const vw_anim_session *s)
     return j;
 }
 
-/* The next line of the edits (getline's length, <= 0 at the end; *read_error gets errno
-   when reading failed). A file is read by every process. Standard input is read by the
-   output process alone, which hands each line to the others: MPI launchers forward
-   stdin to rank 0 only, and every process must apply the same edits in the same order. */
-static ssize_t next_line(FILE *in, int from_output, char **line, size_t *cap, int *read_error)
+/* Where the edits come from. Every process must apply the same edits in the same order:
+   a line bad on one host only would stop that process alone while the others wait in the
+   next collective. So the output process alone reads them and hands them to the others.
+   A script file is read whole and broadcast once (its length, then its bytes); standard
+   input (vwalls edit) must stream, as a line is answered before the next is typed, so it
+   is broadcast a line at a time (MPI launchers forward stdin to rank 0 alone anyway). */
+typedef struct edits_src {
+    char *text;         /* the script file's bytes, on every process; NULL for stdin */
+    size_t len, pos;    /* its length and the start of the next line */
+    char *line;         /* stdin: the current line, on every process */
+    size_t cap;
+} edits_src;
+
+/* Reads the script at path whole on the output process, and gives every process its
+   bytes. Collective; every process returns the same status, the message in err:
+   VW_E_INPUT when the script cannot be opened (bad input: exit status 2), VW_E_IO or
+   VW_E_NOMEM when it cannot be read or held. */
+static vw_status edits_load(edits_src *e, const char *path, char *err, size_t errlen)
 {
-    ssize_t len = 0;
-    if (!from_output || vw_cli_is_output()) {
-        len = getline(line, cap, in);
-        *read_error = len < 0 && ferror(in) ? errno : 0;
+    vw_status st = VW_OK;
+    int64_t len = 0;
+    if (vw_cli_is_output()) {
+        FILE *in = fopen(path, "r");
+        struct stat sb;
+        if (!in || (fstat(fileno(in), &sb) == 0 && S_ISDIR(sb.st_mode))) {
+            snprintf(err, errlen, "cannot open '%s': %s", path, in ? strerror(EISDIR) : strerror(errno));
+            st = VW_E_INPUT;
+        } else {
+            size_t cap = 0, n = 0, k;
+            char *p;
+            do {
+                if (n == cap) {
+                    cap = cap ? 2 * cap : 65536;
+                    if (!(p = realloc(e->text, cap + 1))) {
+                        snprintf(err, errlen, "out of memory reading '%s'", path);
+                        st = VW_E_NOMEM;
+                        break;
+                    }
+                    e->text = p;
+                }
+                n += k = fread(e->text + n, 1, cap - n, in);
+            } while (k > 0);
+            if (st == VW_OK && ferror(in)) {
+                snprintf(err, errlen, "cannot read '%s': %s", path, strerror(errno ? errno : EIO));
+                st = VW_E_IO;
+            }
+            len = (int64_t)n;
+        }
+        if (in) fclose(in);
     }
-    if (!from_output) return len;
+    if ((st = vw_engine_agree(st, err, errlen)) != VW_OK) return st;
+    vw_engine_broadcast(&len, sizeof len);
+    if (!vw_cli_is_output() && !(e->text = malloc((size_t)len + 1))) {
+        snprintf(err, errlen, "out of memory for the %lld bytes of '%s'", (long long)len, path);
+        st = VW_E_NOMEM;
+    }
+    if ((st = vw_engine_agree(st, err, errlen)) != VW_OK) return st;
+    vw_engine_broadcast(e->text, (size_t)len);
+    e->text[len] = 0;
+    e->len = (size_t)len;
+    return VW_OK;
+}
+
+/* The next line of the edits, with its line end (its length, <= 0 at the end;
+   *read_error gets errno when reading stdin failed). Collective for stdin. */
+static ssize_t next_line(edits_src *e, const char **line, int *read_error)
+{
+    *read_error = 0;
+    if (e->text) {
+        if (e->pos >= e->len) return 0;
+        const char *p = e->text + e->pos, *nl = memchr(p, '\n', e->len - e->pos);
+        size_t n = nl ? (size_t)(nl - p) + 1 : e->len - e->pos;
+        e->pos += n;
+        *line = p;
+        return (ssize_t)n;
+    }
+    ssize_t len = 0;
+    if (vw_cli_is_output()) {
+        len = getline(&e->line, &e->cap, stdin);
+        *read_error = len < 0 && ferror(stdin) ? errno : 0;
+    }
     int64_t head[2] = {len, *read_error};
     vw_engine_broadcast(head, sizeof head);
     len = (ssize_t)head[0];
     *read_error = (int)head[1];
     if (len <= 0) return len;
-    if (!vw_cli_is_output() && *cap < (size_t)len + 1) {
-        char *p = realloc(*line, (size_t)len + 1);
+    if (!vw_cli_is_output() && e->cap < (size_t)len + 1) {
+        char *p = realloc(e->line, (size_t)len + 1);
         if (!p) vw_engine_abort(VW_EXIT_FAIL, "vwalls edit: out of memory for a line of stdin");
-        *line = p;
-        *cap = (size_t)len + 1;
+        e->line = p;
+        e->cap = (size_t)len + 1;
     }
-    vw_engine_broadcast(*line, (size_t)len);
-    (*line)[len] = 0;
+    vw_engine_broadcast(e->line, (size_t)len);
+    e->line[len] = 0;
+    *line = e->line;
     return len;
 }
 
@@ -396,6 +467,7 @@ static ssize_t next_line(FILE *in, int from_output, char **line, size_t *cap, in
 int vw_anim_main(const char *cmd, int argc, char **argv)
 {
     const char *scene_path = NULL, *edits_path = NULL, *stats = NULL, *log_path = NULL;
+    edits_src ed = {0};
     vw_anim_session *s = calloc(1, sizeof *s);
     /* Before the options are read: this process cannot know where the others will next
        agree (a usage error returns before any collective call), so it ends the job. */
@@ -484,45 +556,30 @@ int vw_anim_main(const char *cmd, int argc, char **argv)
     p.farm = (rt_farm)vw_cli_farm_resolve(farm, s->strategy != NULL); /* as render's */
     s->farm = p.farm;
     double t_start = vw_cli_now();
-    /* Under MPI every process opens the edits and reads the scene; all stop if one
-       cannot (a file missing on one host), and the output process says which and why. */
-    FILE *in = stdin;
-    s->name = "stdin";
+    /* Under MPI the output process reads the edits (edits_load) and every process reads
+       the scene; all stop if one cannot (a file missing on one host), and the output
+       process says which and why. */
+    s->name = edits_path ? edits_path : "stdin";
     char err[1024] = "";
-    vw_status ost = VW_OK;
-    if (edits_path) {
-        in = fopen(edits_path, "r");
-        struct stat sb;
-        if (!in || (fstat(fileno(in), &sb) == 0 && S_ISDIR(sb.st_mode))) {
-            snprintf(err, sizeof err, "cannot open '%s': %s", edits_path,
-                     in ? strerror(EISDIR) : strerror(errno));
-            if (in) fclose(in);
-            in = NULL;
-            ost = VW_E_IO;
-        }
-        s->name = edits_path;
-    }
-    if (vw_engine_agree(ost, err, sizeof err) != VW_OK) {
+    vw_status est = edits_path ? edits_load(&ed, edits_path, err, sizeof err) : VW_OK;
+    if (est != VW_OK) {
         vw_cli_error(cmd, "%s", err);
-        if (in && in != stdin) fclose(in);
+        rc = est == VW_E_INPUT ? VW_EXIT_USAGE : VW_EXIT_FAIL;
         goto done;
     }
     vw_scene *scene = NULL;
     if (vw_engine_agree(vw_scene_read_file(scene_path, &scene, err, sizeof err), err, sizeof err) != VW_OK) {
         if (vw_cli_is_output()) fprintf(stderr, "%s\n", err);
         vw_scene_free(scene);
-        if (in != stdin) fclose(in);
         goto done;
     }
     if (vw_cli_same_view(cmd, p.width, p.height, depth, &scene->camera, scene)) {
         vw_scene_free(scene);
-        if (in != stdin) fclose(in);
         goto done;
     }
     vw_status st = rt_anim_create(scene, &p, &s->anim, err, sizeof err);
     if (st != VW_OK) {
         vw_cli_error(cmd, "%s", err);
-        if (in != stdin) fclose(in);
         rc = st == VW_E_INVAL ? VW_EXIT_USAGE : VW_EXIT_FAIL; /* as render's */
         goto done;
     }
@@ -530,7 +587,6 @@ int vw_anim_main(const char *cmd, int argc, char **argv)
         vw_status lst = vw_cli_is_output() ? vw_outfile_open(log_path, &s->logf, err, sizeof err) : VW_OK;
         if (vw_engine_agree(lst, err, sizeof err) != VW_OK) {
             vw_cli_error(cmd, "%s", err);
-            if (in != stdin) fclose(in);
             rc = VW_EXIT_FAIL;
             goto done;
         }
@@ -538,8 +594,7 @@ int vw_anim_main(const char *cmd, int argc, char **argv)
     }
     /* Whole lines, however long (the parser refuses a long command; a long comment is
        fine), so no tail of a line is ever read as a line of its own. */
-    char *line = NULL;
-    size_t cap = 0;
+    const char *line = NULL;
     ssize_t len;
     int lineno = 0;
     if (s->interactive) {
@@ -549,7 +604,7 @@ int vw_anim_main(const char *cmd, int argc, char **argv)
     }
     int read_error = 0;
     int stop = 0;
-    while (!stop && (len = next_line(in, in == stdin, &line, &cap, &read_error)) > 0) {
+    while (!stop && (len = next_line(&ed, &line, &read_error)) > 0) {
         /* A lone CR ends a line too (classic Mac OS files), as in the NFF and OBJ
            readers; CRLF is one line end. The parser stops at the CR, so each piece is
            handed over in place. */
@@ -563,11 +618,9 @@ int vw_anim_main(const char *cmd, int argc, char **argv)
         }
         if (s->interactive) fflush(stdout);
     }
-    free(line);
     if (!s->failed) flush(s);
-    if (in != stdin) fclose(in);
     if (read_error && !s->failed) {
-        vw_cli_error(cmd, "cannot read '%s': %s", edits_path ? edits_path : "stdin", strerror(read_error));
+        vw_cli_error(cmd, "cannot read 'stdin': %s", strerror(read_error));
         s->failed = 1;
     }
     say(s, "%s: %zu accepted, %zu rejected at the destination, %zu rejected along the path, "
@@ -601,6 +654,8 @@ int vw_anim_main(const char *cmd, int argc, char **argv)
     /* A bad line is bad input even when the session went on past it (--keep-going, edit). */
     rc = s->failed ? s->failed : s->bad_lines ? VW_EXIT_USAGE : VW_EXIT_OK;
 done:
+    free(ed.text);
+    free(ed.line);
     vw_outfile_abort(s->logf);
     rt_anim_free(s->anim);
     free(s->frames);

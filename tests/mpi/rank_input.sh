@@ -2,7 +2,9 @@
 # rank_input.sh - input and output that only some ranks have never leave a rank waiting:
 #   * vwalls edit reads stdin, which the launcher gives rank 0 alone: every rank must
 #     apply the same edits (same log and frames as the single process's);
-#   * a scene or an edit script missing on one rank stops every rank, naming it, and
+#   * vwalls animate's edit script is rank 0's, read there and handed to every rank, so
+#     a script that differs (or is missing) on another rank changes nothing;
+#   * a scene missing on one rank stops every rank, naming it, and
 #     another --workers, --depth or camera on one rank is named as such, and so is
 #     another radiosity option that changes the solution (--sf, --hemicube, ...);
 #   * gen -o is written by rank 0 alone, and warnings about a scene come from rank 0;
@@ -66,9 +68,30 @@ run "render, scene missing on rank 1" 2 "rank 1: .*s1.nff" \
 # shellcheck disable=SC2086
 run "animate, scene missing on rank 1" 2 "rank 1: .*s1.nff" \
     sh -c "exec \"$vwalls\" animate \"$dir/s$rank.nff\" \"$dir/edits\" -o \"$dir/a%d.png\" $common"
+# The edit script is rank 0's: the others' copies are not read, so one missing there
+# is no error, and one missing on rank 0 is named as such.
 # shellcheck disable=SC2086
-run "animate, edits missing on rank 1" 2 "rank 1: .*e1.txt" \
+run "animate, edits on rank 0 alone" 2 "e0.txt:3: " \
     sh -c "exec \"$vwalls\" animate \"$scene\" \"$dir/e$rank.txt\" -o \"$dir/a%d.png\" $common"
+# shellcheck disable=SC2086
+run "animate, edits missing on rank 0" 2 "rank 0: .*e1.txt" \
+    sh -c "exec \"$vwalls\" animate \"$scene\" \"$dir/e$wrank.txt\" -o \"$dir/a%d.png\" $common"
+# An edit script that differs between ranks, with a line bad on rank 1 alone: every
+# rank runs rank 0's (rank 1 used to stop at its bad line while rank 0 waited for it
+# in the next collective), so the frames are the single process's.
+printf 'move 0 0.01 0 0\nframe\nmove 1 0 0.01 0\nframe\n' >"$dir/d0.txt"
+printf 'move 0 0.01 0 0\nframe\nbogus\nmove 1 0 0.01 0\nframe\n' >"$dir/d1.txt"
+mkdir "$dir/d1" "$dir/dm"
+# shellcheck disable=SC2086
+"$vwalls" animate "$scene" "$dir/d0.txt" -o "$dir/d1/%d.png" $common --quiet ||
+  { echo "FAIL: animate $dir/d0.txt: status $?"; fail=1; }
+# shellcheck disable=SC2086
+if run "animate, an edit script bad on rank 1 alone" 0 "" \
+    sh -c "exec \"$vwalls\" animate \"$scene\" \"$dir/d$rank.txt\" -o \"$dir/dm/%d.png\" $common --quiet"; then
+    for f in 0 1; do
+        cmp "$dir/d1/$f.png" "$dir/dm/$f.png" || { echo "FAIL: animate: frame $f differs"; fail=1; }
+    done
+fi
 
 # A scene whose camera differs on rank 1, and another --depth there: each would draw
 # another image (the world's check compares only cells and object bounds).

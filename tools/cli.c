@@ -29,8 +29,7 @@ int vw_cli_fault(const char *name)
 
 int vw_cli_job_workers(long workers)
 {
-    long cores = sysconf(_SC_NPROCESSORS_ONLN);
-    return (int)(workers > 0 ? workers : cores > 0 ? cores : 1) * vw_engine_size();
+    return vw_engine_workers((int)workers) * vw_engine_size();
 }
 
 void vw_cli_error(const char *cmd, const char *fmt, ...)

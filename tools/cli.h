@@ -52,8 +52,9 @@ int vw_cli_fault(const char *name);
 
 /* Is this process the one that prints (rank 0, or no MPI)? Valid after vw_cli_engine_init. */
 int vw_cli_is_output(void);
-/* Workers of the whole job: --workers W (0: the world's default, one per core) times
-   the processes. Valid after vw_cli_engine_init. */
+/* Workers of the whole job: --workers W (0: the world's default, one per core, and under
+   MPI the fewest cores of any host, as the world takes them) times the processes, the
+   same on every process. Collective under MPI; valid after vw_cli_engine_init. */
 int vw_cli_job_workers(long workers);
 
 /* Under MPI, checks that every process holds the same n numbers v as the first process

@@ -30,7 +30,8 @@ static void help(void)
            "virtual walls. The image is bit-identical for every layout and worker count.\n"
            "  -o FILE          output image, .png (8-bit) or .pfm (float, unclamped)\n"
            "  --cells L        layout of cells, like 4, 2x4, 2x2x2 (default 1)\n"
-           "  --workers W      worker threads per process (default: number of cores)\n"
+           "  --workers W      worker threads per process (default: number of cores; under\n"
+           "                   MPI, of the host with fewest)\n"
            "  --size WxH       image size (default: the scene's, else 512x512)\n"
            "  --depth D        maximum ray depth, eye rays being depth 1 (default 5)\n"
            "  --from X,Y,Z --at X,Y,Z --up X,Y,Z --angle DEG\n"
@@ -64,7 +65,9 @@ static void help(void)
            "  --map K          block (default) | greedy (by load) | weighted (by --speeds)\n"
            "  --speeds LIST    relative speed of every worker, like 1,1,2,4: --map weighted\n"
            "                   maps by them, and copies of cells take shares of the work\n"
-           "                   in proportion (--slow W:K gives worker W the speed 1/K)\n"
+           "                   in proportion (--slow W:K gives worker W the speed 1/K);\n"
+           "                   one per worker of the job: processes x --workers (default:\n"
+           "                   the cores of the host with fewest)\n"
            "  --slow W:K[,..]  worker W does its work K times slower, K from 1 to 1000\n"
            "                   (emulates a slow machine)\n"
            "  --overlay-by B   load (default): each cell by its measured load; worker: each\n"
@@ -342,7 +345,8 @@ int vw_cmd_render(int argc, char **argv)
     }
 
     /* Workers of the whole job, for --speeds and --slow (the world's own default when
-       --workers is not given: one per core). */
+       --workers is not given: one per core, under MPI the fewest cores of any host, so
+       every host expects as many speeds). */
     int gw = vw_cli_job_workers(workers);
     /* Up to the world's creation, each process checks what it has itself (its memory,
        its scene file: every process reads its own copy) and all agree at the end of
@@ -357,7 +361,13 @@ int vw_cmd_render(int argc, char **argv)
             rc = vw_cli_fail(CMD, VW_EXIT_FAIL, err, sizeof err, "out of memory for --speeds");
         else if (vw_map_parse_speeds(speeds_s, speeds, gw) != VW_OK)
             rc = vw_cli_fail(CMD, VW_EXIT_USAGE, err, sizeof err, "--speeds: bad value '%s' "
-                             "(expected %d positive numbers, one per worker)", speeds_s, gw);
+                             "(expected %d positive numbers, one per worker: %d process%s x %d "
+                             "worker%s%s)", speeds_s, gw, vw_engine_size(),
+                             vw_engine_size() == 1 ? "" : "es", gw / vw_engine_size(),
+                             gw / vw_engine_size() == 1 ? "" : "s",
+                             workers > 0 ? "" : vw_engine_size() == 1 ? ", one per core; --workers sets them"
+                                                                      : ", one per core of the host with "
+                                                                        "fewest; --workers sets them");
     }
     if (rc == VW_EXIT_OK && slow_s) {
         slowdown = malloc(sizeof(double) * (size_t)gw);

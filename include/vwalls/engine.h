@@ -51,6 +51,13 @@ VW_API vw_status vw_world_agree(vw_world *w, vw_status local, char *msg, size_t 
    nothing without MPI or with one process. */
 VW_API void vw_engine_broadcast(void *buf, size_t n);
 
+/* Workers per process of a world created on MPI_COMM_WORLD with vw_config.workers =
+   workers: workers when positive; otherwise one per core, and under MPI the fewest cores
+   of any process, which every process of the world then runs (global worker = rank * W +
+   local). So a tool can size per-worker options (speeds) before the world exists, the
+   same on every host. Collective under MPI: every rank must call it. */
+VW_API int vw_engine_workers(int workers);
+
 #ifdef __cplusplus
 }
 #endif

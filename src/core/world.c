@@ -93,8 +93,12 @@ void vw_config_init(vw_config *c)
 
 int vw__worker_process(const vw_world *w, int global_worker) { return global_worker / w->nworkers; }
 
-static int default_workers(void)
+/* VW_CORES=N counts N cores instead of the machine's (1 to 1024): so tests can play
+   hosts of different sizes on one machine, and a container can say its share. */
+int vw__default_workers(void)
 {
+    uint64_t c = env_u64("VW_CORES");
+    if (c >= 1 && c <= 1024) return (int)c;
     long n = sysconf(_SC_NPROCESSORS_ONLN);
     return n < 1 ? 1 : (int)n;
 }
@@ -264,7 +268,7 @@ vw_status vw_world_create(const vw_module *m, void *user, const vw_decomp *d, co
     if (w->cfg.packet_bytes < 64) w->cfg.packet_bytes = 64;
     w->rank = 0;
     w->nprocs = 1;
-    w->nworkers = w->cfg.workers > 0 ? w->cfg.workers : default_workers();
+    w->nworkers = w->cfg.workers > 0 ? w->cfg.workers : vw__default_workers();
     if (w->nworkers > 1024) {
         create_failed(VW_E_LIMIT, "vw_world_create: %d workers (at most 1024)", w->nworkers);
         free(w);
@@ -278,7 +282,7 @@ vw_status vw_world_create(const vw_module *m, void *user, const vw_decomp *d, co
         free(w);
         return VW_E_LIMIT;
     }
-    w->steal = w->cfg.steal > 0 || (w->cfg.steal < 0 && w->nworkers <= default_workers());
+    w->steal = w->cfg.steal > 0 || (w->cfg.steal < 0 && w->nworkers <= vw__default_workers());
     w->cfg.cell_worker = NULL; /* copied into w->cell_worker below */
     pthread_mutex_init(&w->output_mu, NULL);
     pthread_mutex_init(&w->pool_mu, NULL);
@@ -1063,4 +1067,5 @@ vw_status vw_world_agree(vw_world *w, vw_status local, char *msg, size_t len)
     return w ? local : VW_E_INVAL; /* as the MPI build answers */
 }
 void vw_engine_broadcast(void *buf, size_t n) { (void)buf, (void)n; }
+int vw_engine_workers(int workers) { return workers > 0 ? workers : vw__default_workers(); }
 #endif

@@ -58,6 +58,9 @@ typedef struct vw__packet {
    speeds that is max / mean of t, DESIGN's definition. 1 with no work; INFINITY when a
    speed is not positive and finite or a t is negative, NaN or infinite. */
 double vw__lambda(const double *t, const double *speeds, int n);
+/* One worker per core of this machine (at least one; VW_CORES overrides the count): a
+   world's default worker count. */
+int vw__default_workers(void);
 
 /* A unit's (a cell's, or a copy's) measured busy time, and the inline hand-offs into it
    (vw_ctx_enter) that the meter (runtime.c) noted since its worker last read the clock. */

@@ -160,6 +160,14 @@ void vw_engine_broadcast(void *buf, size_t n)
     }
 }
 
+int vw_engine_workers(int workers)
+{
+    /* The reduction runs whatever this rank's workers, so every rank makes it. */
+    int cores = vw__default_workers(), fewest = cores;
+    if (mpi_up() && vw_engine_size() > 1) MPI_Allreduce(&cores, &fewest, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
+    return workers > 0 ? workers : fewest;
+}
+
 vw_status vw_world_agree(vw_world *w, vw_status local, char *msg, size_t len)
 {
     if (!w) return VW_E_INVAL;

@@ -109,6 +109,15 @@ run "render, another worker count on rank 1" 2 "different worker counts" \
     sh -c "exec \"$vwalls\" render \"$scene\" -o \"$dir/r.png\" --size 48x48 --cells 2x2x2 --workers $wrank"
 run "example-pairs, another worker count on rank 1" 1 "different worker counts" \
     sh -c "exec \"$vwalls\" example-pairs --spheres 500 --workers $wrank"
+# Hosts of 2 and 3 cores (VW_CORES) without --workers: every process runs 2 workers, the
+# fewest, so --speeds takes 2 x 2 numbers on both (rank 1 used to expect 6 and stop);
+# a wrong count says where the count comes from.
+cores='$(('"$rank"' + 2))'
+run "render --speeds, hosts of 2 and 3 cores" 0 "" \
+    sh -c "export VW_CORES=$cores; exec \"$vwalls\" render \"$scene\" -o \"$dir/r.png\" --size 48x48 --cells 2x2x2 --speeds 1,2,1,2 --quiet"
+run "render --speeds, a wrong count on hosts of 2 and 3 cores" 2 \
+    "expected 4 positive numbers, one per worker: 2 processes x 2 workers, one per core of the host with fewest; --workers sets them" \
+    sh -c "export VW_CORES=$cores; exec \"$vwalls\" render \"$scene\" -o \"$dir/r.png\" --size 48x48 --cells 2x2x2 --speeds 1,2,1,2,1,2 --quiet"
 
 # Outputs into a missing directory: status 1, as the single process's.
 # shellcheck disable=SC2086

@@ -39,7 +39,8 @@ static void help(void)
            "                   above 0 and below 180 degrees, as in an NFF file)\n"
            "  --light X,Y,Z[,R,G,B]  replace the scene's lights: each --light adds one point\n"
            "                   light (up to 64); without a colour, 1/sqrt(lights) each,\n"
-           "                   as NFF gives a light without one\n"
+           "                   as NFF gives a light without one; a colour is taken as an\n"
+           "                   NFF 'l' takes it (negative darkens)\n"
            "  --stats FILE     write the stats JSON\n"
            "  --overlay FILE   write a PNG of the image with the walls drawn and each cell's\n"
            "                   pixels tinted by its measured load (green light .. red heavy)\n"
@@ -190,6 +191,7 @@ int vw_cmd_render(int argc, char **argv)
     double from[3], at[3], up[3], angle = 0;
     int has_from = 0, has_at = 0, has_up = 0, has_angle = 0;
     vw_light lights[MAX_LIGHTS];
+    int light_color[MAX_LIGHTS]; /* was the colour given? */
     int nlights = 0;
     const char *speeds_s = NULL, *slow_s = NULL;
     vw_balance_strategy strategy = VW_BALANCE_NONE;
@@ -304,15 +306,18 @@ int vw_cmd_render(int argc, char **argv)
             if (vw_cli_numbers(CMD, a, v = vw_cli_value(CMD, argc, argv, &i), "X,Y,Z or X,Y,Z,R,G,B",
                                l, 3, 6, &n))
                 return VW_EXIT_USAGE;
-            if ((n != 3 && n != 6) || (n == 6 && !(l[3] >= 0 && l[4] >= 0 && l[5] >= 0))) {
-                vw_cli_error(CMD, "--light: bad value '%s' (expected X,Y,Z or X,Y,Z,R,G,B with "
-                                  "a colour of at least 0)", v);
+            /* The colour as an NFF 'l' line takes it (nff.c): any number that fits a
+               float, which vw_cli_numbers checks, negative too (a negative light
+               darkens, as in POV-Ray; the pixel sums are signed). */
+            if (n != 3 && n != 6) {
+                vw_cli_error(CMD, "--light: bad value '%s' (expected X,Y,Z or X,Y,Z,R,G,B)", v);
                 return VW_EXIT_USAGE;
             }
+            light_color[nlights] = n == 6;
             vw_light *L = &lights[nlights++];
             for (int k = 0; k < 3; k++) {
                 L->pos[k] = l[k];
-                L->color[k] = n == 6 ? (float)l[3 + k] : -1.0f; /* -1: not given */
+                L->color[k] = n == 6 ? (float)l[3 + k] : 0.0f;
             }
         } else if (!strcmp(a, "--angle")) {
             /* Any angle an NFF file may give, which the ray tracer takes as given. */
@@ -413,7 +418,7 @@ int vw_cmd_render(int argc, char **argv)
             float dflt = (float)(1.0 / sqrt((double)nlights));
             for (int k = 0; k < nlights; k++) {
                 L[k] = lights[k];
-                if (L[k].color[0] < 0) L[k].color[0] = L[k].color[1] = L[k].color[2] = dflt;
+                if (!light_color[k]) L[k].color[0] = L[k].color[1] = L[k].color[2] = dflt;
             }
             free(scene->lights);
             scene->lights = L;

@@ -247,7 +247,7 @@ static void begin(nff *P, const char *entity, int line)
 static vw_status parse_view(nff *P)
 {
     vw_camera *cam = &P->b.s->camera;
-    int view_line = P->entity_line;
+    int view_line = P->entity_line, up_line = 0;
     int have_from = 0, have_at = 0, have_up = 0, have_angle = 0;
     /* Not every NFF writer gives hither and resolution, and SPD's own reader (ReadNFF)
        takes a 'v' block without them: they default to 1 and to vwalls render's
@@ -270,6 +270,7 @@ static vw_status parse_view(nff *P)
             have_at = 1;
         } else if (tok_is(&t, "up")) {
             begin(P, "up", t.line);
+            up_line = t.line;
             st = read_nums(P, cam->up, 3);
             have_up = 1;
         } else if (tok_is(&t, "angle")) {
@@ -301,9 +302,11 @@ static vw_status parse_view(nff *P)
                         : !have_angle ? "angle" : NULL;
     if (missing)
         return fail(P, view_line, "'v' block without '%s'", missing);
+    /* A problem of 'up' alone (vw_camera_problem names it first) is the up line's, where
+       the user will look; one of from and at together is the block's. */
     const char *problem = vw_camera_problem(cam);
     if (problem)
-        return fail(P, view_line, "%s", problem);
+        return fail(P, strncmp(problem, "'up'", 4) ? view_line : up_line, "%s", problem);
     cam->valid = 1;
     P->have_v = 1;
     return VW_OK;

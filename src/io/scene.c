@@ -624,6 +624,8 @@ VW_API vw_status vw_scene_find_object(const vw_scene *s, int id, vw_prim_kind *k
     return VW_E_INVAL;
 }
 
+/* A message that blames 'up' alone begins with 'up' (the NFF reader then names the
+   up line). */
 VW_API const char *vw_camera_problem(const vw_camera *cam)
 {
     double d[3], c[3];

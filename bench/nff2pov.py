@@ -1,14 +1,28 @@
 #!/usr/bin/env python3
 """nff2pov.py - converts an NFF scene to POV-Ray 3.7 SDL for bench/raytrace.sh, matching
 vwalls render's conventions: no ambient, diffuse = colour * Kd, Phong highlight Ks with
-exponent Shine, mirror reflection Ks (per channel from the extension lines '#vw Ks r g b'
-and '#vw Kr r g b' that vwalls writes after an 'f'; the highlight keeps the 'f' line's
-Ks, and '#vw Ke' is not converted), transmission T with ior, lights without colour at
+exponent Shine, mirror reflection Ks, transmission T with ior, lights without colour at
 1/sqrt(#lights), linear output (assumed_gamma 1), the same camera (NFF angle is the
 vertical field of view; POV's is horizontal) and a right-handed image. Polygons of more
 than three corners become POV-Ray polygons (drawn concave or not), pp ones smooth
 triangles by ear clipping: a fan from the first corner covers a concave polygon's
 notches.
+
+The extension lines vwalls writes after an 'f' (docs/raytrace.md) are converted as far
+as POV-Ray can follow them, each from where it stands (objects before it keep the
+material they had):
+  '#vw Ks r g b'  highlight and mirror weight per channel. The mirror is exact
+                  (reflection rgb). POV-Ray's phong has one amount for every channel
+                  (times the light's colour), or with 'metallic' times the pigment's
+                  colour: equal channels are exact, channels in proportion to the 'f'
+                  colour are exact with metallic; other colours get the channels' mean,
+                  said on stderr.
+  '#vw Kr r g b'  the mirror weight alone (reflection rgb): exact.
+  '#vw Ke r g b'  emission, added whatever the lights. POV-Ray's emission is scaled by
+                  the pigment's colour and by (1 - transmit), so it is written divided
+                  by them: exact, except in a channel where the 'f' colour is 0 (or
+                  T is 1), which POV-Ray cannot make emit; said on stderr, and that
+                  channel emits nothing.
 
 usage: nff2pov.py SCENE.nff WIDTH HEIGHT DEPTH > SCENE.pov
 """
@@ -19,12 +33,13 @@ import sys
 def main():
     path, width, height, depth = sys.argv[1], int(sys.argv[2]), int(sys.argv[3]), int(sys.argv[4])
     # NFF is read by tokens, not lines; '#' starts a comment to the end of the line.
-    # The extension lines become a token of their own ('#vwKs', '#vwKr') and their numbers.
+    # The extension lines become a token of their own ('#vwKs', '#vwKr', '#vwKe') and
+    # their numbers.
     toks = []
     with open(path) as f:
         for line in f:
             w = line.split()
-            if len(w) == 5 and w[0] == '#vw' and w[1] in ('Ks', 'Kr'):
+            if len(w) == 5 and w[0] == '#vw' and w[1] in ('Ks', 'Kr', 'Ke'):
                 toks.extend(['#vw' + w[1]] + w[2:])
                 continue
             toks.extend(line.split('#', 1)[0].split())
@@ -43,10 +58,12 @@ def main():
 
     cam = {'from': (0, 0, 5), 'at': (0, 0, 0), 'up': (0, 1, 0), 'angle': 45.0}
     bg = (0, 0, 0)
-    lights, objects, out_mats, mirror = [], [], [], []
-    mat = None
+    # Per material: the 'f' values, and the highlight, mirror and emission colours.
+    lights, objects, out_mats, spec, mirror, emit = [], [], [], [], [], []
+    mat, used = None, False  # used: an object has the current material
     while pos < len(toks):
         t = nxt()
+        used = used or t in ('s', 'c', 'p', 'pp')
         if t == 'v':
             continue
         if t in ('from', 'at', 'up'):
@@ -68,14 +85,26 @@ def main():
             lights.append((p, col))
         elif t == 'f':
             r, g, b, kd, ks, shine, tr, ior = (num() for _ in range(8))
-            mat = len(out_mats)
+            mat, used = len(out_mats), False
             out_mats.append((r, g, b, kd, ks, shine, tr, ior))
+            spec.append((ks, ks, ks))
             mirror.append((ks, ks, ks))
-        elif t in ('#vwKs', '#vwKr'):
+            emit.append((0.0, 0.0, 0.0))
+        elif t in ('#vwKs', '#vwKr', '#vwKe'):
             # Ks sets the mirror weight too (NFF's Ks weights both); Kr, after it, alone.
             rgb = vec()
-            if mat is not None:
+            if mat is None:
+                continue  # vwalls refuses it ('before any f'); nothing to convert
+            if used:  # as vwalls: the objects before it keep their material
+                for a in (out_mats, spec, mirror, emit):
+                    a.append(a[mat])
+                mat, used = len(out_mats) - 1, False
+            if t == '#vwKs':
+                spec[mat] = mirror[mat] = rgb
+            elif t == '#vwKr':
                 mirror[mat] = rgb
+            else:
+                emit[mat] = rgb
         elif t == 's':
             c = vec()
             objects.append('sphere { %s, %r @M%d@ }' % (_v(c), num(), mat))
@@ -125,9 +154,11 @@ def main():
     for i, (r, g, b, kd, ks, shine, tr, ior) in enumerate(out_mats):
         mr = mirror[i]
         refl = '%r' % mr[0] if mr[0] == mr[1] == mr[2] else 'rgb %s' % _v(mr)
+        phong = _highlight(path, i, (r, g, b), spec[i])
+        emission = _emission(path, i, (r, g, b), tr, emit[i])
         o.append('#declare M%d = texture { pigment { rgbt <%r,%r,%r,%r> } '
-                 'finish { ambient 0 emission 0 diffuse %r phong %r phong_size %r reflection %s } }'
-                 % (i, r, g, b, tr, kd, ks, max(shine, 1e-6), refl))
+                 'finish { ambient 0 emission %s diffuse %r phong %s phong_size %r reflection %s } }'
+                 % (i, r, g, b, tr, emission, kd, phong, max(shine, 1e-6), refl))
     # Interiors (the ior) belong to objects, not textures.
     for ob in objects:
         head, m, tail = ob.rsplit('@', 2)[0], None, None
@@ -137,6 +168,45 @@ def main():
         inside = ' interior { ior %r }' % ior if tr > 0 else ''
         o.append(parts[0] + 'texture { M%d }%s' % (m, inside) + parts[2])
     print('\n'.join(o))
+
+
+def _highlight(path, i, pigment, ks):
+    """POV-Ray's phong for the highlight colour ks: one amount (times the light), or
+    with metallic times the pigment's colour too."""
+    if ks[0] == ks[1] == ks[2]:
+        return '%r' % ks[0]
+    # In proportion to the pigment: amount k with metallic, exact.
+    k = [ks[c] / pigment[c] for c in range(3) if pigment[c] != 0]
+    if k and all(ks[c] == 0 for c in range(3) if pigment[c] == 0) and \
+            max(k) - min(k) <= 1e-9 * max(abs(x) for x in k):
+        return '%r metallic' % k[0]
+    mean = sum(ks) / 3
+    sys.stderr.write('%s: material %d: highlight \'#vw Ks %r %r %r\': POV-Ray\'s phong has one '
+                     'amount for all channels (or one in proportion to the pigment %r %r %r): '
+                     'converted as their mean, %r\n' % ((path, i) + tuple(ks) + tuple(pigment) + (mean,)))
+    return '%r' % mean
+
+
+def _emission(path, i, pigment, tr, ke):
+    """POV-Ray's emission for vwalls' Ke: POV scales it by the pigment's colour and by
+    (1 - transmit), so it is divided by them; a channel where they are 0 cannot emit."""
+    if ke == (0.0, 0.0, 0.0):
+        return '0'
+    out, lost = [], []
+    for c in range(3):
+        scale = pigment[c] * (1 - tr)
+        if scale != 0:
+            out.append(ke[c] / scale)
+        else:
+            out.append(0.0)
+            if ke[c] != 0:
+                lost.append('rgb'[c])
+    if lost:
+        sys.stderr.write('%s: material %d: emission \'#vw Ke %r %r %r\': POV-Ray scales emission '
+                         'by the pigment (%r %r %r) and by 1 - transmit (%r), which are 0 in '
+                         'channel %s: it emits nothing there\n'
+                         % ((path, i) + tuple(ke) + tuple(pigment) + (1 - tr, ', '.join(lost))))
+    return 'rgb %s' % _v(out)
 
 
 def _triangulate(vs):

@@ -16,6 +16,7 @@ extern "C" {
 #endif
 
 typedef struct vw_world vw_world;
+typedef struct vw_config vw_config;
 
 /* Nonzero when the build has MPI and the process is part of an MPI job: MPI is already
    initialised, or an MPI launcher (mpirun, mpiexec, srun) started it. */
@@ -41,9 +42,19 @@ VW_API int vw_engine_size(void);
    every rank returns the status of the lowest failing rank, and msg (of size len) holds
    "rank R: <its message>" on every rank. vw_engine_agree runs on MPI_COMM_WORLD (usable
    before a world exists), vw_world_agree on the world's communicator (VW_E_INVAL for a
-   NULL world, with MPI or without). */
+   NULL world, with MPI or without). vw_config_agree runs on the communicator a world
+   made with config c would run on (c->mpi_comm, or MPI_COMM_WORLD when c or its
+   mpi_comm is NULL), before that world exists: a program that prepares rank-local
+   input for vw_world_create (reads, checks, allocates) calls it once with that
+   preparation's status before vw_world_create, so a rank that failed alone does not
+   return while the others wait in vw_world_create; after the world exists,
+   vw_world_agree does the same before the next collective step. Like vw_world_create
+   it initialises MPI when the process was started by a launcher and nobody did; where
+   the world would run on the threads engine alone (or on one process) it returns
+   local and leaves msg as it is. */
 VW_API vw_status vw_engine_agree(vw_status local, char *msg, size_t len);
 VW_API vw_status vw_world_agree(vw_world *w, vw_status local, char *msg, size_t len);
+VW_API vw_status vw_config_agree(const vw_config *c, vw_status local, char *msg, size_t len);
 
 /* Broadcast (collective on MPI_COMM_WORLD: every rank must call it with the same n): the
    n bytes at buf on rank 0 replace those at buf on every other rank. For input only rank

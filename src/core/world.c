@@ -1066,6 +1066,11 @@ vw_status vw_world_agree(vw_world *w, vw_status local, char *msg, size_t len)
     (void)msg, (void)len;
     return w ? local : VW_E_INVAL; /* as the MPI build answers */
 }
+vw_status vw_config_agree(const vw_config *c, vw_status local, char *msg, size_t len)
+{
+    (void)c, (void)msg, (void)len;
+    return local;
+}
 void vw_engine_broadcast(void *buf, size_t n) { (void)buf, (void)n; }
 int vw_engine_workers(int workers) { return workers > 0 ? workers : vw__default_workers(); }
 #endif

@@ -168,6 +168,27 @@ int vw_engine_workers(int workers)
     return workers > 0 ? workers : fewest;
 }
 
+/* On the communicator vw__mpi_attach will choose for a world made with c, without making
+   the world: the application's own set-up before vw_world_create can then fail on one
+   rank and still meet the others in the same collective call. Where no communicator can
+   be had (one was given but MPI is not initialised), vw_world_create fails alike on
+   every rank, so local is all there is to say. */
+vw_status vw_config_agree(const vw_config *c, vw_status local, char *msg, size_t len)
+{
+    int init = 0;
+    MPI_Initialized(&init);
+    if (!(c && c->mpi_comm) && !init && vw__mpi_launcher_env()) {
+        char why[300];
+        (void)vw__mpi_autoinit(why, sizeof why); /* (a low thread level: create will say) */
+    }
+    if (!mpi_up()) return local; /* the threads engine alone */
+    MPI_Comm base = c && c->mpi_comm ? *(const MPI_Comm *)c->mpi_comm : MPI_COMM_WORLD;
+    int size = 1;
+    MPI_Comm_size(base, &size);
+    if (size == 1) return local;
+    return vw__mpi_agree(base, local, msg, len);
+}
+
 vw_status vw_world_agree(vw_world *w, vw_status local, char *msg, size_t len)
 {
     if (!w) return VW_E_INVAL;

@@ -11,6 +11,7 @@
  *                       [--fail STEP --fail-rank R] [--wire]
  * Runs alone (threads engine) or under mpirun; honours VW_STRESS / VW_STRESS_SPLIT.
  */
+#include <mpi.h>
 #include <signal.h>
 #include <string.h>
 #include <unistd.h>
@@ -184,6 +185,46 @@ static void test_agree(int bad)
         CHECK_EQ_INT(st, VW_OK);
     }
     CHECK_EQ_INT(vw_engine_agree(VW_OK, NULL, 0), VW_OK);
+}
+
+/* vw_config_agree agrees on the communicator a configuration names, before any world:
+   MPI_COMM_WORLD when it names none (as vw_engine_agree), else that one alone. Rank
+   `bad` fails; with the job split into even and odd ranks, only bad's half learns it,
+   from "rank R" of that half. */
+static void expect_agreed(vw_status st, const char *msg, int failed, int r, int n)
+{
+    char want[256];
+    snprintf(want, sizeof want, n > 1 ? "rank %d: no memory for the cells" : "no memory for the cells", r);
+    if (!failed) {
+        CHECK_EQ_INT(st, VW_OK);
+    } else {
+        CHECK_EQ_INT(st, VW_E_NOMEM);
+        if (strcmp(msg, want) != 0) {
+            fprintf(stderr, "rank %d: agreed message '%s', expected '%s'\n", vw_engine_rank(), msg, want);
+            exit(1);
+        }
+    }
+}
+
+static void test_config_agree(int bad)
+{
+    int rank = vw_engine_rank(), size = vw_engine_size();
+    char msg[256];
+    snprintf(msg, sizeof msg, "%s", rank == bad ? "no memory for the cells" : "");
+    vw_status st = vw_config_agree(NULL, rank == bad ? VW_E_NOMEM : VW_OK, msg, sizeof msg);
+    expect_agreed(st, msg, bad < size, bad, size);
+
+    MPI_Comm half;
+    MPI_Comm_split(MPI_COMM_WORLD, rank % 2, rank, &half); /* rank r is r / 2 there */
+    int hsize;
+    MPI_Comm_size(half, &hsize);
+    vw_config c;
+    vw_config_init(&c);
+    c.mpi_comm = &half;
+    snprintf(msg, sizeof msg, "%s", rank == bad ? "no memory for the cells" : "");
+    st = vw_config_agree(&c, rank == bad ? VW_E_NOMEM : VW_OK, msg, sizeof msg);
+    expect_agreed(st, msg, bad < size && bad % 2 == rank % 2, bad / 2, hsize);
+    MPI_Comm_free(&half);
 }
 
 static void point_bounds(const void *o, vw_box *b, void *user)
@@ -416,6 +457,7 @@ int main(int argc, char **argv)
     }
     if (agree) {
         for (int bad = 0; bad <= vw_engine_size(); bad++) test_agree(bad);
+        for (int bad = 0; bad <= vw_engine_size(); bad++) test_config_agree(bad);
         test_mismatch(workers);
         if (rank == 0) printf("agreement: %d checks, %d failed\n", vw_test_checks, vw_test_failures);
         vw_engine_finish();

@@ -18,14 +18,7 @@ static int cli_rank = 0;
 
 int vw_cli_is_output(void) { return cli_rank == 0; }
 
-int vw_cli_fault(const char *name)
-{
-    const char *v = getenv("VW_FAULT");
-    size_t n = strlen(name);
-    for (const char *p = v; p && *p; p += strcspn(p, ","), p += *p == ',')
-        if (!strncmp(p, name, n) && (p[n] == ',' || !p[n])) return 1;
-    return 0;
-}
+int vw_cli_fault(const char *name) { return vw_test_fault(name); }
 
 int vw_cli_job_workers(long workers)
 {

@@ -47,7 +47,8 @@ const char *vw_cli_output(const char *cmd, int argc, char **argv, int *i);
 
 /* Fault injection for tests: is name one of the comma-separated words of the
    environment variable VW_FAULT (e.g. VW_FAULT=ledger: vwalls radiosity takes its
-   energy ledger as off)? Never set outside tests. */
+   energy ledger as off)? vw_test_fault, which the applications use too. Never set
+   outside tests. */
 int vw_cli_fault(const char *name);
 
 /* Is this process the one that prints (rank 0, or no MPI)? Valid after vw_cli_engine_init. */

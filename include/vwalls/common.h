@@ -46,6 +46,14 @@ VW_API const char *vw_status_name(vw_status s);
 VW_API const char *vw_status_message(vw_status s);
 VW_API const char *vw_version(void);
 
+/* Test-only fault injection (sqlite3_test_control's role): nonzero when name is one of
+   the comma-separated words of the environment variable VW_FAULT. The applications and
+   the vwalls command force rare failures with it (VW_FAULT=solver-nomem: the radiosity
+   solver's allocation fails; docs/runtime.md lists the words), so the tests can reach
+   paths no real input reaches, such as memory that one process of an MPI job lacks.
+   Never set outside tests. */
+VW_API int vw_test_fault(const char *name);
+
 /* Runs fn(i, user) for every i in [0, n), each on a thread of its own (i = 0 on the
    calling thread), and returns when all have: for a serial phase split over the
    workers, which are idle then. A part whose thread cannot be started runs on the

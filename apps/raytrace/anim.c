@@ -73,49 +73,55 @@ vw_status rt_anim_create(vw_scene *s, const rt_anim_params *p, rt_anim **out, ch
 {
     *out = NULL;
     rt_anim *a = calloc(1, sizeof *a);
-    if (!a) {
-        vw_scene_free(s);
-        return VW_E_NOMEM;
-    }
-    a->full_rebuild = p->full_rebuild;
-    a->farm = p->farm;
-    a->rebuild_all = 1; /* the first frame builds every cell */
-    double lo[3], hi[3], diag = 0;
-    vw_scene_bounds(s, lo, hi);
-    for (int k = 0; k < 3; k++) diag += (hi[k] - lo[k]) * (hi[k] - lo[k]);
-    diag = sqrt(diag);
-    if (!(diag > 0)) diag = 1;
-    a->scale = diag;
-    double margin = p->margin > 0 ? p->margin : 0.25;
-    for (int k = 0; k < 3; k++) {
-        a->world.lo[k] = lo[k] - margin * diag;
-        a->world.hi[k] = hi[k] + margin * diag;
-    }
-    if (s->camera.valid)
-        a->cam = s->camera;
-    else
-        vw_scene_default_camera(s, &a->cam);
+    rt_object *rec = NULL;
+    size_t nrec = 0;
+    vw_status st = a ? VW_OK : VW_E_NOMEM;
+    if (a) {
+        a->full_rebuild = p->full_rebuild;
+        a->farm = p->farm;
+        a->rebuild_all = 1; /* the first frame builds every cell */
+        double lo[3], hi[3], diag = 0;
+        vw_scene_bounds(s, lo, hi);
+        for (int k = 0; k < 3; k++) diag += (hi[k] - lo[k]) * (hi[k] - lo[k]);
+        diag = sqrt(diag);
+        if (!(diag > 0)) diag = 1;
+        a->scale = diag;
+        double margin = p->margin > 0 ? p->margin : 0.25;
+        for (int k = 0; k < 3; k++) {
+            a->world.lo[k] = lo[k] - margin * diag;
+            a->world.hi[k] = hi[k] + margin * diag;
+        }
+        if (s->camera.valid)
+            a->cam = s->camera;
+        else
+            vw_scene_default_camera(s, &a->cam);
 
-    /* Records in slot order: object by object, in id order. */
-    size_t n = vw_scene_count_objects(s), cap = 0;
-    for (size_t id = 0; id < n; id++) {
-        vw_prim_kind k;
-        size_t idx;
-        if (vw_scene_find_object(s, (int)id, &k, &idx) != VW_OK) continue;
-        cap += k == VW_PRIM_POLYGON ? (size_t)(s->polygons[idx].count - 2) : 1;
+        /* Records in slot order: object by object, in id order. */
+        size_t n = vw_scene_count_objects(s), cap = 0;
+        for (size_t id = 0; id < n; id++) {
+            vw_prim_kind k;
+            size_t idx;
+            if (vw_scene_find_object(s, (int)id, &k, &idx) != VW_OK) continue;
+            cap += k == VW_PRIM_POLYGON ? (size_t)(s->polygons[idx].count - 2) : 1;
+        }
+        rec = vw_test_fault("anim-nomem") ? NULL : malloc((cap ? cap : 1) * sizeof *rec);
+        if (!rec) st = VW_E_NOMEM;
+        for (size_t id = 0; rec && id < n; id++) {
+            vw_prim_kind k;
+            size_t idx;
+            if (vw_scene_find_object(s, (int)id, &k, &idx) != VW_OK) continue;
+            nrec += rt_object_records(s, k, idx, rec + nrec);
+        }
     }
-    rt_object *rec = malloc((cap ? cap : 1) * sizeof *rec);
-    if (!rec) {
+    if (st != VW_OK) snprintf(err, errlen, "out of memory for the scene's records");
+    /* Each process makes its records from its own copy of the scene: all fail, or none
+       waits for one in the world's creation (rt_job_create). */
+    st = vw_config_agree(p->config, st, err, errlen);
+    if (st != VW_OK) {
+        free(rec);
         rt_anim_free(a);
         vw_scene_free(s);
-        return VW_E_NOMEM;
-    }
-    size_t nrec = 0;
-    for (size_t id = 0; id < n; id++) {
-        vw_prim_kind k;
-        size_t idx;
-        if (vw_scene_find_object(s, (int)id, &k, &idx) != VW_OK) continue;
-        nrec += rt_object_records(s, k, idx, rec + nrec);
+        return st;
     }
     rt_params rp;
     memset(&rp, 0, sizeof rp);
@@ -130,7 +136,7 @@ vw_status rt_anim_create(vw_scene *s, const rt_anim_params *p, rt_anim **out, ch
     rp.scale = a->scale;
     rp.objects = rec;
     rp.nobjects = nrec;
-    vw_status st = rt_job_create(s, &rp, &a->job, err, errlen);
+    st = rt_job_create(s, &rp, &a->job, err, errlen);
     a->rec = rec;
     a->nrec = a->caprec = nrec;
     if (st != VW_OK) {

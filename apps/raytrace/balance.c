@@ -42,12 +42,15 @@ vw_status rt_job_map(rt_job *j, vw_map_kind kind, const double *load, const doub
 {
     vw_world *w = rt_job_world(j);
     const vw_decomp *d = vw_world_decomp(w);
-    int *cw = malloc(sizeof(int) * (size_t)vw_decomp_cell_count(d));
+    int *cw = vw_test_fault("map-nomem") ? NULL : malloc(sizeof(int) * (size_t)vw_decomp_cell_count(d));
     vw_status st = cw ? vw_map_compute(kind, d, load, vw_world_processes(w), vw_world_workers(w),
                                        speeds, cw)
                       : VW_E_NOMEM;
-    if (st == VW_OK) st = vw_world_remap(w, cw);
     if (st != VW_OK) snprintf(err, errlen, "mapping the cells: %s", vw_status_message(st));
+    /* The mapping is computed by each process: all fail, or none waits in the remap. */
+    st = vw_world_agree(w, st, err, errlen);
+    if (st == VW_OK && (st = vw_world_remap(w, cw)) != VW_OK)
+        snprintf(err, errlen, "mapping the cells: %s", vw_world_errmsg(w));
     free(cw);
     return st;
 }
@@ -74,9 +77,19 @@ vw_status rt_job_farm(rt_job *j, rt_farm f, int *copies, char *err, size_t errle
     if (f == RT_FARM_NONE || gw < 2) return VW_OK;
     /* Which workers and processes host something (a master or a copy) now. */
     int np = vw_world_processes(w);
-    unsigned char *hosts = calloc((size_t)gw, 1), *proc_hosts = calloc((size_t)np, 1);
+    unsigned char *hosts = vw_test_fault("farm-nomem") ? NULL : calloc((size_t)gw, 1);
+    unsigned char *proc_hosts = calloc((size_t)np, 1);
     int *on = malloc(sizeof(int) * (size_t)gw), *have = malloc(sizeof(int) * (size_t)gw);
     vw_status st = hosts && proc_hosts && on && have ? VW_OK : VW_E_NOMEM;
+    if (st != VW_OK) snprintf(err, errlen, "farming the cells: %s", vw_status_message(st));
+    /* Memory is each process's own: all fail, or none waits in vw_world_set_replicas
+       for one that returned. What follows fails alike everywhere (the same mapping, and
+       set_replicas agrees). */
+    st = vw_world_agree(w, st, err, errlen);
+    if (st != VW_OK) {
+        free(hosts), free(proc_hosts), free(on), free(have);
+        return st;
+    }
     for (int c = 0; st == VW_OK && c < nc; c++) {
         int m = vw_world_cell_worker(w, c); /* -1 only for a cell outside 0..nc-1 */
         if (m < 0 || m >= gw) {

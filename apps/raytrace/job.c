@@ -130,17 +130,14 @@ vw_config rt_job_config(const rt_params *p)
     return cfg;
 }
 
-vw_status rt_job_create(const vw_scene *s, const rt_params *p, rt_job **out, char *err,
-                        size_t errlen)
+/* The part of rt_job_create that needs nobody else: checks, the view, the lights, the
+   records, the world box and the decomposition, and the Embree device. Each process
+   does it on its own copy of the scene, so it can fail on one process only; the caller
+   agrees on the outcome before the world (collective) is made. */
+static vw_status job_prepare(rt_job *j, const vw_scene *s, const rt_params *p, rt_object **objs_out,
+                             size_t *nobjs_out, char *err, size_t errlen)
 {
-    *out = NULL;
-    rt_job *j = calloc(1, sizeof *j);
-    if (!j) return VW_E_NOMEM;
     rt_shared *sh = &j->sh;
-    atomic_init(&sh->pixels_done, 0);
-    atomic_init(&sh->entries, 0);
-    atomic_init(&sh->rays, 0);
-
     double lo[3], hi[3];
     vw_scene_bounds(s, lo, hi);
     double diag = 0;
@@ -150,7 +147,6 @@ vw_status rt_job_create(const vw_scene *s, const rt_params *p, rt_job **out, cha
         snprintf(err, errlen, "the scene is %g across: the ray tracer needs at least %g (Embree "
                               "computes in float, whose squares of smaller lengths vanish)",
                  diag, RT_MIN_SIZE);
-        rt_job_free(j);
         return VW_E_INVAL;
     }
     if (p->scale > 0) diag = p->scale;
@@ -170,7 +166,6 @@ vw_status rt_job_create(const vw_scene *s, const rt_params *p, rt_job **out, cha
     int h = p->height > 0 ? p->height : cam.height > 0 ? cam.height : 512;
     if (w > 16384 || h > 16384) {
         snprintf(err, errlen, "image size %dx%d too large (at most 16384 on a side)", w, h);
-        rt_job_free(j);
         return VW_E_INVAL;
     }
     rt_view_init(&sh->view, &cam, w, h);
@@ -179,7 +174,7 @@ vw_status rt_job_create(const vw_scene *s, const rt_params *p, rt_job **out, cha
 
     size_t nl = s->nlights ? s->nlights : 1;
     sh->lights = calloc(nl, sizeof *sh->lights);
-    if (!sh->lights) goto nomem;
+    if (!sh->lights) return VW_E_NOMEM;
     if (s->nlights) {
         for (size_t i = 0; i < s->nlights; i++)
             for (int a = 0; a < 3; a++) {
@@ -195,18 +190,16 @@ vw_status rt_job_create(const vw_scene *s, const rt_params *p, rt_job **out, cha
     }
     sh->nlights = (int)nl;
 
-    rt_object *objs = NULL;
-    size_t nobjs = 0;
     vw_status st = VW_OK;
     if (p->objects) {
-        objs = malloc((p->nobjects ? p->nobjects : 1) * sizeof *objs);
-        if (!objs) goto nomem;
-        memcpy(objs, p->objects, p->nobjects * sizeof *objs);
-        nobjs = p->nobjects;
+        *objs_out = malloc((p->nobjects ? p->nobjects : 1) * sizeof **objs_out);
+        if (!*objs_out) return VW_E_NOMEM;
+        memcpy(*objs_out, p->objects, p->nobjects * sizeof **objs_out);
+        *nobjs_out = p->nobjects;
     } else {
-        st = rt_objects_from_scene(s, &objs, &nobjs);
+        st = rt_objects_from_scene(s, objs_out, nobjs_out);
     }
-    if (st != VW_OK) goto fail;
+    if (st != VW_OK) return st;
 
     /* The world box: the scene bounds padded so no primitive touches the outer walls,
        and so a flat scene still gives cells of positive volume. */
@@ -243,8 +236,6 @@ vw_status rt_job_create(const vw_scene *s, const rt_params *p, rt_job **out, cha
                  fmax(fabs(cam.from[0]), fmax(fabs(cam.from[1]), fabs(cam.from[2]))) == far ? "eye"
                                                                                           : "scene",
                  far, RT_MAX_COORD);
-        free(objs);
-        rt_job_free(j);
         return VW_E_INVAL;
     }
     sh->overlap = 1e-6 * 3 * m;
@@ -260,20 +251,42 @@ vw_status rt_job_create(const vw_scene *s, const rt_params *p, rt_job **out, cha
     if (st != VW_OK) {
         snprintf(err, errlen, "cannot create the %dx%dx%d decomposition: %s", dims[0], dims[1],
                  dims[2], vw_status_message(st));
-        free(objs);
-        rt_job_free(j);
         return st;
     }
     sh->device = rt_device_new();
     sh->geo_cache = sh->device ? rt_geo_cache_new() : NULL;
     if (!sh->device || !sh->geo_cache) {
         snprintf(err, errlen, "cannot create the Embree device");
-        free(objs);
-        rt_job_free(j);
         return VW_E_STATE;
     }
+    return VW_OK;
+}
 
+vw_status rt_job_create(const vw_scene *s, const rt_params *p, rt_job **out, char *err,
+                        size_t errlen)
+{
+    *out = NULL;
+    if (errlen) err[0] = 0;
     vw_config cfg = rt_job_config(p);
+    rt_object *objs = NULL;
+    size_t nobjs = 0;
+    rt_job *j = calloc(1, sizeof *j);
+    if (j) {
+        atomic_init(&j->sh.pixels_done, 0);
+        atomic_init(&j->sh.entries, 0);
+        atomic_init(&j->sh.rays, 0);
+    }
+    vw_status st = j ? job_prepare(j, s, p, &objs, &nobjs, err, errlen) : VW_E_NOMEM;
+    if (st != VW_OK && errlen && !err[0]) snprintf(err, errlen, "%s", vw_status_message(st));
+    /* What failed on one process alone fails on all (with the lowest failing rank's
+       message), before the world: the others would otherwise wait for it there. */
+    st = vw_config_agree(&cfg, st, err, errlen);
+    if (st != VW_OK) {
+        free(objs);
+        rt_job_free(j);
+        return st;
+    }
+    rt_shared *sh = &j->sh;
     st = vw_world_create(&rt_module, sh, j->decomp, &cfg, &j->world);
     if (st != VW_OK) {
         snprintf(err, errlen, "cannot create the world: %s", vw_world_errmsg(NULL)); /* why not */
@@ -288,29 +301,33 @@ vw_status rt_job_create(const vw_scene *s, const rt_params *p, rt_job **out, cha
         rt_job_free(j);
         return st;
     }
-
+    /* The image sums are the output process's alone, and the pixel owners are computed
+       by each process: the caller's next step is collective, so all agree first. */
     if (vw_world_is_output(j->world)) {
-        sh->accum = calloc((size_t)w * (size_t)h, sizeof *sh->accum);
-        if (!sh->accum) goto nomem;
+        size_t npix = (size_t)sh->view.width * (size_t)sh->view.height;
+        sh->accum = vw_test_fault("job-accum-nomem") ? NULL : calloc(npix, sizeof *sh->accum);
+        if (!sh->accum) {
+            st = VW_E_NOMEM;
+            snprintf(err, errlen, "out of memory for the %dx%d image", sh->view.width, sh->view.height);
+        }
     }
-    if ((st = owners(j)) != VW_OK) goto fail;
+    if (st == VW_OK && (st = owners(j)) != VW_OK)
+        snprintf(err, errlen, "the pixels' cells: %s", vw_status_message(st));
+    st = vw_world_agree(j->world, st, err, errlen);
+    if (st != VW_OK) {
+        rt_job_free(j);
+        return st;
+    }
     *out = j;
     return VW_OK;
-nomem:
-    st = VW_E_NOMEM;
-fail:
-    snprintf(err, errlen, "%s", vw_status_message(st));
-    rt_job_free(j);
-    return st;
 }
 
 vw_status rt_job_commit(rt_job *j, char *err, size_t errlen)
 {
     vw_status st = owners(j); /* the walls may have moved since the last commit */
-    if (st != VW_OK) {
-        snprintf(err, errlen, "%s", vw_status_message(st));
-        return st;
-    }
+    if (st != VW_OK) snprintf(err, errlen, "the pixels' cells: %s", vw_status_message(st));
+    /* (each process computes them: all fail, or none waits in the commit for one) */
+    if ((st = vw_world_agree(j->world, st, err, errlen)) != VW_OK) return st;
     st = vw_world_commit(j->world);
     if (st != VW_OK) snprintf(err, errlen, "building the cells: %s", vw_world_errmsg(j->world));
     return st;
@@ -344,7 +361,10 @@ vw_status rt_job_reset(rt_job *j)
 {
     if (j->sh.accum)
         memset(j->sh.accum, 0, sizeof *j->sh.accum * (size_t)j->sh.view.width * j->sh.view.height);
-    vw_status st = owners(j);
+    /* Each process computes the owners: all fail, or none waits for one in the
+       collective step that follows (a commit, a redecomposition). */
+    char msg[64] = "";
+    vw_status st = vw_world_agree(j->world, owners(j), msg, sizeof msg);
     if (st != VW_OK) return st;
     atomic_store(&j->sh.pixels_done, 0);
     atomic_store(&j->sh.entries, 0);

@@ -176,7 +176,14 @@ typedef struct rt_job rt_job;
 #define RT_MIN_SIZE 1e-15
 
 /* Phases, each timed by the caller if it wishes: create (objects, decomposition, world,
-   objects added), commit (cells built), run (rays traced). err gets a message. */
+   objects added), commit (cells built), run (rays traced). err gets a message.
+   Under MPI every process calls each of these (and rt_job_reset, rt_job_map, rt_job_farm,
+   rt_job_balance) alike, and each fails on every process or on none: what a process
+   does alone (checking its own copy of the scene against the coordinate limits, the
+   decomposition, the Embree device, memory; the image sums rank 0 alone keeps) ends in
+   agreement before the next collective step, vw_config_agree before the world exists
+   and vw_world_agree after, so every process returns the lowest failing rank's status
+   and err says "rank R: <its message>" on every process. */
 vw_status rt_job_create(const vw_scene *s, const rt_params *p, rt_job **out, char *err,
                         size_t errlen);
 /* The runtime configuration a job with these parameters runs with: p->config (or the

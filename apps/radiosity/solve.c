@@ -70,21 +70,22 @@ static void cell_elements(const rad_mesh *m, int ncells, double *load)
    another worker of this process costs a queue push, not a network message, and a few
    percent of imbalance cost more than that. With no more cells than workers every
    mapping is one cell per worker, and the runtime's is kept. */
-static vw_status map_by_elements(rad_solver *s, const rad_mesh *m, const vw_decomp *d)
+/* The mapping by element counts, or *map NULL when the block mapping stays (a cell or
+   fewer per worker). Local: the caller agrees before the remap. */
+static vw_status map_by_elements(rad_solver *s, const rad_mesh *m, const vw_decomp *d, int **map)
 {
+    *map = NULL;
     int ncells = vw_decomp_cell_count(d);
     int gworkers = vw_world_processes(s->w) * vw_world_workers(s->w);
     if (gworkers < 2 || ncells <= gworkers) return VW_OK;
     double *load = malloc(sizeof(double) * (size_t)ncells);
-    int *map = malloc(sizeof(int) * (size_t)ncells);
-    vw_status st = load && map ? VW_OK : VW_E_NOMEM;
+    *map = malloc(sizeof(int) * (size_t)ncells);
+    vw_status st = load && *map ? VW_OK : VW_E_NOMEM;
     if (st == VW_OK) {
         cell_elements(m, ncells, load);
-        st = vw_map_greedy(d, load, gworkers, NULL, 0.0, map);
+        st = vw_map_greedy(d, load, gworkers, NULL, 0.0, *map);
     }
-    if (st == VW_OK) st = vw_world_remap(s->w, map);
     free(load);
-    free(map);
     return st;
 }
 
@@ -448,17 +449,25 @@ vw_status rad_solver_create(const rad_mesh *m, const vw_decomp *d, const rad_opt
 {
     *out = NULL;
     if (errlen) err[0] = 0;
-    rad_solver *s = calloc(1, sizeof *s);
-    if (!s) return VW_E_NOMEM;
+    vw_config cfg;
+    vw_config_init(&cfg);
+    cfg.workers = o->workers;
+    rad_solver *s = vw_test_fault("solver-nomem") ? NULL : calloc(1, sizeof *s);
+    vw_status st = s ? rad_hemicube_init(&s->hc, o->res) : VW_E_NOMEM;
+    if (st == VW_E_INVAL)
+        snprintf(err, errlen, "--hemicube %d: must be even and between 2 and %d", o->res, RAD_MAX_RES);
+    else if (st != VW_OK)
+        snprintf(err, errlen, "cannot set up the radiosity solver: %s", vw_status_message(st));
+    /* Memory is each process's own: all fail, or none waits for one in the world's
+       creation. */
+    st = vw_config_agree(&cfg, st, err, errlen);
+    if (st != VW_OK) {
+        rad_solver_free(s);
+        return st;
+    }
     s->mesh = m;
     s->d = d;
     s->opt = *o;
-    vw_status st = rad_hemicube_init(&s->hc, o->res);
-    if (st != VW_OK) {
-        snprintf(err, errlen, "--hemicube %d: must be even and between 2 and %d", o->res, RAD_MAX_RES);
-        free(s);
-        return st;
-    }
     s->bitmap_bytes = rad_hemicube_bitmap_bytes(o->res);
     rad_module_setup(s);
     s->mod.object_bounds = piece_bounds;
@@ -468,19 +477,30 @@ vw_status rad_solver_create(const rad_mesh *m, const vw_decomp *d, const rad_opt
     double ext = 0;
     for (int a = 0; a < 3; a++) ext = fmax(ext, wb.hi[a] - wb.lo[a]);
     s->near_eps = 1e-9 * ext;
-    vw_config cfg;
-    vw_config_init(&cfg);
-    cfg.workers = o->workers;
     st = vw_world_create(&s->mod, s, d, &cfg, &s->w);
-    if (st == VW_OK) st = map_by_elements(s, m, d);
+    int *map = NULL;
     if (st == VW_OK) {
+        vw_status local = map_by_elements(s, m, d, &map);
         size_t gw = (size_t)vw_world_processes(s->w) * (size_t)vw_world_workers(s->w);
-        s->slots = aligned_alloc(_Alignof(rad_worker_slot), gw * sizeof *s->slots);
+        s->slots = vw_test_fault("solver-slots-nomem")
+                       ? NULL
+                       : aligned_alloc(_Alignof(rad_worker_slot), gw * sizeof *s->slots);
         s->nslots = s->slots ? gw : 0;
         if (s->slots) memset(s->slots, 0, gw * sizeof *s->slots);
         s->stepwork = calloc((size_t)vw_decomp_cell_count(d), 1);
-        if (!s->slots || !s->stepwork) st = VW_E_NOMEM;
+        if (local == VW_OK && (!s->slots || !s->stepwork)) local = VW_E_NOMEM;
+        if (local != VW_OK)
+            snprintf(err, errlen, "cannot set up the radiosity world: %s", vw_status_message(local));
+        /* All of it is local: all fail, or none waits in the remap or the placement. */
+        st = vw_world_agree(s->w, local, err, errlen);
+        if (st != VW_OK) {
+            free(map);
+            rad_solver_free(s);
+            return st;
+        }
     }
+    if (st == VW_OK && map) st = vw_world_remap(s->w, map);
+    free(map);
     if (st == VW_OK) st = vw_world_add_objects(s->w, m->pieces, m->npieces);
     if (st == VW_OK) st = vw_world_commit(s->w);
     if (st != VW_OK) {

@@ -285,7 +285,11 @@ vw_status vw_collider_create(const vw_decomp *d, const vw_config *cfg, double to
     if (!out || !d) return VW_E_INVAL;
     *out = NULL;
     vw_collider *c = calloc(1, sizeof *c);
-    if (!c) return VW_E_NOMEM;
+    /* (collective: the others go on to create the world) */
+    if (vw_config_agree(cfg, c ? VW_OK : VW_E_NOMEM, NULL, 0) != VW_OK) {
+        free(c);
+        return VW_E_NOMEM;
+    }
     c->tol = tol > 0 ? tol : 0;
     pthread_mutex_init(&c->mu, NULL);
     vw_status st = vw_world_create(&collider_module, c, d, cfg, &c->world);

@@ -4,6 +4,7 @@
 #define VW_DYNAMIC_INTERNAL_H
 
 #include "vwalls/dynamic.h"
+#include "vwalls/engine.h"
 
 /* The test of one probe against one obstacle shape, as a cell runs it: VW_PROBE_END
    and/or VW_PROBE_SWEEP bits, 0 for no hit. The brute-force reference uses it too, so

@@ -281,8 +281,12 @@ vw_status vw_dynscene_create(vw_scene *s, const vw_dynscene_params *p, vw_dynsce
     *out = NULL;
     vw_dynscene *ds = calloc(1, sizeof *ds);
     if (!ds) {
+        /* (collective: the others go on to the collider's world) */
+        char msg[64] = "";
+        vw_status st = vw_config_agree(p->config, VW_E_NOMEM, msg, sizeof msg);
+        if (err && errlen) snprintf(err, errlen, "cannot set up the dynamic scene: %s", msg[0] ? msg : vw_status_message(st));
         vw_scene_free(s);
-        return VW_E_NOMEM;
+        return st;
     }
     ds->s = s;
     ds->capspheres = s->nspheres;
@@ -316,6 +320,16 @@ vw_status vw_dynscene_create(vw_scene *s, const vw_dynscene_params *p, vw_dynsce
         geom_free(&g);
     }
     ds->nids = n;
+    /* Each process made the shapes from its own copy of the scene: all fail with the
+       lowest failing rank's status, or none waits for it in the collider's world. */
+    char msg[160] = "";
+    if (st != VW_OK) snprintf(msg, sizeof msg, "%s", vw_status_message(st));
+    st = vw_config_agree(p->config, st, msg, sizeof msg);
+    if (st != VW_OK) {
+        if (err && errlen) snprintf(err, errlen, "cannot set up the dynamic scene: %s", msg);
+        vw_dynscene_free(ds);
+        return st;
+    }
     if (st == VW_OK) st = vw_collider_create(p->decomp, p->config, ds->tol, &ds->col);
     if (st == VW_OK) st = vw_collider_add(ds->col, ds->shapes, ds->nslots);
     if (st != VW_OK) {

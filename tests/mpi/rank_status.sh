@@ -9,6 +9,17 @@
 # forced by the test switch VW_FAULT=ledger). Standard output into /dev/full is rank 0's
 # alone: the others' goes to /dev/null. And a failure of another rank alone: all exit
 # with its status, and rank 0 names it.
+# And failures inside the applications' own set-up, before or between the library's
+# collective steps (which used to end the job with status 15 or hang it; each now ends
+# in vw_config_agree or vw_world_agree):
+#   * a scene the ray tracer refuses on ranks 1 and up alone (one sphere 1e-17 across,
+#     a sphere beyond its coordinate limit), for render and animate (rt_job_create);
+#     with NP 3, ranks 1 and 2 both fail and the message is rank 1's;
+#   * memory, by the test switch VW_FAULT: for the image sums, which rank 0 alone keeps
+#     (job-accum-nomem); on rank 1 alone for the mapping (map-nomem, rt_job_map), the
+#     farming (farm-nomem, rt_job_farm), animate's records (anim-nomem, rt_anim_create),
+#     the radiosity solver before its world exists (solver-nomem) and after it
+#     (solver-slots-nomem, rad_solver_create).
 # usage: rank_status.sh VWALLS NP "MPIEXEC -n NP [flags]"
 vwalls=$1 np=$2 launch=$3
 dir=$(mktemp -d)
@@ -92,4 +103,43 @@ must_agree "example-components --stats into a missing directory" 1 "nodir/s.json
 cp "$dir/balls.nff" "$dir/balls0.nff"
 must_agree "info, the scene missing on rank 1" 2 "rank 1: .*balls1.nff" \
     "\"$vwalls\" info \"$dir/balls$rank.nff\" >/dev/null"
+
+# The applications' set-up. Ranks 1 and up read tiny1.nff, rank 0 tiny0.nff.
+ge1="[ $rank -ge 1 ] && n=1 || n=0"
+{ sed -n '1,/^f /p' "$dir/balls.nff"; echo "s 0 0 0 1e-17"; } >"$dir/tiny1.nff"
+cp "$dir/balls.nff" "$dir/tiny0.nff"
+grep -q "^s 0 0 0 1e-17" "$dir/tiny1.nff" && grep -q "^v" "$dir/tiny1.nff" ||
+    { echo "FAIL: could not make tiny1.nff"; fail=1; }
+rm -f "$dir/r.png"
+must_agree "render, a scene too small for the ray tracer on ranks 1 and up" 2 \
+    "^vwalls render: rank 1: the scene is [-0-9.e+]* across: the ray tracer needs at least" \
+    "$ge1; \"$vwalls\" render \"$dir/tiny\$n.nff\" -o \"$dir/r.png\" $small"
+[ ! -e "$dir/r.png" ] || { echo "FAIL: render, tiny scene: output written"; fail=1; }
+must_agree "animate, a scene too small for the ray tracer on ranks 1 and up" 2 \
+    "^vwalls animate: rank 1: the scene is [-0-9.e+]* across" \
+    "$ge1; \"$vwalls\" animate \"$dir/tiny\$n.nff\" \"$dir/edits\" -o \"$dir/a%d.png\" $small"
+{ cat "$dir/balls.nff"; echo "s 2e18 0 0 1"; } >"$dir/far1.nff"
+cp "$dir/balls.nff" "$dir/far0.nff"
+must_agree "render, a sphere beyond the coordinate limit on ranks 1 and up" 2 \
+    "^vwalls render: rank 1: the scene lies [-0-9.e+]* from the origin on an axis" \
+    "$ge1; \"$vwalls\" render \"$dir/far\$n.nff\" -o \"$dir/r.png\" $small"
+must_agree "render, no memory for the image sums (rank 0 alone keeps them)" 1 \
+    "^vwalls render: rank 0: out of memory for the 32x32 image" \
+    "VW_FAULT=job-accum-nomem \"$vwalls\" render \"$dir/balls.nff\" -o \"$dir/r.png\" $small"
+for f in map farm; do
+    [ $f = map ] && what="mapping the cells" || what="farming the cells"
+    must_agree "render, no memory for $what on rank 1" 1 "^vwalls render: rank 1: $what: out of memory" \
+        "[ $rank = 1 ] && export VW_FAULT=$f-nomem; \"$vwalls\" render \"$dir/balls.nff\" -o \"$dir/r.png\" --map greedy $small"
+done
+[ ! -e "$dir/r.png" ] || { echo "FAIL: render, no memory: output written"; fail=1; }
+must_agree "animate, no memory for the records on rank 1" 1 \
+    "^vwalls animate: rank 1: out of memory for the scene's records" \
+    "[ $rank = 1 ] && export VW_FAULT=anim-nomem; \"$vwalls\" animate \"$dir/balls.nff\" \"$dir/edits\" -o \"$dir/a%d.png\" $small"
+for f in solver solver-slots; do
+    [ $f = solver ] && what="the radiosity solver" || what="the radiosity world"
+    must_agree "radiosity, no memory for $what on rank 1" 1 \
+        "^vwalls radiosity: rank 1: cannot set up $what: out of memory" \
+        "[ $rank = 1 ] && export VW_FAULT=$f-nomem; \"$vwalls\" radiosity \"$dir/cornell.nff\" -o \"$dir/l.ply\" --cells 2x2x2 --workers 1 --max-shots 4 --quiet"
+done
+[ ! -e "$dir/l.ply" ] || { echo "FAIL: radiosity, no memory: output written"; fail=1; }
 exit $fail

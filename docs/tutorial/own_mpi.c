@@ -27,29 +27,37 @@ int main(int argc, char **argv)
     vw_decomp *d = NULL;
     if (vw_decomp_create_grid(&unit, dims, &d) != VW_OK) MPI_Abort(MPI_COMM_WORLD, 1);
     int ncells = vw_decomp_cell_count(d);
-    enum { N = 20000 };
-    ex_point *pts = malloc(sizeof *pts * N);
-    ex_hello_result result = {ncells, calloc((size_t)ncells, sizeof(int64_t)),
-                              calloc((size_t)ncells, sizeof(int64_t))};
-    if (!pts || !result.own || !result.neighbours) MPI_Abort(MPI_COMM_WORLD, 1);
-    /* A deterministic spread; some points lie exactly on walls, and the module's owner
-       rule counts each of them once. */
-    for (int i = 0; i < N; i++)
-        for (int k = 0; k < 3; k++) pts[i].p[k] = ((i * (k + 7) * 7919) % 997 + 0.5) / 997.0;
-
     vw_config cfg;
     vw_config_init(&cfg);
     cfg.workers = 2;
     cfg.mpi_comm = &comm;           /* a pointer to the MPI_Comm, kept opaque in the API */
+
+    /* What each rank prepares alone (here, memory) is agreed on before the world, on
+       the group's communicator: a rank that gave up alone would leave the others
+       waiting for it in vw_world_create. */
+    enum { N = 20000 };
+    ex_point *pts = malloc(sizeof *pts * N);
+    ex_hello_result result = {ncells, calloc((size_t)ncells, sizeof(int64_t)),
+                              calloc((size_t)ncells, sizeof(int64_t))};
+    char msg[256] = "";
+    vw_status st = pts && result.own && result.neighbours ? VW_OK : VW_E_NOMEM;
+    st = vw_config_agree(&cfg, st, msg, sizeof msg);
+    /* A deterministic spread; some points lie exactly on walls, and the module's owner
+       rule counts each of them once. */
+    for (int i = 0; st == VW_OK && i < N; i++)
+        for (int k = 0; k < 3; k++) pts[i].p[k] = ((i * (k + 7) * 7919) % 997 + 0.5) / 997.0;
+
     vw_world *w = NULL;
-    vw_status st = vw_world_create(&ex_hello_module, &result, d, &cfg, &w);
+    if (st == VW_OK && (st = vw_world_create(&ex_hello_module, &result, d, &cfg, &w)) != VW_OK)
+        snprintf(msg, sizeof msg, "%s", vw_world_errmsg(NULL)); /* (fails on every rank) */
     if (st == VW_OK) st = vw_world_add_objects(w, pts, N);
     if (st == VW_OK) st = vw_world_run(w);    /* run() commits first if needed */
 
     /* Agreement on the group's communicator: every rank learns if any rank failed. */
-    char msg[256] = "";
-    if (st != VW_OK) snprintf(msg, sizeof msg, "%s", vw_world_errmsg(w));
-    st = vw_world_agree(w, st, msg, sizeof msg);
+    if (w) {
+        if (st != VW_OK) snprintf(msg, sizeof msg, "%s", vw_world_errmsg(w));
+        st = vw_world_agree(w, st, msg, sizeof msg);
+    }
     int rc = st != VW_OK;
     if (w && vw_world_is_output(w)) {
         int64_t total = 0;
@@ -57,6 +65,10 @@ int main(int argc, char **argv)
         rc |= total != N || vw_world_counter(w, EX_HELLO_CNT_POINTS) != N;
         printf("group %d: %d process(es), %d cells, %lld points: %s%s\n", group,
                vw_world_processes(w), ncells, (long long)total, rc ? "FAILED " : "ok", msg);
+    } else if (!w) {
+        int grank;
+        MPI_Comm_rank(comm, &grank);
+        if (grank == 0) printf("group %d: FAILED %s\n", group, msg);
     }
     vw_world_free(w);
     vw_decomp_free(d);

@@ -92,7 +92,8 @@ typedef struct vw_contact {
     int32_t pad;
 } vw_contact;
 
-/* c may be NULL (defaults). tol: the contact tolerance of vw_shape_collide. */
+/* c may be NULL (defaults). tol: the contact tolerance of vw_shape_collide. Collective
+   under MPI; memory one process lacks fails it on all (vw_config_agree). */
 VW_API vw_status vw_collider_create(const vw_decomp *d, const vw_config *c, double tol,
                                     vw_collider **out);
 VW_API void vw_collider_free(vw_collider *c);
@@ -163,7 +164,11 @@ typedef struct vw_dynscene_params {
                                    (the tests' reference) */
 } vw_dynscene_params;
 
-/* Takes ownership of scene s (freed by vw_dynscene_free, also on failure). */
+/* Takes ownership of scene s (freed by vw_dynscene_free, also on failure). Collective
+   under MPI, like vw_world_create: the shapes each process makes from its own copy of
+   the scene are agreed on (vw_config_agree on p->config) before the collider's world,
+   so a process that fails alone (memory, a polygon its copy gives fewer than three
+   vertices) fails on every process, with "rank R: ..." in err. */
 VW_API vw_status vw_dynscene_create(vw_scene *s, const vw_dynscene_params *p,
                                     vw_dynscene **out, char *err, size_t errlen);
 VW_API void vw_dynscene_free(vw_dynscene *ds);

@@ -18,6 +18,9 @@
  * create: vw_world_errmsg(NULL)) says "rank R: <its message>" everywhere. So a program
  * may stop at the first failing step on every process alike, and no process is left
  * waiting for another in a collective call. vw_world_post and the queries are local.
+ * What a program does on one process alone before or between these steps (reading its
+ * copy of the input, allocating) needs its own agreement before the next one:
+ * vw_config_agree before vw_world_create, vw_world_agree after (vwalls/engine.h).
  */
 #ifndef VWALLS_WORLD_H
 #define VWALLS_WORLD_H

@@ -284,7 +284,8 @@ vw_status vw_dynscene_create(vw_scene *s, const vw_dynscene_params *p, vw_dynsce
         /* (collective: the others go on to the collider's world) */
         char msg[64] = "";
         vw_status st = vw_config_agree(p->config, VW_E_NOMEM, msg, sizeof msg);
-        if (err && errlen) snprintf(err, errlen, "cannot set up the dynamic scene: %s", msg[0] ? msg : vw_status_message(st));
+        if (err && errlen)
+            snprintf(err, errlen, "cannot set up the dynamic scene: %s", msg[0] ? msg : vw_status_message(st));
         vw_scene_free(s);
         return st;
     }
@@ -330,7 +331,7 @@ vw_status vw_dynscene_create(vw_scene *s, const vw_dynscene_params *p, vw_dynsce
         vw_dynscene_free(ds);
         return st;
     }
-    if (st == VW_OK) st = vw_collider_create(p->decomp, p->config, ds->tol, &ds->col);
+    st = vw_collider_create(p->decomp, p->config, ds->tol, &ds->col);
     if (st == VW_OK) st = vw_collider_add(ds->col, ds->shapes, ds->nslots);
     if (st != VW_OK) {
         if (err && errlen)

@@ -5,7 +5,7 @@
 # an agent script that runs the daemon inside that namespace (with its own host name).
 # The example module must give the threads engine's answer, and the ray tracer (when
 # built, given a scene) the threads engine's image bit for bit. Exit 77 (ctest SKIP) where
-# namespaces cannot be made (not root, no CAP_NET_ADMIN, no iproute2).
+# namespaces cannot be made or entered (not root, no CAP_NET_ADMIN, no iproute2, a chroot).
 # usage: two_hosts.sh VWALLS MPIEXEC [SCENE.nff]
 vwalls=$1 mpiexec=$2 scene=$3
 skip() { echo "two_hosts.sh: SKIP: $*"; exit 77; }
@@ -23,6 +23,9 @@ cleanup() {
 trap cleanup EXIT INT TERM
 ip netns add "$nsa" 2>/dev/null || skip "cannot create network namespaces (need root / CAP_NET_ADMIN)"
 ip netns add "$nsb" || skip "cannot create a second namespace"
+# Entering one remounts /sys there, which fails where / is no mount point (a plain
+# chroot): the namespaces exist but no process can run in them.
+ip netns exec "$nsa" true 2>/dev/null || skip "cannot run a process in a network namespace (ip netns exec)"
 ip link add "va$id" type veth peer name "vb$id" || skip "cannot create a veth pair"
 ip link set "va$id" netns "$nsa" && ip link set "vb$id" netns "$nsb" || exit 1
 ip -n "$nsa" addr add "$a/24" dev "va$id" && ip -n "$nsa" link set "va$id" up && ip -n "$nsa" link set lo up || exit 1

@@ -17,46 +17,4 @@ python3 "$CONV" "$SCENE" 64 64 5 >"$T/scene.pov" || { echo "FAIL: conversion"; e
    >"$T/povray.log" 2>&1) || { cat "$T/povray.log"; echo "FAIL: povray"; exit 1; }
 "$V" render "$SCENE" -o "$T/vw.pfm" --size 64x64 --depth 5 --cells 1 --quiet || { echo "FAIL: render"; exit 1; }
 bg=$(sed -n 's/^b \([-0-9.e]*\) \([-0-9.e]*\) \([-0-9.e]*\).*/\1,\2,\3/p' "$SCENE")
-python3 - "$T/pov.ppm" "$T/vw.pfm" "$bg" <<'PY'
-import struct, sys
-
-def header(d, n):
-    """The first n header tokens of a PPM or PFM ('#' comments skipped) and the offset
-    after the single blank that ends the header."""
-    toks, i = [], 0
-    while len(toks) < n:
-        if d[i:i + 1] == b'#':
-            i = d.index(b'\n', i) + 1
-        elif d[i:i + 1].isspace():
-            i += 1
-        else:
-            j = i
-            while not d[j:j + 1].isspace():
-                j += 1
-            toks.append(d[i:j])
-            i = j
-    return toks, i + 1
-
-d = open(sys.argv[1], 'rb').read()
-(magic, w, h, mx), at = header(d, 4)
-assert magic == b'P6' and int(mx) == 255, magic
-w, h = int(w), int(h)
-pov = [[tuple(d[at + 3 * (y * w + x) + k] / 255 for k in range(3)) for x in range(w)] for y in range(h)]
-d = open(sys.argv[2], 'rb').read()
-(magic, w2, h2, scale), at = header(d, 4)
-assert magic == b'PF' and (int(w2), int(h2)) == (w, h), magic
-v = struct.unpack(('<' if float(scale) < 0 else '>') + '%df' % (3 * w * h), d[at:at + 12 * w * h])
-vw = [[tuple(v[3 * (y * w + x) + k] for k in range(3)) for x in range(w)] for y in range(h)][::-1]
-bg = [float(x) for x in sys.argv[3].split(',')]
-
-def covered(c):
-    return any(abs(c[k] - bg[k]) > 0.02 for k in range(3))
-
-diff = [(x, y) for y in range(h) for x in range(w) if covered(pov[y][x]) != covered(vw[y][x])]
-n = sum(covered(vw[y][x]) for y in range(h) for x in range(w))
-print('%d of %d pixels covered by vwalls; %d differ in POV-Ray' % (n, w * h, len(diff)))
-if diff:
-    for y in range(h):  # X: differs, #: covered, .: background (vwalls)
-        print(''.join('X' if (x, y) in diff else '#' if covered(vw[y][x]) else '.' for x in range(w)))
-sys.exit(1 if diff else 0)
-PY
+python3 "$(dirname "$0")/pov_compare.py" "$T/pov.ppm" "$T/vw.pfm" --covered "$bg"

@@ -19,44 +19,8 @@ python3 "$CONV" "$SCENE" 64 64 5 >"$T/scene.pov" 2>"$T/conv.err" || { cat "$T/co
 (cd "$T" && povray +I"$T/scene.pov" +O"$T/pov.ppm" +FP +W64 +H64 -D -A File_Gamma=1.0 \
    >"$T/povray.log" 2>&1) || { cat "$T/povray.log"; echo "FAIL: povray"; exit 1; }
 "$V" render "$SCENE" -o "$T/vw.pfm" --size 64x64 --depth 5 --cells 1 --quiet || { echo "FAIL: render"; exit 1; }
-python3 - "$T/pov.ppm" "$T/vw.pfm" <<'PY' || fail=1
-import struct, sys
-
-def header(d, n):
-    """The first n header tokens of a PPM or PFM and the offset after the header."""
-    toks, i = [], 0
-    while len(toks) < n:
-        if d[i:i + 1] == b'#':
-            i = d.index(b'\n', i) + 1
-        elif d[i:i + 1].isspace():
-            i += 1
-        else:
-            j = i
-            while not d[j:j + 1].isspace():
-                j += 1
-            toks.append(d[i:j])
-            i = j
-    return toks, i + 1
-
-d = open(sys.argv[1], 'rb').read()
-(magic, w, h, mx), at = header(d, 4)
-assert magic == b'P6' and int(mx) == 255, magic
-w, h = int(w), int(h)
-pov = [[tuple(d[at + 3 * (y * w + x) + k] / 255 for k in range(3)) for x in range(w)] for y in range(h)]
-d = open(sys.argv[2], 'rb').read()
-(magic, w2, h2, scale), at = header(d, 4)
-assert magic == b'PF' and (int(w2), int(h2)) == (w, h), magic
-v = struct.unpack(('<' if float(scale) < 0 else '>') + '%df' % (3 * w * h), d[at:at + 12 * w * h])
-vw = [[tuple(min(1.0, max(0.0, v[3 * (y * w + x) + k])) for k in range(3)) for x in range(w)]
-      for y in range(h)][::-1]
 # 0.02: POV-Ray's 8-bit output and float differences (measured: at most 0.004).
-bad = [(x, y) for y in range(h) for x in range(w)
-       if max(abs(pov[y][x][k] - vw[y][x][k]) for k in range(3)) > 0.02]
-print('%d of %d pixels differ by more than 0.02' % (len(bad), w * h))
-for x, y in bad[:5]:
-    print('  pixel %d,%d: vwalls %s, POV-Ray %s' % (x, y, vw[y][x], pov[y][x]))
-sys.exit(1 if bad else 0)
-PY
+python3 "$(dirname "$0")/pov_compare.py" "$T/pov.ppm" "$T/vw.pfm" --within 0.02 || fail=1
 # What POV-Ray cannot draw is said, naming the material.
 cat >"$T/lossy.nff" <<'EOF'
 v

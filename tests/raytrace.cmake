@@ -69,14 +69,14 @@ endif()
 add_test(NAME bench_nff2pov_concave
          COMMAND sh ${PROJECT_SOURCE_DIR}/tests/raytrace/nff2pov.sh $<TARGET_FILE:vwalls_tool>
                  ${PROJECT_SOURCE_DIR}/bench/nff2pov.py ${PROJECT_SOURCE_DIR}/tests/data/good/concave.nff
-                 ${CMAKE_CURRENT_BINARY_DIR}/bench_nff2pov_concave)
+                 ${CMAKE_CURRENT_BINARY_DIR}/bench_nff2pov_concave covered)
 set_tests_properties(bench_nff2pov_concave PROPERTIES LABELS "bench" SKIP_RETURN_CODE 77 TIMEOUT 60)
 # ... and the '#vw Ks' and '#vw Ke' extension lines so that povray draws vwalls' image
 # (within 0.02 a channel), and says on stderr what POV-Ray cannot draw.
 add_test(NAME bench_nff2pov_ext
-         COMMAND sh ${PROJECT_SOURCE_DIR}/tests/raytrace/nff2pov_ext.sh $<TARGET_FILE:vwalls_tool>
+         COMMAND sh ${PROJECT_SOURCE_DIR}/tests/raytrace/nff2pov.sh $<TARGET_FILE:vwalls_tool>
                  ${PROJECT_SOURCE_DIR}/bench/nff2pov.py ${PROJECT_SOURCE_DIR}/tests/raytrace/nff2pov_ext.nff
-                 ${CMAKE_CURRENT_BINARY_DIR}/bench_nff2pov_ext)
+                 ${CMAKE_CURRENT_BINARY_DIR}/bench_nff2pov_ext within)
 set_tests_properties(bench_nff2pov_ext PROPERTIES LABELS "bench" SKIP_RETURN_CODE 77 TIMEOUT 60)
 
 # Under mpirun (when the build has MPI; launcher flags: cmake/mpi_launcher.cmake): the

@@ -1,5 +1,5 @@
 """pov_compare.py - povray's picture of a converted scene against vwalls render's, for
-the nff2pov tests (nff2pov.sh, nff2pov_ext.sh).
+the nff2pov tests (nff2pov.sh).
 
 usage: pov_compare.py POV.ppm VWALLS.pfm --covered R,G,B
          the same pixels covered (not the background colour R,G,B, within 0.02)

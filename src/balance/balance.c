@@ -85,8 +85,10 @@ static double units_lambda(const vw_world *w, const double *load, const double *
 static vw_status balance_duplicate(vw_world *w, const double *load, const vw_balance_params *p,
                                    const vw_balance_apply *a, vw_balance_report *r)
 {
+    vw_status before_err = w->err;
     int max_extra = p->max_extra > 0 ? p->max_extra : 4 * w->gworkers;
-    int *pc = malloc(sizeof(int) * (size_t)max_extra), *pw = malloc(sizeof(int) * (size_t)max_extra);
+    size_t nextra = sizeof(int) * (size_t)max_extra;
+    int *pc = vw_test_fault("balance-copies-nomem") ? NULL : malloc(nextra), *pw = malloc(nextra);
     int *list = malloc(sizeof(int) * (size_t)w->gworkers);
     int np = 0;
     vw_status st = pc && pw && list ? VW_OK : VW_E_NOMEM;
@@ -108,6 +110,9 @@ static vw_status balance_duplicate(vw_world *w, const double *load, const vw_bal
     size_t gw = (size_t)w->gworkers;
     unsigned char *held = pays ? calloc(w->nobjects ? w->nobjects * gw : 1, 1) : NULL;
     if (pays && !held) st = VW_E_NOMEM;
+    /* The plan is each process's own (from the same loads: only memory can differ), and
+       the copies are collective: all fail, or none waits for one in them. */
+    st = vw__world_step_agreed(w, st, before_err, "vw_balance_world");
     for (int c = 0; pays && st == VW_OK && c < w->ncells; c++) {
         const vw__cell *cl = &w->cells[c];
         for (int u = 0; u <= cl->nreps; u++) {
@@ -160,7 +165,9 @@ vw_status vw_balance_world(vw_world *w, const vw_load_field *f, const vw_balance
 
     /* Before: the field's loads on the current layout and mapping (the field was made
        from, or calibrated by, the last measurement, so these are the measured loads). */
-    double *load = malloc(sizeof(double) * VW_MAX_CELLS);
+    vw_status before_err = w->err;
+    double *load =
+        vw_test_fault("balance-plan-nomem") ? NULL : malloc(sizeof(double) * VW_MAX_CELLS);
     int *map = malloc(sizeof(int) * VW_MAX_CELLS);
     vw_decomp *nd = NULL;
     vw_status st = load && map ? VW_OK : VW_E_NOMEM;
@@ -168,13 +175,16 @@ vw_status vw_balance_world(vw_world *w, const vw_load_field *f, const vw_balance
         vw_load_field_cell_loads(f, w->decomp, load);
         /* With duplicated cells, their copies carry their share (units_lambda). */
         r.imbalance_before = units_lambda(w, load, speeds);
-        if (p->strategy == VW_BALANCE_DUPLICATE) {
-            st = balance_duplicate(w, load, &pp, a, &r);
-            goto done;
-        }
-        st = vw_balance_decompose(w->decomp, f, &pp, &nd, map);
     }
-    int nc = nd ? vw_decomp_cell_count(nd) : 0;
+    if (p->strategy == VW_BALANCE_DUPLICATE) {
+        /* One agreement on every process: balance_duplicate's, or, without memory for
+           the loads, this one. */
+        st = st == VW_OK ? balance_duplicate(w, load, &pp, a, &r)
+                         : vw__world_step_agreed(w, st, before_err, "vw_balance_world");
+        goto done;
+    }
+    if (st == VW_OK) st = vw_balance_decompose(w->decomp, f, &pp, &nd, map);
+    int nc = nd ? vw_decomp_cell_count(nd) : 0, pays = 0;
     if (st == VW_OK) {
         vw_load_field_cell_loads(f, nd, load);
         if (p->strategy != VW_BALANCE_DIVIDE) {
@@ -188,20 +198,22 @@ vw_status vw_balance_world(vw_world *w, const vw_load_field *f, const vw_balance
         r.max_neighbours = vw_decomp_max_neighbours(nd);
         /* Does it pay? The expected gain is the part of the last compute time the
            better balance saves; the cost is what re-placing and rebuilding took. */
-        int pays = r.imbalance_predicted < r.imbalance_before;
+        pays = r.imbalance_predicted < r.imbalance_before;
         if (pays && a && a->last_compute_s > 0) {
             double gain = (1.0 - r.imbalance_predicted / r.imbalance_before) * a->last_compute_s;
             pays = gain > a->rebuild_s;
         }
-        if (pays) {
-            uint64_t before = w->migrated;
-            st = vw_world_redecompose(w, nd, map);
-            r.migrated_objects = w->migrated - before;
-            r.bytes_moved = r.migrated_objects * (uint64_t)w->m->object_size;
-            r.applied = st == VW_OK;
-        } else {
-            r.imbalance_predicted = r.imbalance_before;
-        }
+        if (!pays) r.imbalance_predicted = r.imbalance_before;
+    }
+    /* Each process plans alone, from the same field, so only memory can make the plans
+       differ: all fail, or none waits for one in the redecomposition. */
+    st = vw__world_step_agreed(w, st, before_err, "vw_balance_world");
+    if (st == VW_OK && pays) {
+        uint64_t before = w->migrated;
+        st = vw_world_redecompose(w, nd, map);
+        r.migrated_objects = w->migrated - before;
+        r.bytes_moved = r.migrated_objects * (uint64_t)w->m->object_size;
+        r.applied = st == VW_OK;
     }
 done:
     vw_decomp_free(nd);

@@ -58,7 +58,7 @@ const char *vw_world_errmsg(const vw_world *w)
    world's error (that process too, unless it already held an earlier error: the first
    is kept). One MPI_Allreduce of an int when all is well. `before` is w->err before the
    step; `step` names it where the failure left no message of its own. */
-static vw_status step_agreed(vw_world *w, vw_status st, vw_status before, const char *step)
+vw_status vw__world_step_agreed(vw_world *w, vw_status st, vw_status before, const char *step)
 {
     char msg[512] = "";
     if (st != VW_OK && before == VW_OK && w->err == VW_OK)
@@ -320,7 +320,7 @@ vw_status vw_world_create(const vw_module *m, void *user, const vw_decomp *d, co
     if (st == VW_OK) st = map_cells(w, c ? c->cell_worker : NULL);
     /* Every process made the transport (vw__mpi_attach agrees on that); what failed
        after it may have failed on some processes only. */
-    if (w->transport) st = step_agreed(w, st, VW_OK, "vw_world_create");
+    if (w->transport) st = vw__world_step_agreed(w, st, VW_OK, "vw_world_create");
     if (st != VW_OK) {
         create_failed(st, "%s", w->err != VW_OK ? w->errmsg : vw_status_message(st));
         vw_world_free(w);
@@ -447,7 +447,7 @@ vw_status vw_world_add_objects(vw_world *w, const void *objects, size_t n)
 {
     if (!w) return VW_E_INVAL;
     vw_status before = w->err;
-    return step_agreed(w, add_objects(w, objects, n), before, "vw_world_add_objects");
+    return vw__world_step_agreed(w, add_objects(w, objects, n), before, "vw_world_add_objects");
 }
 
 static vw_status update_object(vw_world *w, size_t id, const void *object)
@@ -478,7 +478,7 @@ vw_status vw_world_update_object(vw_world *w, size_t id, const void *object)
 {
     if (!w) return VW_E_INVAL;
     vw_status before = w->err;
-    return step_agreed(w, update_object(w, id, object), before, "vw_world_update_object");
+    return vw__world_step_agreed(w, update_object(w, id, object), before, "vw_world_update_object");
 }
 
 int vw_world_cells_of_object(const vw_world *w, size_t id, int *out, int max)
@@ -661,7 +661,7 @@ vw_status vw_world_redecompose(vw_world *w, const vw_decomp *d, const int *cell_
 {
     if (!w) return VW_E_INVAL;
     vw_status before = w->err;
-    return step_agreed(w, redecompose(w, d, cell_worker), before, "vw_world_redecompose");
+    return vw__world_step_agreed(w, redecompose(w, d, cell_worker), before, "vw_world_redecompose");
 }
 
 /* ---- duplicated cells --------------------------------------------------------------- */
@@ -831,7 +831,8 @@ vw_status vw_world_set_replicas(vw_world *w, int cell, const int *workers, int n
 {
     if (!w) return VW_E_INVAL;
     vw_status before = w->err;
-    return step_agreed(w, set_replicas(w, cell, workers, n), before, "vw_world_set_replicas");
+    return vw__world_step_agreed(w, set_replicas(w, cell, workers, n), before,
+                                 "vw_world_set_replicas");
 }
 
 int vw_world_replicas(const vw_world *w, int cell, int *out, int max)

@@ -235,6 +235,9 @@ double vw__unit_share(const vw__cell *c, int u);
 vw_status vw__world_error(vw_world *w, vw_status st, const char *fmt, ...)
     __attribute__((format(printf, 3, 4)));
 int vw__worker_process(const vw_world *w, int global_worker);
+/* Ends a collective step in agreement (see world.c): st is this process's outcome,
+   before w->err before the step, step its name for a failure without a message. */
+vw_status vw__world_step_agreed(vw_world *w, vw_status st, vw_status before, const char *step);
 /* calloc for n items of `size`, aligned to and padded to whole cache lines. */
 void *vw__calloc_lines(size_t n, size_t size);
 vw_status vw__world_build_cell(vw_world *w, int cell, vw__worker *wk);

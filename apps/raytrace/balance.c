@@ -123,25 +123,29 @@ vw_status rt_job_farm(rt_job *j, rt_farm f, int *copies, char *err, size_t errle
 
 /* Rebuilds the cells in place (same walls, same workers, same copies of duplicated
    cells: nothing migrates), for cells that were last built for the pre-pass's sparse
-   pixels. */
-static vw_status rebuild(vw_world *w)
+   pixels. Its arrays are each process's own: all fail, or none waits for one in the
+   redecomposition (one agreement a rebuild). */
+static vw_status rebuild(vw_world *w, char *err, size_t errlen)
 {
     const vw_decomp *d = vw_world_decomp(w);
     int nc = vw_decomp_cell_count(d), gw = vw_world_workers(w) * vw_world_processes(w);
-    int *cw = malloc(sizeof(int) * (size_t)nc);
+    int *cw = vw_test_fault("balance-rebuild-nomem") ? NULL : malloc(sizeof(int) * (size_t)nc);
     int *nrep = calloc((size_t)nc, sizeof *nrep);
     int *reps = malloc(sizeof(int) * (size_t)nc * (size_t)gw);
-    if (!cw || !nrep || !reps) {
+    vw_status st = cw && nrep && reps ? VW_OK : VW_E_NOMEM;
+    if (st != VW_OK) snprintf(err, errlen, "rebuilding the cells: out of memory");
+    if ((st = vw_world_agree(w, st, err, errlen)) != VW_OK) {
         free(cw), free(nrep), free(reps);
-        return VW_E_NOMEM;
+        return st;
     }
     for (int c = 0; c < nc; c++) {
         cw[c] = vw_world_cell_worker(w, c);
         nrep[c] = vw_world_replicas(w, c, reps + (size_t)c * gw, gw);
     }
-    vw_status st = vw_world_redecompose(w, d, cw); /* (drops the copies) */
+    st = vw_world_redecompose(w, d, cw); /* (drops the copies) */
     for (int c = 0; c < nc && st == VW_OK; c++)
         if (nrep[c]) st = vw_world_set_replicas(w, c, reps + (size_t)c * gw, nrep[c]);
+    if (st != VW_OK) snprintf(err, errlen, "rebuilding the cells: %s", vw_world_errmsg(w));
     free(cw), free(nrep), free(reps);
     return st;
 }
@@ -165,7 +169,7 @@ static vw_status layout_save(vw_world *w, layout *l)
     layout_free(l);
     int nc = vw_decomp_cell_count(vw_world_decomp(w));
     l->gw = vw_world_workers(w) * vw_world_processes(w);
-    l->cw = malloc(sizeof(int) * (size_t)nc);
+    l->cw = vw_test_fault("balance-layout-nomem") ? NULL : malloc(sizeof(int) * (size_t)nc);
     l->nrep = malloc(sizeof(int) * (size_t)nc);
     l->reps = malloc(sizeof(int) * (size_t)nc * (size_t)l->gw);
     if (!l->cw || !l->nrep || !l->reps) return VW_E_NOMEM;
@@ -185,15 +189,16 @@ static vw_status layout_restore(vw_world *w, const layout *l)
     return st;
 }
 
-/* lambda of the last run's loads per worker (copies of duplicated cells where they ran). */
-static double measured_lambda(vw_world *w, const vw_load_spec *ls, const double *cell_load,
-                              const double *speeds)
+/* lambda of the last run's loads per worker (copies of duplicated cells where they ran)
+   into *lam; VW_E_NOMEM on this process alone. */
+static vw_status measured_lambda(vw_world *w, const vw_load_spec *ls, const double *cell_load,
+                                 const double *speeds, double *lam)
 {
     int gw = vw_world_workers(w) * vw_world_processes(w);
     int nc = vw_decomp_cell_count(vw_world_decomp(w));
     double *t = calloc((size_t)gw, sizeof *t);
     int *id = malloc(sizeof(int) * (size_t)gw);
-    double lam = 0;
+    *lam = 0;
     if (t && id) {
         for (int g = 0; g < gw; g++) id[g] = g;
         if (ls->model == VW_LOAD_COUNTER)
@@ -201,11 +206,12 @@ static double measured_lambda(vw_world *w, const vw_load_spec *ls, const double 
         else
             for (int c = 0; c < nc; c++) t[vw_world_cell_worker(w, c)] += cell_load[c];
         /* Busy times are times already: the world's lambda weighs them by speed. */
-        lam = ls->model == VW_LOAD_BUSY ? vw_world_imbalance(w)
-                                        : vw_balance_imbalance(t, id, gw, gw, speeds);
+        *lam = ls->model == VW_LOAD_BUSY ? vw_world_imbalance(w)
+                                         : vw_balance_imbalance(t, id, gw, gw, speeds);
     }
+    vw_status st = t && id ? VW_OK : VW_E_NOMEM;
     free(t), free(id);
-    return lam;
+    return st;
 }
 
 /* Extra pre-pass / balance rounds for divide and rotate (see rt_job_balance). */
@@ -228,8 +234,11 @@ vw_status rt_job_balance(rt_job *j, const rt_balance *b, rt_balance_result *bi, 
     if (errlen) err[0] = 0;
     vw_world *w = rt_job_world(j);
     vw_load_field *f = NULL;
-    double *load = malloc(sizeof(double) * VW_MAX_CELLS);
+    double *load = vw_test_fault("balance-nomem") ? NULL : malloc(sizeof(double) * VW_MAX_CELLS);
     vw_status st = load ? vw_load_field_create(&f) : VW_E_NOMEM;
+    if (st != VW_OK) snprintf(err, errlen, "balancing: the loads: %s", vw_status_message(st));
+    /* Each process's own memory: all fail, or none waits for one in the pre-pass. */
+    st = vw_world_agree(w, st, err, errlen);
     int stale = 0; /* cells are built for the sparse pre-pass */
     const rt_shared *sh = rt_job_shared(j);
     int stride = b->stride > 0 ? b->stride
@@ -264,48 +273,54 @@ vw_status rt_job_balance(rt_job *j, const rt_balance *b, rt_balance_result *bi, 
                 stride = s2;
                 rt_job_set_sample(j, stride);
                 bi->stride = stride;
-                if (st == VW_OK) st = rebuild(w);
+                if (st == VW_OK) st = rebuild(w, err, errlen);
             }
         }
         if (st != VW_OK) break;
         st = rt_job_reset(j);
         /* Cells built before the sample was set (the caller's commit) must be rebuilt. */
-        if (st == VW_OK && r == 0) st = rebuild(w);
+        if (st == VW_OK && r == 0) st = rebuild(w, err, errlen);
         if (st == VW_OK) st = rt_job_commit(j, err, errlen);
         if (st == VW_OK) st = rt_job_run(j, err, errlen);
         if (st != VW_OK) break;
         stale = 1;
         bi->prepass_s += now() - t0;
         const vw_decomp *d = vw_world_decomp(w);
+        /* From here to the round's next collective step (restoring the best layout, the
+           mapping, the balance) each process works alone: the loads (global figures,
+           the same everywhere) and their lambda, the saved layout, the field. Its memory
+           is its own, so the round agrees once on all of it, before that step. */
+        double lam = 0;
         st = vw_balance_cell_loads(w, &b->load, load);
-        if (st != VW_OK) {
+        if (st != VW_OK)
             snprintf(err, errlen, "the load field: %s", vw_status_message(st));
-            break;
-        }
-        double lam = measured_lambda(w, &b->load, load, b->speeds);
+        else if ((st = measured_lambda(w, &b->load, load, b->speeds, &lam)) != VW_OK)
+            snprintf(err, errlen, "the measured imbalance: %s", vw_status_message(st));
         /* Refuted (lambda no lower than the best measured): the field still learns
            from this measurement and the next round balances on from here; the best
            layout measured is restored when the rounds end. */
         int refuted = r > 0 && b->strategy != VW_BALANCE_NONE && !(lam < best_lam);
-        if (refuted && r == rounds) {
+        int last = r == rounds;
+        if (st == VW_OK && !refuted && b->strategy != VW_BALANCE_NONE) {
+            best_lam = lam;
+            bi->measured = lam;
+            if ((st = layout_save(w, &best)) != VW_OK)
+                snprintf(err, errlen, "saving the layout: %s", vw_status_message(st));
+        }
+        if (st == VW_OK && !last) {
+            st = r == 0 ? vw_load_field_add_cells(f, d, load, 4)
+                        : vw_load_field_calibrate(f, d, load, 4);
+            if (st != VW_OK) snprintf(err, errlen, "the load field: %s", vw_status_message(st));
+        }
+        if ((st = vw_world_agree(w, st, err, errlen)) != VW_OK) break;
+        if (refuted && last) {
             /* Back to the best layout measured (its cells are built for the pre-pass as
                the others, so stale stays). */
             st = layout_restore(w, &best);
             bi->reverted++;
             break;
         }
-        if (!refuted && b->strategy != VW_BALANCE_NONE) {
-            best_lam = lam;
-            bi->measured = lam;
-            st = layout_save(w, &best);
-            if (st != VW_OK) break;
-        }
-        if (r == rounds) break;
-        st = r == 0 ? vw_load_field_add_cells(f, d, load, 4) : vw_load_field_calibrate(f, d, load, 4);
-        if (st != VW_OK) {
-            snprintf(err, errlen, "the load field: %s", vw_status_message(st));
-            break;
-        }
+        if (last) break;
         if (b->strategy == VW_BALANCE_NONE) {
             /* Mapping only: greedy / weighted by the measured loads. The cells were
                built for the pre-pass, so what the remap moves counts (the world's
@@ -338,7 +353,7 @@ vw_status rt_job_balance(rt_job *j, const rt_balance *b, rt_balance_result *bi, 
         vw_balance_report rep;
         st = vw_balance_world(w, f, &bp, &ap, &rep);
         if (st != VW_OK) {
-            snprintf(err, errlen, "balancing: %s", vw_status_message(st));
+            snprintf(err, errlen, "balancing: %s", vw_world_errmsg(w));
             break;
         }
         double before = r == 0 ? rep.imbalance_before : bi->rep.imbalance_before;
@@ -357,7 +372,7 @@ vw_status rt_job_balance(rt_job *j, const rt_balance *b, rt_balance_result *bi, 
     }
     layout_free(&best);
     rt_job_set_sample(j, 1);
-    if (st == VW_OK && stale) st = rebuild(w);
+    if (st == VW_OK && stale) st = rebuild(w, err, errlen);
     if (st == VW_OK) st = rt_job_reset(j);
     if (st != VW_OK && !err[0]) snprintf(err, errlen, "balancing: %s", vw_status_message(st));
     vw_load_field_free(f);

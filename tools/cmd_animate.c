@@ -89,9 +89,11 @@ static int flush(vw_anim_session *s)
     memset(res, 0, s->nbatch * sizeof *res);
     rt_anim_stats st;
     memset(&st, 0, sizeof st);
-    vw_status rc = rt_anim_apply(s->anim, s->batch, s->nbatch, s->check, s->sweep, res, &st);
+    char err[512];
+    vw_status rc = rt_anim_apply(s->anim, s->batch, s->nbatch, s->check, s->sweep, res, &st, err,
+                                 sizeof err);
     if (rc != VW_OK) {
-        vw_cli_error(s->cmd, "applying edits: %s", vw_status_message(rc));
+        vw_cli_error(s->cmd, "%s", err);
         s->nbatch = 0;
         return s->failed = 1;
     }

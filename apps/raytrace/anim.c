@@ -179,15 +179,16 @@ static void touch(const vw_decomp *d, const rt_shared *sh, const rt_object *o, u
 }
 
 vw_status rt_anim_apply(rt_anim *a, const vw_edit *edits, size_t n, int check, int sweep,
-                        vw_result *results, rt_anim_stats *rs)
+                        vw_result *results, rt_anim_stats *rs, char *err, size_t errlen)
 {
     double t0 = now();
     int *changed = NULL;
     size_t nchanged = 0;
+    if (errlen) err[0] = 0;
     vw_status st = vw_dynscene_apply(a->ds, edits, n, check, sweep, results, &changed, &nchanged);
-    if (st != VW_OK) return st;
+    if (st != VW_OK) snprintf(err, errlen, "applying edits: %s", vw_status_message(st));
     double t1 = now();
-    for (size_t i = 0; i < n; i++) {
+    for (size_t i = 0; st == VW_OK && i < n; i++) {
         if (results[i].outcome == VW_OUT_ACCEPTED) rs->accepted++;
         else if (results[i].outcome == VW_OUT_COLLISION) rs->collisions++;
         else if (results[i].outcome == VW_OUT_SWEEP) rs->sweeps++;
@@ -198,32 +199,48 @@ vw_status rt_anim_apply(rt_anim *a, const vw_edit *edits, size_t n, int check, i
     const rt_shared *sh = rt_job_shared(a->job);
     const vw_scene *s = vw_dynscene_scene(a->ds);
     int nc = vw_decomp_cell_count(d);
-    if (a->ntouched_cells != nc) {
+    /* The bookkeeping is this process's own: the marks of the touched cells, and room
+       for every changed object's records (the ids and slots are the same everywhere,
+       so the room is too). All of it is made here, before the first update of the world
+       (collective), and agreed on once a batch: all fail, or none waits for one in an
+       update. */
+    int *cells = NULL;
+    if (st == VW_OK && a->ntouched_cells != nc) {
         /* A new layout (rebalanced): its first frame builds every cell anyway. */
         free(a->touched);
-        a->touched = calloc((size_t)nc, 1);
+        a->touched = vw_test_fault("anim-apply-nomem") ? NULL : calloc((size_t)nc, 1);
         a->ntouched_cells = a->touched ? nc : 0;
         a->ntouched = 0;
     }
+    if (st == VW_OK) cells = malloc(sizeof(int) * (size_t)nc);
+    if (st == VW_OK && (!a->touched || !cells)) st = VW_E_NOMEM;
+    size_t need = 0;
+    for (size_t i = 0; st == VW_OK && i < nchanged; i++) {
+        size_t first, ns;
+        vw_dynscene_slots(a->ds, changed[i], &first, &ns);
+        if (first + ns > need) need = first + ns;
+    }
+    if (st == VW_OK && need > a->caprec) {
+        size_t cap = a->caprec ? a->caprec : 64;
+        while (cap < need) cap *= 2;
+        rt_object *r =
+            vw_test_fault("anim-records-nomem") ? NULL : realloc(a->rec, cap * sizeof *r);
+        if (r) {
+            a->rec = r;
+            a->caprec = cap;
+        } else {
+            st = VW_E_NOMEM;
+        }
+    }
+    if (st != VW_OK && !err[0])
+        snprintf(err, errlen, "applying edits: out of memory for the marks and records");
+    st = vw_world_agree(w, st, err, errlen);
     unsigned char *mark = a->touched;
-    int *cells = malloc(sizeof(int) * (size_t)nc);
-    if (!mark || !cells) st = VW_E_NOMEM;
     size_t touched_before = rs->cells_touched;
     for (size_t i = 0; i < nchanged && st == VW_OK; i++) {
         int id = changed[i];
         size_t first, ns;
         vw_dynscene_slots(a->ds, id, &first, &ns);
-        if (first + ns > a->caprec) {
-            size_t cap = a->caprec ? a->caprec : 64;
-            while (cap < first + ns) cap *= 2;
-            rt_object *r = realloc(a->rec, cap * sizeof *r);
-            if (!r) {
-                st = VW_E_NOMEM;
-                break;
-            }
-            a->rec = r;
-            a->caprec = cap;
-        }
         for (size_t k = 0; k < ns; k++) /* the cells it leaves */
             if (first + k < a->nrec) touch(d, sh, &a->rec[first + k], mark, cells, &rs->cells_touched);
         object_records(s, id, vw_dynscene_alive(a->ds, id), ns, a->rec + first);
@@ -238,6 +255,8 @@ vw_status rt_anim_apply(rt_anim *a, const vw_edit *edits, size_t n, int check, i
             } else {
                 st = vw_world_update_object(w, slot, &a->rec[slot]);
             }
+            if (st != VW_OK)
+                snprintf(err, errlen, "updating the render world: %s", vw_world_errmsg(w));
             rs->records_updated++;
         }
     }
@@ -305,9 +324,11 @@ vw_status rt_anim_balance(rt_anim *a, const char *strategy, double *before, doub
         snprintf(err, errlen, "unknown or unsupported balance strategy '%s'", strategy);
         return VW_E_INVAL;
     }
+    if (errlen) err[0] = 0;
     vw_world *w = rt_job_world(a->job);
     int nc = vw_decomp_cell_count(vw_world_decomp(w));
-    double *load = malloc(sizeof(double) * VW_MAX_CELLS);
+    double *load =
+        vw_test_fault("anim-balance-nomem") ? NULL : malloc(sizeof(double) * VW_MAX_CELLS);
     int *cw = malloc(sizeof(int) * VW_MAX_CELLS);
     vw_load_field *f = NULL;
     vw_load_spec ls;
@@ -315,11 +336,17 @@ vw_status rt_anim_balance(rt_anim *a, const char *strategy, double *before, doub
     ls.model = VW_LOAD_COUNTER;   /* ray-cell visits: deterministic, the same on every */
     ls.counter = RT_C_SEGMENTS;   /* process and every run, unlike busy time */
     vw_status st = load && cw ? vw_balance_cell_loads(w, &ls, load) : VW_E_NOMEM;
+    double total = 0;
+    for (int c = 0; st == VW_OK && c < nc; c++) total += load[c];
+    if (st == VW_OK && total > 0) st = vw_load_field_create(&f);
+    if (st == VW_OK && total > 0) st = vw_load_field_add_cells(f, vw_world_decomp(w), load, 4);
+    if (st != VW_OK) snprintf(err, errlen, "balancing: the loads: %s", vw_status_message(st));
+    /* The arrays and the field are this process's own: all fail, or none waits for one
+       in the balance (collective). */
+    st = vw_world_agree(w, st, err, errlen);
     /* New walls start with no load measured: until a frame is rendered on them there
        is nothing to balance by (the loads are the job's own, equal on every process,
        so every process returns here alike). */
-    double total = 0;
-    for (int c = 0; st == VW_OK && c < nc; c++) total += load[c];
     if (st == VW_OK && !(total > 0)) {
         if (before) *before = 0;
         if (predicted) *predicted = 0;
@@ -327,8 +354,6 @@ vw_status rt_anim_balance(rt_anim *a, const char *strategy, double *before, doub
         free(cw);
         return VW_OK;
     }
-    if (st == VW_OK) st = vw_load_field_create(&f);
-    if (st == VW_OK) st = vw_load_field_add_cells(f, vw_world_decomp(w), load, 4);
     vw_balance_report rep;
     memset(&rep, 0, sizeof rep);
     if (st == VW_OK && bs != VW_BALANCE_NONE) {
@@ -338,6 +363,7 @@ vw_status rt_anim_balance(rt_anim *a, const char *strategy, double *before, doub
         vw_balance_apply ap;
         memset(&ap, 0, sizeof ap);
         st = vw_balance_world(w, f, &bp, &ap, &rep);
+        if (st != VW_OK) snprintf(err, errlen, "balancing: %s", vw_world_errmsg(w));
         if (st == VW_OK && rep.applied) a->rebuild_all = 1; /* new cells, all built anew */
     }
     if (st == VW_OK) {
@@ -347,7 +373,7 @@ vw_status rt_anim_balance(rt_anim *a, const char *strategy, double *before, doub
         for (int c = 0; c < nc; c++) cw[c] = vw_world_cell_worker(w, c);
         st = vw_dynscene_redecompose(a->ds, d, cw);
     }
-    if (st != VW_OK) snprintf(err, errlen, "balancing: %s", vw_status_message(st));
+    if (st != VW_OK && !err[0]) snprintf(err, errlen, "balancing: %s", vw_status_message(st));
     if (before) *before = rep.imbalance_before;
     if (predicted) *predicted = rep.imbalance_predicted;
     vw_load_field_free(f);

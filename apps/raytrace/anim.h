@@ -55,9 +55,13 @@ const vw_camera *rt_anim_camera(const rt_anim *a);
 const vw_box *rt_anim_world(const rt_anim *a);
 double rt_anim_scale(const rt_anim *a);
 
-/* Decides a batch of object edits and brings the render world up to date. */
+/* Decides a batch of object edits and brings the render world up to date. err gets a
+   message. Collective under MPI, like the rest of this file: the batch's bookkeeping
+   (the touched cells' marks, room for the records) is each process's own and is agreed
+   on before the render world's first update, so memory one process lacks fails the
+   batch on every process with "rank R: ..." in err (and no process waits for it). */
 vw_status rt_anim_apply(rt_anim *a, const vw_edit *edits, size_t n, int check, int sweep,
-                        vw_result *results, rt_anim_stats *st);
+                        vw_result *results, rt_anim_stats *st, char *err, size_t errlen);
 /* Renders the current scene (rebuilding the dirty cells first). The image is then
    rt_job_rgb8(rt_anim_job(a)) on the output process. */
 vw_status rt_anim_render(rt_anim *a, rt_anim_stats *st, char *err, size_t errlen);

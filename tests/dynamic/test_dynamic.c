@@ -263,7 +263,8 @@ static void test_placement(int seeds, int workers)
             for (int i = 0; i < ne; i++) e[i] = random_edit(vw_dynscene_ids(ds), i + 1);
             rt_anim_stats st;
             memset(&st, 0, sizeof st);
-            CHECK(rt_anim_apply(a, e, (size_t)ne, step % 3 != 0, step % 2, r, &st) == VW_OK);
+            CHECK(rt_anim_apply(a, e, (size_t)ne, step % 3 != 0, step % 2, r, &st, err,
+                                sizeof err) == VW_OK);
             if (step % 5 == 4) CHECK(rt_anim_render(a, NULL, err, sizeof err) == VW_OK);
             /* The collider world: its shapes are the dynscene's slots. */
             vw_world *cw = vw_collider_world(vw_dynscene_collider(ds));
@@ -562,7 +563,7 @@ static void test_frame(int seeds, int workers)
             for (int i = 0; i < 20; i++) e[i] = random_edit(vw_dynscene_ids(ds), i + 1);
             rt_anim_stats st;
             memset(&st, 0, sizeof st);
-            CHECK(rt_anim_apply(a, e, 20, 1, frame % 2, r, &st) == VW_OK);
+            CHECK(rt_anim_apply(a, e, 20, 1, frame % 2, r, &st, err, sizeof err) == VW_OK);
             CHECK(rt_anim_render(a, &st, err, sizeof err) == VW_OK);
             /* The edited scene from scratch. */
             char *text = NULL;

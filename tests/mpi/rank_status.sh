@@ -20,6 +20,15 @@
 #     farming (farm-nomem, rt_job_farm), animate's records (anim-nomem, rt_anim_create),
 #     the radiosity solver before its world exists (solver-nomem) and after it
 #     (solver-slots-nomem, rad_solver_create).
+# And memory that rank 1 alone lacks between the collective steps of a balance or of a
+# frame's edits (which hung the job: the others waited in the next step): render
+# --balance tensor (rt_job_balance: its loads balance-nomem, a rebuild of the cells
+# balance-rebuild-nomem, the saved layout balance-layout-nomem; vw_balance_world's plan
+# balance-plan-nomem, and with --balance duplicate its copies' balance-copies-nomem),
+# animate's edits
+# (rt_anim_apply: the touched cells' marks anim-apply-nomem, room for an added object's
+# records anim-records-nomem) and its rebalance between frames (rt_anim_balance:
+# anim-balance-nomem).
 # usage: rank_status.sh VWALLS NP "MPIEXEC -n NP [flags]"
 vwalls=$1 np=$2 launch=$3
 dir=$(mktemp -d)
@@ -142,4 +151,34 @@ for f in solver solver-slots; do
         "[ $rank = 1 ] && export VW_FAULT=$f-nomem; \"$vwalls\" radiosity \"$dir/cornell.nff\" -o \"$dir/l.ply\" --cells 2x2x2 --workers 1 --max-shots 4 --quiet"
 done
 [ ! -e "$dir/l.ply" ] || { echo "FAIL: radiosity, no memory: output written"; fail=1; }
+
+# Balancing and editing, rank 1 short of memory between collective steps.
+on1="[ $rank = 1 ] && export VW_FAULT"
+for f in balance balance-rebuild balance-layout; do
+    case $f in
+    balance) what="balancing: the loads" ;;
+    balance-rebuild) what="rebuilding the cells" ;;
+    balance-layout) what="saving the layout" ;;
+    esac
+    must_agree "render --balance tensor, no memory for $f on rank 1" 1 \
+        "^vwalls render: rank 1: $what: out of memory" \
+        "$on1=$f-nomem; \"$vwalls\" render \"$dir/balls.nff\" -o \"$dir/r.png\" --balance tensor $small"
+done
+for f in plan copies; do
+    [ $f = plan ] && b=tensor || b=duplicate
+    must_agree "render --balance $b, no memory for the balancer's $f on rank 1" 1 \
+        "^vwalls render: balancing: rank 1: vw_balance_world: out of memory" \
+        "$on1=balance-$f-nomem; \"$vwalls\" render \"$dir/balls.nff\" -o \"$dir/r.png\" --balance $b $small"
+done
+[ ! -e "$dir/r.png" ] || { echo "FAIL: render --balance, no memory: output written"; fail=1; }
+printf 'check off\nadd sphere 0 0 0 0.05\nframe\n' >"$dir/adds"
+for f in anim-apply anim-records; do
+    [ $f = anim-apply ] && e=edits || e=adds
+    must_agree "animate, no memory for the edits' $f bookkeeping on rank 1" 1 \
+        "^vwalls animate: rank 1: applying edits: out of memory for the marks and records" \
+        "$on1=$f-nomem; \"$vwalls\" animate \"$dir/balls.nff\" \"$dir/$e\" -o \"$dir/a%d.png\" $small"
+done
+must_agree "animate --balance tensor, no memory for the rebalance on rank 1" 1 \
+    "^vwalls animate: rank 1: balancing: the loads: out of memory" \
+    "$on1=anim-balance-nomem; \"$vwalls\" animate \"$dir/balls.nff\" \"$dir/edits\" -o \"$dir/a%d.png\" --balance tensor --threshold 0 --trigger work $small"
 exit $fail

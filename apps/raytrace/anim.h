@@ -68,7 +68,9 @@ vw_status rt_anim_render(rt_anim *a, rt_anim_stats *st, char *err, size_t errlen
 /* Rebalances the render world with the given strategy from the last frame's measured
    loads (VW_E_UNSUPPORTED when the build has no balancer); the collider follows. When
    no load has been measured on the current walls (no frame rendered yet, or none since
-   the last rebalance reset the counters), nothing is done and both lambdas are 0. */
+   the last rebalance reset the counters), nothing is done and both lambdas are 0.
+   Collective under MPI: its loads and field are agreed on before the balance, so memory
+   one process lacks fails it on every process with "rank R: ..." in err. */
 vw_status rt_anim_balance(rt_anim *a, const char *strategy, double *lambda_before,
                           double *lambda_predicted, char *err, size_t errlen);
 /* Lambda (max/mean worker busy time) of the last frame. */

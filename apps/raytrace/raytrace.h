@@ -251,8 +251,12 @@ typedef struct rt_balance_result {
    builds the load field and moves the walls (repeated b->rounds times, each pre-pass
    re-calibrating the field on the new layout, and each balance checked by the next
    pre-pass: one that does not lower the measured lambda is undone and ends the rounds);
-   then the job is reset for the full render (commit + run). Strategy none with map greedy/weighted maps by the measured
-   loads instead. Collective under MPI. */
+   then the job is reset for the full render (commit + run). Strategy none with map
+   greedy/weighted maps by the measured loads instead. Collective under MPI: what each
+   process does alone between the collective steps (its loads, field and saved layout,
+   a rebuild's arrays) is agreed on before the next one (once after the loads, once a
+   rebuild, once a pre-pass round), so memory one process lacks fails the balance on
+   every process with "rank R: ..." in err. */
 vw_status rt_job_balance(rt_job *j, const rt_balance *b, rt_balance_result *out, char *err,
                          size_t errlen);
 /* Re-maps the cells (kind, loads or NULL, speeds or NULL) before or between runs. */

@@ -146,7 +146,10 @@ typedef struct vw_balance_apply {
 
 /* Balances world w between runs: decomposition from the field, mapping, re-placement
    and migration of objects, rebuild at the next commit/run; records the balance info
-   for the stats JSON. Collective under MPI (every process calls it with the same field). */
+   for the stats JSON. Collective under MPI (every process calls it with the same field):
+   each process plans alone, and the plans agree (vw_world_agree) before the
+   redecomposition or the copies, so memory one process lacks fails the balance on every
+   process, with "rank R: vw_balance_world: ..." as the world's error. */
 VW_API vw_status vw_balance_world(vw_world *w, const vw_load_field *f, const vw_balance_params *p,
                                   const vw_balance_apply *a, vw_balance_report *rep);
 

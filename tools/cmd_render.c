@@ -120,6 +120,12 @@ static void *progress_main(void *arg)
 
 /* ---- balancing: a sparse pre-pass, the balancer, then the full render ----------------- */
 
+/* JSON has no NaN nor infinity, and one "inf" makes the whole file unreadable: every
+   double of balance_detail goes through num(), as every double of the core's stats does
+   (src/core/stats.c; 0 stands for "not measured"). A lambda is infinite where a worker
+   is next to infinitely slower than another (--speeds 1e308,1). */
+static double num(double x) { return isfinite(x) ? x : 0.0; }
+
 /* The stats JSON member "balance_detail" appended to the ray tracer's members. */
 static char *with_balance_json(char *rt, rt_job *job, vw_world *w, const vw_traffic *tr,
                                const rt_balance_result *bi,
@@ -145,10 +151,11 @@ static char *with_balance_json(char *rt, rt_job *job, vw_world *w, const vw_traf
              "\"share_process\": %.6g, \"share_machine\": %.6g}",
              rt, vw_balance_strategy_name(s), vw_map_kind_name(map),
              models[ls->model <= VW_LOAD_MODEL ? ls->model : 0], bi->rounds,
-             bi->rep.imbalance_before, bi->rep.imbalance_predicted, vw_world_imbalance(w),
-             rt_job_work_imbalance(job, speeds), (unsigned long long)bi->migrated,
+             num(bi->rep.imbalance_before), num(bi->rep.imbalance_predicted),
+             num(vw_world_imbalance(w)), num(rt_job_work_imbalance(job, speeds)),
+             (unsigned long long)bi->migrated,
              (unsigned long long)bi->bytes, vw_decomp_max_neighbours(vw_world_decomp(w)),
-             bi->prepass_s, vw_world_time(w, "balance"), bi->stride, bi->reverted, bi->measured,
+             bi->prepass_s, vw_world_time(w, "balance"), bi->stride, bi->reverted, num(bi->measured),
              bi->rep.duplicates, rt_farm_name(farm), farm_copies, (unsigned long long)tr->msgs,
              (unsigned long long)tr->bytes, (unsigned long long)tr->msgs_worker,
              (unsigned long long)tr->bytes_worker, (unsigned long long)tr->msgs_process,

@@ -63,6 +63,16 @@ render(${WORK}/speeds.png ${VWALLS} render ${SCENE} -o ${WORK}/speeds.png ${comm
 render(${WORK}/huge.png ${VWALLS} render ${SCENE} -o ${WORK}/huge.png ${common} --cells 2x2x2
        --workers 2 --map weighted --balance duplicate --balance-load segments
        --speeds 1e308,1e308)
+# JSON has no infinity: with every cell's work on the slow worker of 1e308,1 lambda is
+# beyond any double, and balance_detail said "imbalance_work": inf (unreadable JSON).
+execute_process(COMMAND ${VWALLS} render ${SCENE} -o ${WORK}/lopsided.png ${common} --cells 2x2x2
+                --workers 2 --map weighted --speeds 1e308,1 --stats ${WORK}/lopsided.json
+                RESULT_VARIABLE rc ERROR_VARIABLE err)
+file(READ ${WORK}/lopsided.json json)
+string(JSON work ERROR_VARIABLE bad GET "${json}" balance_detail imbalance_work)
+if(NOT rc EQUAL 0 OR bad OR json MATCHES "[:,\\[] *-?(inf|nan)")
+  message(FATAL_ERROR "--speeds 1e308,1: exit ${rc}, imbalance_work ${work} ${bad}: ${err}")
+endif()
 # A mapping alone (--map weighted, no --balance) reports the lambda it measured and the
 # one it predicts, by counted work: they were printed as 0.000 (never filled in).
 execute_process(COMMAND ${VWALLS} render ${SCENE} -o ${WORK}/mapped.png --size 80x60 --cells 2x2x2

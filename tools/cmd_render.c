@@ -126,6 +126,16 @@ static void *progress_main(void *arg)
    is next to infinitely slower than another (--speeds 1e308,1). */
 static double num(double x) { return isfinite(x) ? x : 0.0; }
 
+/* The copies of cells in the world as it renders (vw_world_set_replicas): what the
+   last balancing round added would say 0 when that round kept the copies it found, or
+   when the best layout, copies and all, was restored. */
+static int world_duplicates(vw_world *w)
+{
+    int n = 0, nc = vw_decomp_cell_count(vw_world_decomp(w));
+    for (int c = 0; c < nc; c++) n += vw_world_replicas(w, c, NULL, 0);
+    return n;
+}
+
 /* The stats JSON member "balance_detail" appended to the ray tracer's members. */
 static char *with_balance_json(char *rt, rt_job *job, vw_world *w, const vw_traffic *tr,
                                const rt_balance_result *bi,
@@ -156,7 +166,7 @@ static char *with_balance_json(char *rt, rt_job *job, vw_world *w, const vw_traf
              (unsigned long long)bi->migrated,
              (unsigned long long)bi->bytes, vw_decomp_max_neighbours(vw_world_decomp(w)),
              bi->prepass_s, vw_world_time(w, "balance"), bi->stride, bi->reverted, num(bi->measured),
-             bi->rep.duplicates, rt_farm_name(farm), farm_copies, (unsigned long long)tr->msgs,
+             world_duplicates(w), rt_farm_name(farm), farm_copies, (unsigned long long)tr->msgs,
              (unsigned long long)tr->bytes, (unsigned long long)tr->msgs_worker,
              (unsigned long long)tr->bytes_worker, (unsigned long long)tr->msgs_process,
              (unsigned long long)tr->bytes_process, (unsigned long long)tr->msgs_machine,

@@ -43,6 +43,25 @@ foreach(case "tensor;block;2x2x2;2" "rotate;block;2x4;2" "staggered;greedy;2x2x2
   endif()
 endforeach()
 
+# balance_detail.duplicates counts the copies the render ran with (the cells' "replicas"):
+# it said what the last balancing round added, 0 when that round kept the copies it
+# found or the best layout, copies and all, was restored.
+file(READ ${WORK}/duplicate.json json)
+string(JSON dups GET "${json}" balance_detail duplicates)
+string(JSON ncells LENGTH "${json}" cells)
+math(EXPR last "${ncells} - 1")
+set(reps 0)
+foreach(c RANGE ${last})
+  string(JSON n ERROR_VARIABLE noreps LENGTH "${json}" cells ${c} replicas)
+  if(NOT noreps)
+    math(EXPR reps "${reps} + ${n}")
+  endif()
+endforeach()
+if(reps LESS 1 OR NOT dups EQUAL reps)
+  message(FATAL_ERROR "--balance duplicate: balance_detail.duplicates ${dups}, copies in "
+          "the cells ${reps}")
+endif()
+
 file(READ ${WORK}/staggered.json json)
 foreach(key "\"strategy\": \"staggered\"" "\"imbalance_before\"" "\"imbalance_after\""
             "\"migrated_objects\"" "\"bytes_moved\"" "\"max_neighbours\"" "\"balance\": "

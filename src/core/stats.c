@@ -141,8 +141,12 @@ static void write_body(vw_world *w, FILE *f, const char *command, const char *ex
     for (int g = 0; g < w->gworkers; g++) {
         const vw__worker_stats *ws = &w->wstats[g];
         uint64_t rss = vw__worker_process(w, g) == w->rank || !ws->peak_rss ? rss_here : ws->peak_rss;
-        fprintf(f, "    {\"id\": %d, \"process\": %d, \"busy_s\": %.6f, \"peak_rss_bytes\": %llu, \"messages\": %llu, \"bytes\": %llu, \"remote_count\": %llu, \"remote_bytes\": %llu",
-                g, vw__worker_process(w, g), num(vw_world_worker_busy(w, g)), (unsigned long long)rss,
+        /* The worker's speed (vw_config.worker_speeds, 1 when none were given): with
+           speeds lambda is the longest time against a split by speed, which a reader
+           can recompute from busy_s only when the speeds are here. */
+        fprintf(f, "    {\"id\": %d, \"process\": %d, \"speed\": %.9g, \"busy_s\": %.6f, \"peak_rss_bytes\": %llu, \"messages\": %llu, \"bytes\": %llu, \"remote_count\": %llu, \"remote_bytes\": %llu",
+                g, vw__worker_process(w, g), num(w->speeds ? w->speeds[g] : 1.0),
+                num(vw_world_worker_busy(w, g)), (unsigned long long)rss,
                 (unsigned long long)ws->msgs_sent, (unsigned long long)ws->bytes_sent,
                 (unsigned long long)ws->msgs_remote, (unsigned long long)ws->bytes_remote);
         /* The module's counters of the units (cells, copies) on this worker: what each

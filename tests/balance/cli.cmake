@@ -76,7 +76,15 @@ endforeach()
 render(${WORK}/slow.png ${VWALLS} render ${SCENE} -o ${WORK}/slow.png ${common} --cells 4x2
        --workers 2 --map weighted --slow 1:3)
 render(${WORK}/speeds.png ${VWALLS} render ${SCENE} -o ${WORK}/speeds.png ${common} --cells 4x2
-       --workers 2 --map weighted --speeds 1,2)
+       --workers 2 --map weighted --speeds 1,2 --stats ${WORK}/speeds.json)
+# ... and the stats name every worker's speed: lambda with speeds is the longest time
+# against a split by speed, which a reader could not recompute from busy_s without them.
+file(READ ${WORK}/speeds.json json)
+string(JSON speed0 ERROR_VARIABLE nospeed GET "${json}" workers 0 speed)
+string(JSON speed1 ERROR_VARIABLE nospeed GET "${json}" workers 1 speed)
+if(nospeed OR NOT speed0 EQUAL 1 OR NOT speed1 EQUAL 2)
+  message(FATAL_ERROR "--speeds 1,2: workers' speeds ${speed0}, ${speed1} ${nospeed}")
+endif()
 # Speeds are relative, at any scale: 1e308 each once summed to infinity, and the shares of
 # a duplicated cell's copies came out NaN (a crash).
 render(${WORK}/huge.png ${VWALLS} render ${SCENE} -o ${WORK}/huge.png ${common} --cells 2x2x2

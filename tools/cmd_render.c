@@ -126,14 +126,15 @@ static void *progress_main(void *arg)
    is next to infinitely slower than another (--speeds 1e308,1). */
 static double num(double x) { return isfinite(x) ? x : 0.0; }
 
-/* The copies of cells in the world as it renders (vw_world_set_replicas): what the
-   last balancing round added would say 0 when that round kept the copies it found, or
-   when the best layout, copies and all, was restored. */
-static int world_duplicates(vw_world *w)
+/* The copies of cells the balancer made (--balance duplicate) in the world as it
+   renders: all its copies less the farm's (made after balancing, counted apart in
+   farm_copies). What the last balancing round added said 0 when that round kept the
+   copies it found, or when the best layout, copies and all, was restored. */
+static int world_duplicates(vw_world *w, int farm_copies)
 {
     int n = 0, nc = vw_decomp_cell_count(vw_world_decomp(w));
     for (int c = 0; c < nc; c++) n += vw_world_replicas(w, c, NULL, 0);
-    return n;
+    return n - farm_copies;
 }
 
 /* The stats JSON member "balance_detail" appended to the ray tracer's members. */
@@ -166,7 +167,7 @@ static char *with_balance_json(char *rt, rt_job *job, vw_world *w, const vw_traf
              (unsigned long long)bi->migrated,
              (unsigned long long)bi->bytes, vw_decomp_max_neighbours(vw_world_decomp(w)),
              bi->prepass_s, vw_world_time(w, "balance"), bi->stride, bi->reverted, num(bi->measured),
-             world_duplicates(w), rt_farm_name(farm), farm_copies, (unsigned long long)tr->msgs,
+             world_duplicates(w, farm_copies), rt_farm_name(farm), farm_copies, (unsigned long long)tr->msgs,
              (unsigned long long)tr->bytes, (unsigned long long)tr->msgs_worker,
              (unsigned long long)tr->bytes_worker, (unsigned long long)tr->msgs_process,
              (unsigned long long)tr->bytes_process, (unsigned long long)tr->msgs_machine,

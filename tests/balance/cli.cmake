@@ -43,24 +43,34 @@ foreach(case "tensor;block;2x2x2;2" "rotate;block;2x4;2" "staggered;greedy;2x2x2
   endif()
 endforeach()
 
-# balance_detail.duplicates counts the copies the render ran with (the cells' "replicas"):
-# it said what the last balancing round added, 0 when that round kept the copies it
-# found or the best layout, copies and all, was restored.
-file(READ ${WORK}/duplicate.json json)
-string(JSON dups GET "${json}" balance_detail duplicates)
-string(JSON ncells LENGTH "${json}" cells)
-math(EXPR last "${ncells} - 1")
-set(reps 0)
-foreach(c RANGE ${last})
-  string(JSON n ERROR_VARIABLE noreps LENGTH "${json}" cells ${c} replicas)
-  if(NOT noreps)
-    math(EXPR reps "${reps} + ${n}")
+# balance_detail.duplicates counts the copies the balancer made and the render ran with
+# (the cells' "replicas", less the farm's copies, counted apart): it said what the last
+# balancing round added, 0 when that round kept the copies it found or the best layout,
+# copies and all, was restored.
+function(check_duplicates file expect_some)
+  file(READ ${file} json)
+  string(JSON dups GET "${json}" balance_detail duplicates)
+  string(JSON farmed GET "${json}" balance_detail farm_copies)
+  string(JSON ncells LENGTH "${json}" cells)
+  math(EXPR last "${ncells} - 1")
+  set(reps 0)
+  foreach(c RANGE ${last})
+    string(JSON n ERROR_VARIABLE noreps LENGTH "${json}" cells ${c} replicas)
+    if(NOT noreps)
+      math(EXPR reps "${reps} + ${n}")
+    endif()
+  endforeach()
+  math(EXPR made "${reps} - ${farmed}")
+  if(NOT dups EQUAL made OR (expect_some AND dups LESS 1) OR (NOT expect_some AND NOT dups EQUAL 0))
+    message(FATAL_ERROR "${file}: balance_detail.duplicates ${dups}, copies in the cells "
+            "${reps}, of them farmed ${farmed}")
   endif()
-endforeach()
-if(reps LESS 1 OR NOT dups EQUAL reps)
-  message(FATAL_ERROR "--balance duplicate: balance_detail.duplicates ${dups}, copies in "
-          "the cells ${reps}")
-endif()
+endfunction()
+check_duplicates(${WORK}/duplicate.json 1)
+# Farmed copies are no duplicates: --farm all on two workers copies every cell.
+render("" ${VWALLS} render ${SCENE} -o ${WORK}/farmed.png ${common} --cells 2x2x2 --workers 2
+       --farm all --stats ${WORK}/farmed.json)
+check_duplicates(${WORK}/farmed.json 0)
 
 file(READ ${WORK}/staggered.json json)
 foreach(key "\"strategy\": \"staggered\"" "\"imbalance_before\"" "\"imbalance_after\""

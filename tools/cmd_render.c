@@ -384,8 +384,8 @@ int vw_cmd_render(int argc, char **argv)
             rc = vw_cli_fail(CMD, VW_EXIT_FAIL, err, sizeof err, "out of memory for --speeds");
         else if (vw_map_parse_speeds(speeds_s, speeds, gw) != VW_OK)
             rc = vw_cli_fail(CMD, VW_EXIT_USAGE, err, sizeof err, "--speeds: bad value '%s' "
-                             "(expected %d positive numbers, one per worker: %d process%s x %d "
-                             "worker%s%s)", speeds_s, gw, vw_engine_size(),
+                             "(expected %d positive number%s, one per worker: %d process%s x %d "
+                             "worker%s%s)", speeds_s, gw, gw == 1 ? "" : "s", vw_engine_size(),
                              vw_engine_size() == 1 ? "" : "es", gw / vw_engine_size(),
                              gw / vw_engine_size() == 1 ? "" : "s",
                              workers > 0 ? "" : vw_engine_size() == 1 ? ", one per core; --workers sets them"

@@ -166,6 +166,12 @@ foreach(bad "--balance;sideways" "--map;random" "--speeds;1,x" "--speeds;1" "--s
     message(FATAL_ERROR "${bad}: exit ${rc} (expected 2): ${err}")
   endif()
 endforeach()
+# One worker: "1 positive number" (it said "1 positive numbers").
+execute_process(COMMAND ${VWALLS} render ${SCENE} -o ${WORK}/bad.png --workers 1 --speeds 1,2
+                RESULT_VARIABLE rc OUTPUT_QUIET ERROR_VARIABLE err)
+if(NOT rc EQUAL 2 OR EXISTS ${WORK}/bad.png OR NOT err MATCHES "expected 1 positive number, one per worker: 1 process x 1 worker\\)")
+  message(FATAL_ERROR "--workers 1 --speeds 1,2: exit ${rc} (expected 2, in the singular): ${err}")
+endif()
 # A K beyond the limit: the message says what the limit is (it said "K >= 1" alone).
 execute_process(COMMAND ${VWALLS} render ${SCENE} -o ${WORK}/bad.png --workers 2 --slow 1:2000
                 RESULT_VARIABLE rc OUTPUT_QUIET ERROR_VARIABLE err)

@@ -5,6 +5,7 @@
 #include "vwalls/engine.h"
 
 #include <errno.h>
+#include <sys/stat.h>
 #include <float.h>
 #include <math.h>
 #include <stdarg.h>
@@ -273,6 +274,43 @@ int vw_cli_agree(const char *cmd, int rc, char *msg, size_t len)
             fprintf(stderr, "%s\n", msg);
     }
     return all;
+}
+
+/* Can a file be made at path: its directory exists and may be written into, and path
+   is not a directory? 0, or -1 with the reason in err. Checked before the solve, so
+   that a result is not computed for minutes and then lost; the writes at the end still
+   report their own errors (a full disk, a directory removed meanwhile). */
+static int check_writable(const char *opt, const char *path, char *err, size_t errlen)
+{
+    struct stat st;
+    if (stat(path, &st) == 0 && S_ISDIR(st.st_mode)) {
+        snprintf(err, errlen, "%s %s: cannot write: it is a directory", opt, path);
+        return -1;
+    }
+    const char *slash = strrchr(path, '/');
+    char *dir = slash ? strndup(path, slash == path ? 1 : (size_t)(slash - path)) : strdup(".");
+    if (!dir) {
+        snprintf(err, errlen, "out of memory");
+        return -1;
+    }
+    int bad = 0;
+    if (stat(dir, &st) != 0) bad = errno;
+    else if (!S_ISDIR(st.st_mode)) bad = ENOTDIR;
+    else if (access(dir, W_OK | X_OK) != 0) bad = errno;
+    if (bad) snprintf(err, errlen, "%s %s: cannot write: %s: %s", opt, path, dir, strerror(bad));
+    free(dir);
+    return bad ? -1 : 0;
+}
+
+int vw_cli_check_outputs(const char *cmd, const char *const *opts, const char *const *paths, int n)
+{
+    char err[1024] = "";
+    vw_status st = VW_OK;
+    for (int k = 0; k < n && st == VW_OK && vw_cli_is_output(); k++)
+        if (paths[k] && check_writable(opts[k], paths[k], err, sizeof err)) st = VW_E_IO;
+    if (vw_engine_agree(st, err, sizeof err) == VW_OK) return VW_EXIT_OK;
+    if (vw_cli_is_output()) vw_cli_error(cmd, "%s", err);
+    return VW_EXIT_FAIL;
 }
 
 /* Rank 0's n values (collective; a copy to free). */

@@ -51,6 +51,15 @@ const char *vw_cli_output(const char *cmd, int argc, char **argv, int *i);
    outside tests. */
 int vw_cli_fault(const char *name);
 
+/* Can the output files be made: for each of the n paths given (NULL: none), its
+   directory exists and may be written into, and it is not a directory? Checked on the
+   output process (the one that writes) before the work, so that a result is not
+   computed and then lost, or half of the outputs written; the writes at the end still
+   report their own errors (a full disk, a directory removed meanwhile). VW_EXIT_OK, or
+   VW_EXIT_FAIL on every process with "vwalls CMD: OPT PATH: cannot write: DIR: why"
+   printed once. Collective under MPI. */
+int vw_cli_check_outputs(const char *cmd, const char *const *opts, const char *const *paths, int n);
+
 /* Is this process the one that prints (rank 0, or no MPI)? Valid after vw_cli_engine_init. */
 int vw_cli_is_output(void);
 /* Workers of the whole job: --workers W (0: the world's default, one per core, and under

@@ -557,6 +557,16 @@ int vw_anim_main(const char *cmd, int argc, char **argv)
     p.depth = (int)depth;
     p.farm = (rt_farm)vw_cli_farm_resolve(farm, s->strategy != NULL); /* as render's */
     s->farm = p.farm;
+    {
+        /* The frames' directory and the stats' (the log is opened below), before any
+           frame: a --stats into a missing directory failed after the last frame. */
+        const char *opts[] = {"-o", "--stats"};
+        const char *paths[] = {s->pattern, stats};
+        if (vw_cli_check_outputs(cmd, opts, paths, 2) != VW_EXIT_OK) {
+            rc = VW_EXIT_FAIL;
+            goto done;
+        }
+    }
     double t_start = vw_cli_now();
     /* Under MPI the output process reads the edits (edits_load) and every process reads
        the scene; all stop if one cannot (a file missing on one host), and the output

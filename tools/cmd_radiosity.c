@@ -145,32 +145,6 @@ static void on_round(void *user, rad_solver *s, int round)
     if (vw_world_agree(w, wst, err, sizeof err) != VW_OK) r->failed = 1;
 }
 
-/* Can a file be made at path: its directory exists and may be written into, and path
-   is not a directory? 0, or -1 with the reason in err. Checked before the solve, so
-   that a result is not computed for minutes and then lost; the writes at the end still
-   report their own errors (a full disk, a directory removed meanwhile). */
-static int check_writable(const char *opt, const char *path, char *err, size_t errlen)
-{
-    struct stat st;
-    if (stat(path, &st) == 0 && S_ISDIR(st.st_mode)) {
-        snprintf(err, errlen, "%s %s: cannot write: it is a directory", opt, path);
-        return -1;
-    }
-    const char *slash = strrchr(path, '/');
-    char *dir = slash ? strndup(path, slash == path ? 1 : (size_t)(slash - path)) : strdup(".");
-    if (!dir) {
-        snprintf(err, errlen, "out of memory");
-        return -1;
-    }
-    int bad = 0;
-    if (stat(dir, &st) != 0) bad = errno;
-    else if (!S_ISDIR(st.st_mode)) bad = ENOTDIR;
-    else if (access(dir, W_OK | X_OK) != 0) bad = errno;
-    if (bad) snprintf(err, errlen, "%s %s: cannot write: %s: %s", opt, path, dir, strerror(bad));
-    free(dir);
-    return bad ? -1 : 0;
-}
-
 /* x as a JSON number, or null: JSON has no NaN nor infinity, and "nan" makes the whole
    stats file unreadable. */
 static const char *json_number(double x, char buf[32])
@@ -355,17 +329,9 @@ int vw_cmd_radiosity(int argc, char **argv)
         if (vw_cli_same_options(CMD, names, v, sizeof v / sizeof v[0])) return VW_EXIT_USAGE;
     }
     {
-        /* Only the output process writes; all stop if it cannot. */
         const char *opts[] = {"-o", "--csv", "--image", "--stats", "--trace", "--checkpoint"};
         const char *paths[] = {r.out, r.csv, r.image, r.stats, trace, o.checkpoint};
-        char werr[1024] = "";
-        vw_status wst = VW_OK;
-        for (int k = 0; k < 6 && wst == VW_OK && vw_cli_is_output(); k++)
-            if (paths[k] && check_writable(opts[k], paths[k], werr, sizeof werr)) wst = VW_E_IO;
-        if (vw_engine_agree(wst, werr, sizeof werr) != VW_OK) {
-            if (vw_cli_is_output()) vw_cli_error(CMD, "%s", werr);
-            return VW_EXIT_FAIL;
-        }
+        if (vw_cli_check_outputs(CMD, opts, paths, 6) != VW_EXIT_OK) return VW_EXIT_FAIL;
     }
 
     /* A radiosity cell cannot be shared by workers (a shot's bitmaps depend on the order

@@ -367,6 +367,13 @@ int vw_cmd_render(int argc, char **argv)
         return VW_EXIT_USAGE;
     }
 
+    {
+        /* A --stats into a missing directory failed after the image was written. */
+        const char *opts[] = {"-o", "--overlay", "--stats"};
+        const char *paths[] = {out, overlay, stats};
+        if (vw_cli_check_outputs(CMD, opts, paths, 3) != VW_EXIT_OK) return VW_EXIT_FAIL;
+    }
+
     /* Workers of the whole job, for --speeds and --slow (the world's own default when
        --workers is not given: one per core, under MPI the fewest cores of any host, so
        every host expects as many speeds). */

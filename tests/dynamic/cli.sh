@@ -214,9 +214,16 @@ for ends in lf crlf cr; do
 done
 cmp -s ends_lf00.png ends_cr00.png && cmp -s ends_lf00.png ends_crlf00.png ||
   fail "the frames differ between LF, CRLF and CR line ends"
-# --stats that cannot be written says why.
+# --stats that cannot be written says why, before any frame (it used to fail after the
+# last one); so does a frames directory that does not exist.
+rm -f st*.png
 "$V" animate scene.nff "$E/good_moves.edits" -o 'st%02d.png' --workers 1 --quiet \
-  --stats nodir/s.json 2> sterr.txt && fail "--stats into a missing directory: status 0"
-grep -q 'nodir/s.json: cannot create: No such file' sterr.txt || fail "--stats: no reason: $(cat sterr.txt)"
+  --stats nodir/s.json 2> sterr.txt; rc=$?
+[ $rc -eq 1 ] || fail "--stats into a missing directory: status $rc"
+grep -q -- '--stats nodir/s.json: cannot write: nodir: No such file' sterr.txt || fail "--stats: no reason: $(cat sterr.txt)"
+! ls st*.png > /dev/null 2>&1 || fail "--stats into a missing directory: frames written"
+"$V" animate scene.nff "$E/good_moves.edits" -o 'nodir/st%02d.png' --workers 1 --quiet 2> sterr.txt; rc=$?
+[ $rc -eq 1 ] || fail "frames into a missing directory: status $rc"
+grep -q -- '-o nodir/st%02d.png: cannot write: nodir: No such file' sterr.txt || fail "-o: no reason: $(cat sterr.txt)"
 "$V" animate scene.nff 2> /dev/null; [ $? -eq 2 ] || fail "usage status"
 echo "cli ok"

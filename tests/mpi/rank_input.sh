@@ -119,9 +119,10 @@ run "render --speeds, a wrong count on hosts of 2 and 3 cores" 2 \
     "expected 4 positive numbers, one per worker: 2 processes x 2 workers, one per core of the host with fewest; --workers sets them" \
     sh -c "export VW_CORES=$cores; exec \"$vwalls\" render \"$scene\" -o \"$dir/r.png\" --size 48x48 --cells 2x2x2 --speeds 1,2,1,2,1,2 --quiet"
 
-# Outputs into a missing directory: status 1, as the single process's.
+# Outputs into a missing directory: status 1, as the single process's (the frames'
+# directory checked before any frame).
 # shellcheck disable=SC2086
-run "animate -o into a missing directory" 1 "nodir/0.png" \
+run "animate -o into a missing directory" 1 "nodir/%d.png: cannot write" \
     "$vwalls" animate "$scene" "$dir/edits" -o "$dir/nodir/%d.png" $common
 # shellcheck disable=SC2086
 run "animate --log into a missing directory" 1 "nodir/log" \

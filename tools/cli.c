@@ -277,9 +277,7 @@ int vw_cli_agree(const char *cmd, int rc, char *msg, size_t len)
 }
 
 /* Can a file be made at path: its directory exists and may be written into, and path
-   is not a directory? 0, or -1 with the reason in err. Checked before the solve, so
-   that a result is not computed for minutes and then lost; the writes at the end still
-   report their own errors (a full disk, a directory removed meanwhile). */
+   is not a directory? 0, or -1 with the reason in err (vw_cli_check_outputs). */
 static int check_writable(const char *opt, const char *path, char *err, size_t errlen)
 {
     struct stat st;

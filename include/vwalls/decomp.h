@@ -105,6 +105,16 @@ VW_API int vw_decomp_walk(const vw_decomp *d, const double o[3], const double di
 /* The first segment of that walk; returns 0 when the ray misses the world. */
 VW_API int vw_decomp_first_segment(const vw_decomp *d, const double o[3], const double dir[3],
                                    double t0, double t1, vw_segment *out);
+/* The cell whose walk every ray o + t v starts in, for every v in the cone that the n
+   directions dirs span (their non-negative combinations), when that can be shown
+   cheaply: o lies inside the world box, away from the walls of its cell (that cell,
+   whatever the cone); or all of the rays enter the world box through one face, inside
+   one cell's piece of it, away from its edges and walls. -1 when it cannot (o lies on
+   or near a wall, the cone meets a wall or an edge of the world box, or misses it):
+   ask per ray. For the pixels of an image tile this answers for the whole tile from
+   its four corners' rays. */
+VW_API int vw_decomp_cone_cell(const vw_decomp *d, const double o[3], const double (*dirs)[3],
+                               int n);
 /* A walk in two halves, for a ray that crosses many walls: vw_decomp_clip narrows
    [*t0, *t1] to the world box (returns 0 when nothing is left), and on a clipped
    interval, or one that starts at the t1 of one of its segments and ends where the

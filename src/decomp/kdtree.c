@@ -503,6 +503,86 @@ int vw_decomp_first_segment(const vw_decomp *d, const double o[3], const double 
     return descend(d, q, v, t0, t1, out, NULL) != 0;
 }
 
+/* From inside the world box every ray's walk starts in the cell that holds o. From
+   outside, the rays of a cone all enter the world through the face of the world box that the
+   first generator's ray enters by, and inside one cell's piece of that face, when each
+   generator crosses the face's plane inside the face, a margin away from its edges,
+   and the rectangle those crossings span lies a margin away from every wall: a central
+   projection maps segments to segments, so every ray of the cone crosses the plane in
+   the crossings' convex hull, inside that rectangle; and a ray from outside the box
+   that crosses a face's plane inside the face enters the box there. The margin (1e-9
+   of the coordinates' magnitude) is a million times the rounding of the crossings, so
+   the per-ray walk agrees with the answer (a ray on a wall is no concern: no rectangle
+   within the margin of one is accepted). */
+int vw_decomp_cone_cell(const vw_decomp *d, const double o[3], const double (*dirs)[3], int n)
+{
+    if (n < 1) return -1;
+    double q[3];
+    vw_decomp_to_frame(d, o, q);
+    const vw_box *W = &d->world;
+    double mag = 0;
+    for (int a = 0; a < 3; a++)
+        mag = fmax(mag, fmax(fabs(q[a]), fmax(fabs(W->lo[a]), fabs(W->hi[a]))));
+    double m = 1e-9 * mag;
+    if (!(m > 0) || !isfinite(m)) return -1;
+    int within = 1; /* o inside the world box, a margin away from its faces */
+    for (int a = 0; a < 3; a++) within &= q[a] > W->lo[a] + m && q[a] < W->hi[a] - m;
+    if (within) { /* every walk starts in o's cell: o's cell, when away from its walls */
+        const vw_kd_node *nodes = d->nodes, *nd = &nodes[0];
+        while (nd && nd->axis >= 0)
+            nd = q[nd->axis] < nd->split - m   ? &nodes[nd->left]
+                 : q[nd->axis] > nd->split + m ? &nodes[nd->right]
+                                                 : NULL;
+        return nd ? nd->cell : -1;
+    }
+    int fa = -1, hiside = 0; /* the face: axis and side (0 lower, 1 upper) */
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (int k = 0; k < n; k++) {
+        double v[3];
+        vw_decomp_to_frame(d, dirs[k], v);
+        int found = 0;
+        /* The first generator picks the face among those the eye lies beyond; the
+           others must cross the same one. */
+        for (int a = k ? fa : 0; a < (k ? fa + 1 : 3) && !found; a++) {
+            int up = k ? hiside : q[a] > W->hi[a];
+            double face = up ? W->hi[a] : W->lo[a];
+            if (up ? !(q[a] > W->hi[a] + m) : !(q[a] < W->lo[a] - m)) continue;
+            if (up ? !(v[a] < 0) : !(v[a] > 0)) continue; /* not toward the face */
+            double t = (face - q[a]) / v[a];
+            double p[3] = {0, 0, 0};
+            int inside = 1;
+            for (int b = 0; b < 3; b++) {
+                if (b == a) continue;
+                p[b] = q[b] + t * v[b];
+                inside &= p[b] > W->lo[b] + m && p[b] < W->hi[b] - m;
+            }
+            if (!inside) continue;
+            found = 1;
+            fa = a;
+            hiside = up;
+            for (int b = 0; b < 3; b++) {
+                if (b == a) continue;
+                lo[b] = fmin(lo[b], p[b]);
+                hi[b] = fmax(hi[b], p[b]);
+            }
+        }
+        if (!found) return -1;
+    }
+    const vw_kd_node *nodes = d->nodes, *nd = &nodes[0];
+    while (nd->axis >= 0) {
+        int a = nd->axis;
+        if (a == fa) /* the face's side of the split, when it is not the face */
+            nd = hiside ? (nd->split < W->hi[a] - m ? &nodes[nd->right] : NULL)
+                        : (nd->split > W->lo[a] + m ? &nodes[nd->left] : NULL);
+        else
+            nd = hi[a] < nd->split - m   ? &nodes[nd->left]
+                 : lo[a] > nd->split + m ? &nodes[nd->right]
+                                         : NULL;
+        if (!nd) return -1;
+    }
+    return nd->cell;
+}
+
 int vw_decomp_clip(const vw_decomp *d, const double o[3], const double dir[3], double *t0,
                    double *t1)
 {

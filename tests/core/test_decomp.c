@@ -82,6 +82,82 @@ static int crosses(const vw_box *b, const double o[3], const double d[3], double
     return t1 - t0 > 1e-9;
 }
 
+/* vw_decomp_cone_cell against the walk: an eye outside the world looks at it through
+   small cones (an image tile's four corner rays); where a cone gets a cell, rays drawn
+   at random inside the cone, and its generators, all start their walk in that cell.
+   Most small cones away from the walls get one (the answer is of use); an eye inside
+   the world, or a cone across a wall, gets none. */
+static void check_cones(const vw_decomp *d)
+{
+    vw_box w = vw_decomp_world(d);
+    const double *F = vw_decomp_frame(d);
+    int answered = 0, asked = 0;
+    for (int i = 0; i < 300; i++) {
+        /* An eye on a sphere around the world (world coordinates), looking at a point
+           of the world's box in frame coordinates turned to the world's. */
+        double eye[3], q[3], at[3];
+        double th = 2 * M_PI * urand(), z = 2 * urand() - 1, r = sqrt(1 - z * z);
+        double dir0[3] = {r * cos(th), r * sin(th), z};
+        for (int a = 0; a < 3; a++) {
+            q[a] = w.lo[a] + (w.hi[a] - w.lo[a]) * urand();
+            eye[a] = 0.5 + 3 * dir0[a];
+        }
+        for (int a = 0; a < 3; a++) at[a] = F ? F[a] * q[0] + F[3 + a] * q[1] + F[6 + a] * q[2] : q[a];
+        double fwd[3], u[3], v[3];
+        for (int a = 0; a < 3; a++) fwd[a] = at[a] - eye[a];
+        /* two directions across it */
+        double t[3] = {fabs(fwd[0]) < 0.5 ? 1 : 0, fabs(fwd[0]) < 0.5 ? 0 : 1, 0};
+        u[0] = fwd[1] * t[2] - fwd[2] * t[1], u[1] = fwd[2] * t[0] - fwd[0] * t[2],
+        u[2] = fwd[0] * t[1] - fwd[1] * t[0];
+        v[0] = fwd[1] * u[2] - fwd[2] * u[1], v[1] = fwd[2] * u[0] - fwd[0] * u[2],
+        v[2] = fwd[0] * u[1] - fwd[1] * u[0];
+        double lu = sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
+        double lv = sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+        double half = 0.002 + 0.05 * urand() * urand(); /* the cone's spread */
+        double gen[4][3];
+        for (int k = 0; k < 4; k++)
+            for (int a = 0; a < 3; a++)
+                gen[k][a] = fwd[a] + half * ((k & 1) ? 1 : -1) * u[a] / lu * 3 +
+                            half * ((k & 2) ? 1 : -1) * v[a] / lv * 3;
+        int c = vw_decomp_cone_cell(d, eye, (const double(*)[3])gen, 4);
+        asked++;
+        if (c < 0) continue;
+        answered++;
+        CHECK(c < vw_decomp_cell_count(d));
+        for (int s = 0; s < 40; s++) {
+            double wgt[4], sum = 0, dir[3] = {0, 0, 0};
+            for (int k = 0; k < 4; k++) sum += wgt[k] = s < 4 ? (k == s) : urand();
+            for (int k = 0; k < 4; k++)
+                for (int a = 0; a < 3; a++) dir[a] += wgt[k] / sum * gen[k][a];
+            vw_segment f;
+            CHECK(vw_decomp_first_segment(d, eye, dir, 0, INFINITY, &f));
+            CHECK_EQ_INT(f.cell, c);
+        }
+    }
+    CHECK(answered > asked / 3);
+    /* From inside the world: the cell that holds the eye, for any cone, when the eye
+       lies away from its walls (a cell's centre); none from a point on a wall. */
+    double gen[2][3] = {{1, 0.1, 0.1}, {-0.2, 1, 0.3}};
+    for (int c = 0; c < vw_decomp_cell_count(d); c++) {
+        vw_box b = vw_decomp_cell_box(d, c);
+        double q[3], in[3];
+        for (int a = 0; a < 3; a++) q[a] = 0.5 * (b.lo[a] + b.hi[a]);
+        for (int a = 0; a < 3; a++) in[a] = F ? F[a] * q[0] + F[3 + a] * q[1] + F[6 + a] * q[2] : q[a];
+        CHECK_EQ_INT(vw_decomp_cone_cell(d, in, (const double(*)[3])gen, 2), c);
+        for (int k = 0; k < 2; k++) {
+            vw_segment f;
+            CHECK(vw_decomp_first_segment(d, in, gen[k], 0, INFINITY, &f));
+            CHECK_EQ_INT(f.cell, c);
+        }
+        CHECK_EQ_INT(vw_decomp_cone_cell(d, in, (const double(*)[3])gen, 0), -1);
+        if (c == 0 && vw_decomp_cell_count(d) > 1) { /* on its wall */
+            for (int a = 0; a < 3; a++) q[a] = b.hi[a] < w.hi[a] ? b.hi[a] : q[a];
+            for (int a = 0; a < 3; a++) in[a] = F ? F[a] * q[0] + F[3 + a] * q[1] + F[6 + a] * q[2] : q[a];
+            CHECK_EQ_INT(vw_decomp_cone_cell(d, in, (const double(*)[3])gen, 2), -1);
+        }
+    }
+}
+
 static void check_decomp(const vw_decomp *d)
 {
     int n = vw_decomp_cell_count(d);
@@ -266,6 +342,7 @@ static void check_decomp(const vw_decomp *d)
         }
         CHECK_EQ_INT(k, want);
     }
+    check_cones(d);
 }
 
 /* A staggered kd-tree: 3 x slabs, each cut in y at its own place, each column in z. */

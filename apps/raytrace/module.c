@@ -436,7 +436,6 @@ static vw_status primary_pixels(vw_ctx *ctx, rt_cell *c)
     const vw_decomp *d = vw_ctx_decomp(ctx);
     int me = vw_ctx_cell(ctx);
     vw_box b = vw_ctx_cell_box(ctx);
-    const double *F = vw_decomp_frame(d);
     int x0 = 0, y0 = 0, x1 = v->width - 1, y1 = v->height - 1;
     size_t cap = 0;
     int sample = c->sh->sample > 1 ? c->sh->sample : 1; /* the balancer's pre-pass */
@@ -459,24 +458,8 @@ static vw_status primary_pixels(vw_ctx *ctx, rt_cell *c)
             }
         return VW_OK;
     }
-    double lo[2] = {INFINITY, INFINITY}, hi[2] = {-INFINITY, -INFINITY};
-    int all_front = 1;
-    for (int i = 0; i < 8 && all_front; i++) {
-        double q[3] = {(i & 1) ? b.hi[0] : b.lo[0], (i & 2) ? b.hi[1] : b.lo[1],
-                       (i & 4) ? b.hi[2] : b.lo[2]};
-        double p[3];
-        for (int a = 0; a < 3; a++) /* frame -> world: p = F^T q */
-            p[a] = F ? F[0 * 3 + a] * q[0] + F[1 * 3 + a] * q[1] + F[2 * 3 + a] * q[2] : q[a];
-        double sx, sy;
-        if (!rt_view_project(v, p, &sx, &sy) || !isfinite(sx) || !isfinite(sy)) {
-            all_front = 0;
-            break;
-        }
-        lo[0] = fmin(lo[0], sx);
-        hi[0] = fmax(hi[0], sx);
-        lo[1] = fmin(lo[1], sy);
-        hi[1] = fmax(hi[1], sy);
-    }
+    double lo[2], hi[2];
+    int all_front = rt_view_outline(v, &b, vw_decomp_frame(d), lo, hi);
     if (all_front) {
         /* Pixel px is centred at px + 0.5; one pixel of margin absorbs rounding. */
         x0 = (int)fmax(0, floor(lo[0]) - 1);

@@ -182,6 +182,24 @@ static int64_t *render_farm(const vw_scene *s, int w, int h, const int dims[3], 
                (long long)per[g]);
     free(eye);
     free(per);
+    /* Each cell made the eye rays of the pixels whose walk starts in it: the map made
+       by tiles (job.c) against a walk per pixel. */
+    const vw_decomp *d = vw_world_decomp(world);
+    const rt_view *view = &rt_job_shared(j)->view;
+    int64_t *mine = calloc((size_t)ncells, sizeof *mine);
+    for (int y = 0; mine && y < h; y++)
+        for (int x = 0; x < w; x++) {
+            double dir[3];
+            vw_segment seg;
+            rt_view_ray(view, x, y, dir);
+            if (vw_decomp_first_segment(d, view->eye, dir, 0.0, INFINITY, &seg)) mine[seg.cell]++;
+        }
+    for (int c = 0; mine && c < ncells; c++)
+        EXPECT(mine[c] == vw_world_cell_counter(world, c, RT_C_PIXELS),
+               "%d cells: cell %d made %lld eye rays, its pixels' walks start there %lld times",
+               ncells, c, (long long)vw_world_cell_counter(world, c, RT_C_PIXELS), (long long)mine[c]);
+    EXPECT(mine != NULL, "out of memory");
+    free(mine);
     for (int k = 0; k < RT_NCOUNTERS; k++) counters[k] = vw_world_counter(rt_job_world(j), k);
     if (keep)
         *keep = j;

@@ -50,7 +50,10 @@ typedef struct rt_package {
 typedef struct rt_cell {
     const rt_cell_geo *geo; /* shared with the cell's other copies in this process */
     rt_shared *sh;
-    int *pixels;          /* primary pixels whose eye ray enters the world here */
+    const int *pixels;    /* primary pixels whose eye ray enters the world here: the
+                             cell's slice of the job's map (rt_shared.owner_pixels, kept
+                             while the walls stay, and so the cell), or pixels_own */
+    int *pixels_own;      /* the list made by the cell itself, or NULL */
     size_t npixels;
     int eye_done;         /* this run's eye rays are all made (by this copy or others) */
     rt_package pkg;       /* contributions not yet sent */
@@ -418,12 +421,12 @@ static int add_pixel(rt_cell *c, size_t *cap, int px)
 {
     if (c->npixels == *cap) {
         size_t ncap = *cap ? 2 * *cap : 256;
-        int *np = realloc(c->pixels, ncap * sizeof *np);
+        int *np = realloc(c->pixels_own, ncap * sizeof *np);
         if (!np) return 0;
-        c->pixels = np;
+        c->pixels = c->pixels_own = np;
         *cap = ncap;
     }
-    c->pixels[c->npixels++] = px;
+    c->pixels_own[c->npixels++] = px;
     return 1;
 }
 
@@ -444,11 +447,8 @@ static vw_status primary_pixels(vw_ctx *ctx, rt_cell *c)
         /* The job's map, made by the same walk once per process: no walk here. */
         if (sample == 1) { /* this cell's slice of the map sorted by cell */
             const int *first = c->sh->owner_first;
-            size_t n = (size_t)(first[me + 1] - first[me]);
-            c->pixels = malloc((n ? n : 1) * sizeof *c->pixels);
-            if (!c->pixels) return VW_E_NOMEM;
-            if (n) memcpy(c->pixels, c->sh->owner_pixels + first[me], n * sizeof *c->pixels);
-            c->npixels = n;
+            c->pixels = c->sh->owner_pixels + first[me];
+            c->npixels = (size_t)(first[me + 1] - first[me]);
             return VW_OK;
         }
         for (int y = 0; y < v->height; y += sample)
@@ -488,7 +488,7 @@ static void cell_free(void *state, void *user)
     rt_cell *c = state;
     if (!c) return;
     rt_geo_release(c->sh->geo_cache, c->geo);
-    free(c->pixels);
+    free(c->pixels_own);
     free(c);
 }
 

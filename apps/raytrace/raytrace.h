@@ -112,7 +112,9 @@ typedef struct rt_shared {
     const int *owner;
     const vw_decomp *owner_decomp;
     /* The same map sorted by cell: cell c's pixels, in increasing order, are
-       owner_pixels[owner_first[c] .. owner_first[c + 1]) (set with owner). */
+       owner_pixels[owner_first[c] .. owner_first[c + 1]) (set with owner). A cell
+       built on owner_decomp reads its slice in place while it lives: the arrays are
+       rewritten only for another decomposition, whose cells are all built anew. */
     const int *owner_first, *owner_pixels;
     /* Every process: record which worker makes each eye ray (rt_job_record_eye_workers):
        the cell sends it to the output process with the pixel's contributions. */

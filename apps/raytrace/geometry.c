@@ -328,8 +328,8 @@ void rt_device_free(void *device)
 
 typedef struct rt_geo_entry {
     struct rt_geo_entry *next;
-    /* The records it is built from, compared under the lock: a copy while it is being
-       built, then geo.obj. The geometry is built in place (Embree keeps its address
+    /* The records it is built from, compared under the lock: the builder's own while it
+       is being built, then geo.obj. The geometry is built in place (Embree keeps its address
        for the cones' callbacks), outside the lock, and read only once ready. */
     const rt_object *key;
     size_t nkey;
@@ -415,18 +415,15 @@ vw_status rt_geo_acquire(rt_geo_cache *c, void *device, const rt_object *objects
         pthread_mutex_unlock(&c->mu);
         return st;
     }
-    /* Build it here, listed as building so that others asking for it wait; the records
-       are copied first, so that they can compare while the scene is built. */
+    /* Build it here, listed as building so that others asking for it wait. While it is
+       built, the key is the caller's own records, which stay as they are until this
+       call returns, and that is after the key has become geo.obj (under the lock). */
     e = calloc(1, sizeof *e);
-    rt_object *copy = e ? malloc((n ? n : 1) * sizeof *copy) : NULL;
-    if (!e || !copy) {
+    if (!e) {
         pthread_mutex_unlock(&c->mu);
-        free(e);
-        free(copy);
         return VW_E_NOMEM;
     }
-    if (n) memcpy(copy, objects, n * sizeof *copy);
-    e->key = copy;
+    e->key = objects;
     e->nkey = n;
     e->refs = 1;
     e->next = c->head;
@@ -436,7 +433,6 @@ vw_status rt_geo_acquire(rt_geo_cache *c, void *device, const rt_object *objects
     vw_status st = rt_cell_geo_build(device, objects, n, &e->geo);
 
     pthread_mutex_lock(&c->mu);
-    free(copy);
     e->key = st == VW_OK ? e->geo.obj : NULL; /* (a failed entry is never compared) */
     e->state = st == VW_OK ? 1 : -1;
     e->status = st;

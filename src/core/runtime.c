@@ -850,12 +850,23 @@ static vw_status build_unit(vw_world *w, int cell, int rep, vw__worker *wk)
     vw__replica *rp = rep ? &c->reps[rep - 1] : NULL;
     vw_ctx ctx = {w, wk, cell, rep, cell, rep};
     size_t osz = w->m->object_size;
-    unsigned char *objs = NULL;
+    const unsigned char *objs = NULL;
+    unsigned char *gathered = NULL;
     if (c->nobjs) {
-        objs = malloc(osz * c->nobjs);
-        if (!objs) return VW_E_NOMEM;
-        for (size_t i = 0; i < c->nobjs; i++)
-            memcpy(objs + i * osz, w->objects + c->objs[i] * osz, osz);
+        /* A cell whose objects are a run of the world's, in order (a cell that holds
+           them all), builds from the world's own records: they stay as they are while
+           the cells are built, and a copy would be the largest allocation of the build. */
+        size_t first = c->objs[0], k = 1;
+        while (k < c->nobjs && c->objs[k] == first + k) k++;
+        if (k == c->nobjs) {
+            objs = w->objects + first * osz;
+        } else {
+            gathered = malloc(osz * c->nobjs);
+            if (!gathered) return VW_E_NOMEM;
+            for (size_t i = 0; i < c->nobjs; i++)
+                memcpy(gathered + i * osz, w->objects + c->objs[i] * osz, osz);
+            objs = gathered;
+        }
     }
     int *built = rp ? &rp->built : &c->built;
     void **state = unit_state(w, cell, rep);
@@ -864,7 +875,7 @@ static vw_status build_unit(vw_world *w, int cell, int rep, vw__worker *wk)
     *built = 0;
     vw_status st = VW_OK;
     if (w->m->cell_build) st = w->m->cell_build(&ctx, objs, c->nobjs, state);
-    free(objs);
+    free(gathered);
     if (st != VW_OK) {
         /* The build freed what it made (module.h): what it left here is not a state. */
         *state = NULL;

@@ -439,11 +439,30 @@ void rt_job_progress(const rt_job *j, int64_t *pixels_done, int64_t *rays)
     if (rays) *rays = atomic_load(&m->sh.rays);
 }
 
+/* One thread's share of rt_job_rgb8. */
+typedef struct rgb8_part {
+    const int64_t *sums;
+    uint8_t *out;
+    size_t n;  /* values in all */
+    int parts;
+} rgb8_part;
+
+static void rgb8_range(int i, void *arg)
+{
+    const rgb8_part *p = arg;
+    size_t a = p->n * (size_t)i / (size_t)p->parts, b = p->n * (size_t)(i + 1) / (size_t)p->parts;
+    for (size_t k = a; k < b; k++) p->out[k] = p->sums ? rt_fix_to_u8(p->sums[k]) : 0;
+}
+
 void rt_job_rgb8(const rt_job *j, uint8_t *out)
 {
-    size_t n = (size_t)j->sh.view.width * j->sh.view.height * 3;
-    const int64_t *s = rt_job_sums(j);
-    for (size_t i = 0; i < n; i++) out[i] = s ? rt_fix_to_u8(s[i]) : 0;
+    /* A serial phase after the run (the sums, 24 bytes a pixel, are read once): shared
+       among as many threads as the process has workers, as the PNG's blocks are. */
+    enum { MAX_PARTS = 64 };
+    int parts = vw_world_workers(j->world);
+    rgb8_part p = {rt_job_sums(j), out, (size_t)j->sh.view.width * j->sh.view.height * 3,
+                   parts < 1 ? 1 : parts > MAX_PARTS ? MAX_PARTS : parts};
+    vw_parallel(p.parts, rgb8_range, &p);
 }
 
 void rt_job_rgbf(const rt_job *j, float *out)

@@ -85,8 +85,8 @@ static int crosses(const vw_box *b, const double o[3], const double d[3], double
 /* vw_decomp_cone_cell against the walk: an eye outside the world looks at it through
    small cones (an image tile's four corner rays); where a cone gets a cell, rays drawn
    at random inside the cone, and its generators, all start their walk in that cell.
-   Most small cones away from the walls get one (the answer is of use); an eye inside
-   the world, or a cone across a wall, gets none. */
+   Most small cones get one (the answer is of use). From inside the world every cone
+   gets the eye's cell, when the eye lies away from its walls, and none from a wall. */
 static void check_cones(const vw_decomp *d)
 {
     vw_box w = vw_decomp_world(d);

@@ -67,15 +67,16 @@ typedef struct vw_module {
     const char *const *counters;
     int ncounters;
 
-    /* Build the local state of a cell from its objects (in the order they were added).
-       Runs once per cell at commit, on the worker that hosts the cell. Optional: without
-       it every callback gets state NULL. It may not send (there is no run to deliver in;
-       post with vw_world_post instead): a send here stops the process, as in load().
-       A constructor: on VW_OK *state is the cell's, freed with cell_free when the cell is
-       rebuilt or goes; on failure the build frees whatever it made itself, and the
-       runtime ignores *state (cell_free is never called for a build that failed). The
-       commit then fails (on every process, under MPI), and a later commit builds the
-       cell again. */
+    /* Build the local state of a cell from its objects (in the order they were added;
+       they stay unchanged until the call returns, and only until then: they may be the
+       world's own records). Runs once per cell at commit, on the worker that hosts the
+       cell. Optional: without it every callback gets state NULL. It may not send
+       (there is no run to deliver in; post with vw_world_post instead): a send here
+       stops the process, as in load(). A constructor: on VW_OK *state is the cell's,
+       freed with cell_free when the cell is rebuilt or goes; on failure the build
+       frees whatever it made itself, and the runtime ignores *state (cell_free is
+       never called for a build that failed). The commit then fails (on every process,
+       under MPI), and a later commit builds the cell again. */
     vw_status (*cell_build)(vw_ctx *ctx, const void *objects, size_t nobjects, void **state);
     void (*cell_free)(void *state, void *user);
     /* Optional: local work that needs no message (generate primary rays, shoot a patch).

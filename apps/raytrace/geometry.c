@@ -328,9 +328,9 @@ void rt_device_free(void *device)
 
 typedef struct rt_geo_entry {
     struct rt_geo_entry *next;
-    /* The records it is built from, compared under the lock: the builder's own while it
-       is being built, then geo.obj. The geometry is built in place (Embree keeps its address
-       for the cones' callbacks), outside the lock, and read only once ready. */
+    /* The records it is built from, compared under the lock: the builder's own while
+       it is being built, then geo.obj. The geometry is built in place (Embree keeps its
+       address for the cones' callbacks), outside the lock, and read only once ready. */
     const rt_object *key;
     size_t nkey;
     rt_cell_geo geo;

@@ -38,6 +38,15 @@ void rt_job_free(rt_job *j)
     free(j);
 }
 
+/* Threads for a serial phase of the process (the pixel map, the 8-bit image): as many
+   as it has workers, which are idle then. */
+enum { RT_MAX_PARTS = 64 };
+static int serial_parts(const rt_job *j)
+{
+    int n = vw_world_workers(j->world);
+    return n < 1 ? 1 : n > RT_MAX_PARTS ? RT_MAX_PARTS : n;
+}
+
 /* The pixel-ownership map is made by tiles of RT_TILE x RT_TILE pixels: a tile whose
    four corner rays show that every ray of the tile enters the world through one cell
    (vw_decomp_cone_cell) takes that cell without a walk per pixel, and a tile that lies
@@ -134,15 +143,13 @@ static vw_status owners(rt_job *j)
     if (!j->owner) j->owner = malloc((size_t)w * (size_t)h * sizeof *j->owner);
     if (!j->owner_pixels) j->owner_pixels = malloc((size_t)w * (size_t)h * sizeof *j->owner_pixels);
     if (!j->owner || !j->owner_pixels) return VW_E_NOMEM;
-    /* A serial phase of every render: the rows are shared among as many threads as
-       the process has workers (which are idle now). */
-    enum { MAX_PARTS = 64 };
-    int nparts = vw_world_workers(j->world);
-    nparts = nparts < 1 ? 1 : nparts > MAX_PARTS ? MAX_PARTS : nparts > h ? h : nparts;
+    /* A serial phase of every render: the rows are shared among threads. */
+    int nparts = serial_parts(j);
+    nparts = nparts > h ? h : nparts;
     owners_map map = {j, d, 0, {0, 0}, {0, 0}};
     vw_box world = vw_decomp_world(d);
     map.outline = rt_view_outline(&j->sh.view, &world, vw_decomp_frame(d), map.lo, map.hi);
-    owners_part part[MAX_PARTS];
+    owners_part part[RT_MAX_PARTS];
     for (int i = 0; i < nparts; i++)
         part[i] = (owners_part){&map, (int)((int64_t)h * i / nparts),
                                 (int)((int64_t)h * (i + 1) / nparts), 0};
@@ -451,17 +458,19 @@ static void rgb8_range(int i, void *arg)
 {
     const rgb8_part *p = arg;
     size_t a = p->n * (size_t)i / (size_t)p->parts, b = p->n * (size_t)(i + 1) / (size_t)p->parts;
-    for (size_t k = a; k < b; k++) p->out[k] = p->sums ? rt_fix_to_u8(p->sums[k]) : 0;
+    if (!p->sums) {
+        memset(p->out + a, 0, b - a);
+        return;
+    }
+    for (size_t k = a; k < b; k++) p->out[k] = rt_fix_to_u8(p->sums[k]);
 }
 
 void rt_job_rgb8(const rt_job *j, uint8_t *out)
 {
-    /* A serial phase after the run (the sums, 24 bytes a pixel, are read once): shared
-       among as many threads as the process has workers, as the PNG's blocks are. */
-    enum { MAX_PARTS = 64 };
-    int parts = vw_world_workers(j->world);
+    /* A serial phase after the run (the sums, 24 bytes a pixel, are read once), shared
+       out as the PNG's blocks are. */
     rgb8_part p = {rt_job_sums(j), out, (size_t)j->sh.view.width * j->sh.view.height * 3,
-                   parts < 1 ? 1 : parts > MAX_PARTS ? MAX_PARTS : parts};
+                   serial_parts(j)};
     vw_parallel(p.parts, rgb8_range, &p);
 }
 

@@ -82,6 +82,12 @@ static int crosses(const vw_box *b, const double o[3], const double d[3], double
     return t1 - t0 > 1e-9;
 }
 
+/* Frame coordinates q to world coordinates (F^T q; q itself without a frame). */
+static void frame_to_world(const double *F, const double q[3], double out[3])
+{
+    for (int a = 0; a < 3; a++) out[a] = F ? F[a] * q[0] + F[3 + a] * q[1] + F[6 + a] * q[2] : q[a];
+}
+
 /* vw_decomp_cone_cell against the walk: an eye outside the world looks at it through
    small cones (an image tile's four corner rays); where a cone gets a cell, rays drawn
    at random inside the cone, and its generators, all start their walk in that cell.
@@ -102,7 +108,7 @@ static void check_cones(const vw_decomp *d)
             q[a] = w.lo[a] + (w.hi[a] - w.lo[a]) * urand();
             eye[a] = 0.5 + 3 * dir0[a];
         }
-        for (int a = 0; a < 3; a++) at[a] = F ? F[a] * q[0] + F[3 + a] * q[1] + F[6 + a] * q[2] : q[a];
+        frame_to_world(F, q, at);
         double fwd[3], u[3], v[3];
         for (int a = 0; a < 3; a++) fwd[a] = at[a] - eye[a];
         /* two directions across it */
@@ -142,7 +148,7 @@ static void check_cones(const vw_decomp *d)
         vw_box b = vw_decomp_cell_box(d, c);
         double q[3], in[3];
         for (int a = 0; a < 3; a++) q[a] = 0.5 * (b.lo[a] + b.hi[a]);
-        for (int a = 0; a < 3; a++) in[a] = F ? F[a] * q[0] + F[3 + a] * q[1] + F[6 + a] * q[2] : q[a];
+        frame_to_world(F, q, in);
         CHECK_EQ_INT(vw_decomp_cone_cell(d, in, (const double(*)[3])gen, 2), c);
         for (int k = 0; k < 2; k++) {
             vw_segment f;
@@ -152,7 +158,7 @@ static void check_cones(const vw_decomp *d)
         CHECK_EQ_INT(vw_decomp_cone_cell(d, in, (const double(*)[3])gen, 0), -1);
         if (c == 0 && vw_decomp_cell_count(d) > 1) { /* on its wall */
             for (int a = 0; a < 3; a++) q[a] = b.hi[a] < w.hi[a] ? b.hi[a] : q[a];
-            for (int a = 0; a < 3; a++) in[a] = F ? F[a] * q[0] + F[3 + a] * q[1] + F[6 + a] * q[2] : q[a];
+            frame_to_world(F, q, in);
             CHECK_EQ_INT(vw_decomp_cone_cell(d, in, (const double(*)[3])gen, 2), -1);
         }
     }

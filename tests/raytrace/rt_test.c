@@ -197,7 +197,8 @@ static int64_t *render_farm(const vw_scene *s, int w, int h, const int dims[3], 
     for (int c = 0; mine && c < ncells; c++)
         EXPECT(mine[c] == vw_world_cell_counter(world, c, RT_C_PIXELS),
                "%d cells: cell %d made %lld eye rays, its pixels' walks start there %lld times",
-               ncells, c, (long long)vw_world_cell_counter(world, c, RT_C_PIXELS), (long long)mine[c]);
+               ncells, c, (long long)vw_world_cell_counter(world, c, RT_C_PIXELS),
+               (long long)mine[c]);
     EXPECT(mine != NULL, "out of memory");
     free(mine);
     for (int k = 0; k < RT_NCOUNTERS; k++) counters[k] = vw_world_counter(rt_job_world(j), k);

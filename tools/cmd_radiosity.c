@@ -288,7 +288,7 @@ int vw_cmd_radiosity(int argc, char **argv)
         } else if (!scene_path) {
             scene_path = a;
         } else {
-            vw_cli_error(CMD, "more than one scene ('%s' and '%s')", scene_path, a);
+            vw_cli_error(CMD, "more than one scene: '%s' and '%s'", scene_path, a);
             return VW_EXIT_USAGE;
         }
 #undef VALUE

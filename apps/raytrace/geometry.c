@@ -11,6 +11,11 @@
  * interval runs past its far wall by an overlap (walk_ray, rt_shared.overlap). Exactly
  * coincident primitives tie, and which one Embree reports depends on its tree: such
  * z-fighting is outside the invariant (docs/known-issues.md).
+ *
+ * Embree sees the scene multiplied by a power of two, `scale` (rt_embree_scale): its
+ * float tests multiply three or four coordinates, which overflow for a scene 1e12 across
+ * and vanish for one 1e-15 across, so such a scene is brought near unit size. The
+ * product with a power of two is exact, so the tests find the same hits, at t * scale.
  */
 #include <embree3/rtcore.h>
 #include <math.h>
@@ -27,12 +32,12 @@ typedef struct rt_isect_ctx {
 
 /* ---- cones -------------------------------------------------------------------------- */
 
-/* The smallest t in [tn, tf] (compared as floats, like Embree's own tests) where the
-   ray meets the cone's side between its end discs; 0 when there is none.
+/* The smallest t with t * scale in [tn, tf] (compared as floats, like Embree's own tests)
+   where the ray meets the cone's side between its end discs; 0 when there is none.
    The side is |P - (P.w)w|^2 = (r0 + k P.w)^2 for 0 <= P.w <= h, with P = o + t d - base,
    w the unit axis, h its length and k = (r1 - r0) / h. */
 static int cone_hit(const rt_object *o, const double org[3], const double dir[3], float tn,
-                    float tf, double *tout)
+                    float tf, double scale, double *tout)
 {
     double w[3], D[3], h = 0;
     for (int a = 0; a < 3; a++) {
@@ -69,7 +74,7 @@ static int cone_hit(const rt_object *o, const double org[3], const double dir[3]
     }
     for (int i = 0; i < nt; i++) {
         double t = ts[i];
-        float tf32 = (float)t;
+        float tf32 = (float)(t * scale);
         if (!(tf32 >= tn && tf32 <= tf)) continue;
         double z = Dw + t * dw;
         /* Only the nappe whose radius is the (non-negative) interpolated radius. */
@@ -110,6 +115,10 @@ static void cone_bounds(const struct RTCBoundsFunctionArguments *args)
     const rt_object *o = &g->obj[g->cone_map[args->primID]];
     vw_box b;
     rt_object_bounds(o, 0, &b);
+    for (int a = 0; a < 3; a++) {
+        b.lo[a] *= g->scale;
+        b.hi[a] *= g->scale;
+    }
     /* Round outward so the float box contains the double one. */
     args->bounds_o->lower_x = nextafterf((float)b.lo[0], -INFINITY);
     args->bounds_o->lower_y = nextafterf((float)b.lo[1], -INFINITY);
@@ -127,9 +136,9 @@ static void cone_intersect(const struct RTCIntersectFunctionNArguments *args)
     struct RTCRayHit *rh = (struct RTCRayHit *)args->rayhit; /* N == 1: rtcIntersect1 */
     double t;
     if (!cone_hit(&g->obj[g->cone_map[args->primID]], c->org, c->dir, rh->ray.tnear,
-                  rh->ray.tfar, &t))
+                  rh->ray.tfar, g->scale, &t))
         return;
-    rh->ray.tfar = (float)t;
+    rh->ray.tfar = (float)(t * g->scale);
     rh->hit.u = rh->hit.v = 0;
     rh->hit.Ng_x = rh->hit.Ng_y = rh->hit.Ng_z = 0;
     rh->hit.primID = args->primID;
@@ -144,7 +153,8 @@ static void cone_occluded(const struct RTCOccludedFunctionNArguments *args)
     const rt_isect_ctx *c = (const rt_isect_ctx *)args->context;
     struct RTCRay *r = (struct RTCRay *)args->ray;
     double t;
-    if (cone_hit(&g->obj[g->cone_map[args->primID]], c->org, c->dir, r->tnear, r->tfar, &t))
+    if (cone_hit(&g->obj[g->cone_map[args->primID]], c->org, c->dir, r->tnear, r->tfar,
+                 g->scale, &t))
         r->tfar = -INFINITY;
 }
 
@@ -160,9 +170,11 @@ static vw_status attach(rt_cell_geo *g, RTCGeometry geom, int kind)
     return VW_OK;
 }
 
-vw_status rt_cell_geo_build(void *device, const rt_object *objects, size_t n, rt_cell_geo *g)
+vw_status rt_cell_geo_build(void *device, const rt_object *objects, size_t n, double scale,
+                            rt_cell_geo *g)
 {
     memset(g, 0, sizeof *g);
+    g->scale = scale;
     g->geom_kind[0] = g->geom_kind[1] = g->geom_kind[2] = -1;
     g->obj = malloc((n ? n : 1) * sizeof *g->obj);
     g->sph_map = malloc((n ? n : 1) * sizeof *g->sph_map);
@@ -208,8 +220,8 @@ vw_status rt_cell_geo_build(void *device, const rt_object *objects, size_t n, rt
         if (!v) return VW_E_NOMEM;
         for (size_t i = 0; i < ns; i++) {
             const rt_object *o = &g->obj[g->sph_map[i]];
-            for (int a = 0; a < 3; a++) v[4 * i + a] = (float)o->g.sphere.c[a];
-            v[4 * i + 3] = (float)o->g.sphere.r;
+            for (int a = 0; a < 3; a++) v[4 * i + a] = (float)(o->g.sphere.c[a] * scale);
+            v[4 * i + 3] = (float)(o->g.sphere.r * scale);
         }
         if ((st = attach(g, geom, RT_SPHERE)) != VW_OK) return st;
     }
@@ -225,7 +237,8 @@ vw_status rt_cell_geo_build(void *device, const rt_object *objects, size_t n, rt
         for (size_t i = 0; i < nt; i++) {
             const rt_object *o = &g->obj[g->tri_map[i]];
             for (int c = 0; c < 3; c++) {
-                for (int a = 0; a < 3; a++) v[9 * i + 3 * c + a] = (float)o->g.tri.v[c][a];
+                for (int a = 0; a < 3; a++)
+                    v[9 * i + 3 * c + a] = (float)(o->g.tri.v[c][a] * scale);
                 ix[3 * i + c] = (unsigned)(3 * i + c);
             }
         }
@@ -256,17 +269,18 @@ void rt_cell_geo_free(rt_cell_geo *g)
     memset(g, 0, sizeof *g);
 }
 
+/* The ray as Embree sees it: the origin and t scaled, the direction as it is. */
 static void make_ray(struct RTCRay *r, const double org[3], const double dir[3], double tn,
-                     double tf)
+                     double tf, double scale)
 {
-    r->org_x = (float)org[0];
-    r->org_y = (float)org[1];
-    r->org_z = (float)org[2];
+    r->org_x = (float)(org[0] * scale);
+    r->org_y = (float)(org[1] * scale);
+    r->org_z = (float)(org[2] * scale);
     r->dir_x = (float)dir[0];
     r->dir_y = (float)dir[1];
     r->dir_z = (float)dir[2];
-    r->tnear = (float)tn;
-    r->tfar = (float)tf;
+    r->tnear = (float)(tn * scale);
+    r->tfar = (float)(tf * scale);
     r->time = 0;
     r->mask = 0xFFFFFFFFu;
     r->id = 0;
@@ -282,7 +296,7 @@ int rt_cell_geo_intersect(const rt_cell_geo *g, const double org[3], const doubl
     c.org = org;
     c.dir = dir;
     struct RTCRayHit rh;
-    make_ray(&rh.ray, org, dir, tnear, tfar);
+    make_ray(&rh.ray, org, dir, tnear, tfar, g->scale);
     rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
     rh.hit.primID = RTC_INVALID_GEOMETRY_ID;
     rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
@@ -292,7 +306,7 @@ int rt_cell_geo_intersect(const rt_cell_geo *g, const double org[3], const doubl
     const uint32_t *map = kind == RT_SPHERE ? g->sph_map
                           : kind == RT_TRIANGLE ? g->tri_map : g->cone_map;
     hit->obj = &g->obj[map[rh.hit.primID]];
-    hit->t = rh.ray.tfar;
+    hit->t = rh.ray.tfar / g->scale; /* exact: a power of two */
     hit->u = rh.hit.u;
     hit->v = rh.hit.v;
     return 1;
@@ -307,9 +321,15 @@ int rt_cell_geo_occluded(const rt_cell_geo *g, const double org[3], const double
     c.org = org;
     c.dir = dir;
     struct RTCRay r;
-    make_ray(&r, org, dir, tnear, tfar);
+    make_ray(&r, org, dir, tnear, tfar, g->scale);
     rtcOccluded1((RTCScene)g->scene, &c.base, &r);
     return r.tfar == -INFINITY;
+}
+
+double rt_embree_scale(double far)
+{
+    if (!(far > 0) || !isfinite(far) || (far >= 0x1p-10 && far <= 0x1p20)) return 1.0;
+    return ldexp(1.0, -ilogb(far));
 }
 
 void *rt_device_new(void)
@@ -340,15 +360,17 @@ typedef struct rt_geo_entry {
 } rt_geo_entry;
 
 struct rt_geo_cache {
+    double scale; /* every geometry's (rt_embree_scale) */
     pthread_mutex_t mu;
     pthread_cond_t cv; /* an entry left the building state */
     rt_geo_entry *head;
 };
 
-rt_geo_cache *rt_geo_cache_new(void)
+rt_geo_cache *rt_geo_cache_new(double scale)
 {
     rt_geo_cache *c = calloc(1, sizeof *c);
     if (!c) return NULL;
+    c->scale = scale;
     pthread_mutex_init(&c->mu, NULL);
     pthread_cond_init(&c->cv, NULL);
     return c;
@@ -430,7 +452,7 @@ vw_status rt_geo_acquire(rt_geo_cache *c, void *device, const rt_object *objects
     c->head = e;
     pthread_mutex_unlock(&c->mu);
 
-    vw_status st = rt_cell_geo_build(device, objects, n, &e->geo);
+    vw_status st = rt_cell_geo_build(device, objects, n, c->scale, &e->geo);
 
     pthread_mutex_lock(&c->mu);
     e->key = st == VW_OK ? e->geo.obj : NULL; /* (a failed entry is never compared) */

@@ -14,6 +14,7 @@ typedef struct rt_cell_geo {
     int geom_kind[3];            /* Embree geomID -> rt_kind */
     vw_box bounds;               /* of the objects (world coordinates); empty (lo > hi)
                                     without any */
+    double scale;                /* Embree's coordinates are the world's times this */
 } rt_cell_geo;
 
 typedef struct rt_hit {
@@ -22,14 +23,16 @@ typedef struct rt_hit {
     float u, v;                  /* barycentrics of a triangle hit */
 } rt_hit;
 
-vw_status rt_cell_geo_build(void *device, const rt_object *objects, size_t n, rt_cell_geo *g);
+/* scale: a power of two, the same for every cell of a job (rt_embree_scale). */
+vw_status rt_cell_geo_build(void *device, const rt_object *objects, size_t n, double scale,
+                            rt_cell_geo *g);
 void rt_cell_geo_free(rt_cell_geo *g);
 /* Built cells shared within a process: the copies of a farmed or duplicated cell have
    the same records, so they read one scene (Embree's queries are thread-safe) instead
    of each worker building and keeping its own. Entries are counted references; the
    first worker to ask for some records builds them while the others wait. */
 typedef struct rt_geo_cache rt_geo_cache;
-rt_geo_cache *rt_geo_cache_new(void);
+rt_geo_cache *rt_geo_cache_new(double scale); /* the scale its geometries are built at */
 void rt_geo_cache_free(rt_geo_cache *c); /* every entry must have been released */
 /* The geometry of objects[0..n): a built one with the very same records, or built now.
    Release with rt_geo_release. */
@@ -49,6 +52,11 @@ int rt_cell_geo_occluded(const rt_cell_geo *g, const double org[3], const double
 void rt_cone_normal(const rt_object *o, const double p[3], double n[3]);
 
 /* One RTCDevice per process, shared by every cell (Embree's device is thread-safe). */
+/* The power of two Embree's coordinates are multiplied by, for a scene whose
+   coordinates (and eye) lie at most `far` from the origin: 1 from 2^-10 to 2^20, where
+   Embree's floats are at ease (so most scenes give Embree their own numbers), else the
+   power that brings far into [1, 2). */
+double rt_embree_scale(double far);
 void *rt_device_new(void);
 void rt_device_free(void *device);
 

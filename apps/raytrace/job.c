@@ -203,8 +203,7 @@ static vw_status job_prepare(rt_job *j, const vw_scene *s, const rt_params *p, r
     for (int a = 0; a < 3; a++) diag += (hi[a] - lo[a]) * (hi[a] - lo[a]);
     diag = sqrt(diag);
     if (diag > 0 && diag < RT_MIN_SIZE) {
-        snprintf(err, errlen, "the scene is %g across: the ray tracer needs at least %g (Embree "
-                              "computes in float, whose squares of smaller lengths vanish)",
+        snprintf(err, errlen, "the scene is %g across: the ray tracer needs at least %g",
                  diag, RT_MIN_SIZE);
         return VW_E_INVAL;
     }
@@ -283,15 +282,16 @@ static vw_status job_prepare(rt_job *j, const vw_scene *s, const rt_params *p, r
                    fabs((i & 2) ? world.hi[1] : world.lo[1]) + fabs((i & 4) ? world.hi[2] : world.lo[2]);
         if (n > m) m = n;
     }
-    /* Every ray starts at the eye or inside the world box: Embree refuses (asserts on) an
-       origin beyond its float limit, 1.8e18 on any axis, and squares of such lengths
-       overflow its floats. */
+    /* Every ray starts at the eye or inside the world box, all of it within `far` of the
+       origin on every axis: Embree sees it scaled near unit size by that (and would
+       assert on an origin beyond 1.8e18 unscaled); RT_MAX_COORD bounds the shading's
+       doubles. */
     double far = 0;
     for (int a = 0; a < 3; a++)
         far = fmax(far, fmax(fabs(cam.from[a]), fmax(fabs(world.lo[a]), fabs(world.hi[a]))));
     if (!(far <= RT_MAX_COORD)) {
         snprintf(err, errlen, "the %s lies %g from the origin on an axis: the ray tracer takes "
-                              "coordinates up to %g (Embree computes in float)",
+                              "coordinates up to %g",
                  fmax(fabs(cam.from[0]), fmax(fabs(cam.from[1]), fabs(cam.from[2]))) == far ? "eye"
                                                                                           : "scene",
                  far, RT_MAX_COORD);
@@ -313,7 +313,7 @@ static vw_status job_prepare(rt_job *j, const vw_scene *s, const rt_params *p, r
         return st;
     }
     sh->device = rt_device_new();
-    sh->geo_cache = sh->device ? rt_geo_cache_new() : NULL;
+    sh->geo_cache = sh->device ? rt_geo_cache_new(rt_embree_scale(far)) : NULL;
     if (!sh->device || !sh->geo_cache) {
         snprintf(err, errlen, "cannot create the Embree device");
         return VW_E_STATE;

@@ -173,13 +173,15 @@ void rt_object_empty(rt_object *o);
 
 typedef struct rt_job rt_job;
 
-/* What Embree's float arithmetic can trace, refused by rt_job_create (VW_E_INVAL) rather
-   than rendered wrong: the eye and the world box within RT_MAX_COORD of the origin on
-   every axis (Embree asserts that a ray's origin is within 1.8e18), and a scene at least
-   RT_MIN_SIZE across (below, the squares of its lengths vanish in float; a scene that
-   is a single point is allowed: it shows nothing). */
-#define RT_MAX_COORD 1e18
-#define RT_MIN_SIZE 1e-15
+/* The scenes the ray tracer takes, refused by rt_job_create (VW_E_INVAL) beyond: the eye
+   and the world box within RT_MAX_COORD of the origin on every axis, and a scene at least
+   RT_MIN_SIZE across (a scene that is a single point is allowed: it shows nothing).
+   Embree sees the scene brought near unit size by a power of two (rt_embree_scale), so
+   its floats neither overflow nor vanish; the limits keep the shading's double products
+   of four lengths (a triangle's normal) from doing so, by a wide margin: tests/raytrace
+   renders the same image, byte for byte, from the same scene scaled by 2^100 and 2^-190. */
+#define RT_MAX_COORD 1e36
+#define RT_MIN_SIZE 1e-60
 
 /* Phases, each timed by the caller if it wishes: create (objects, decomposition, world,
    objects added), commit (cells built), run (rays traced). err gets a message.

@@ -12,7 +12,7 @@
 # And failures inside the applications' own set-up, before or between the library's
 # collective steps (which used to end the job with status 15 or hang it; each now ends
 # in vw_config_agree or vw_world_agree):
-#   * a scene the ray tracer refuses on ranks 1 and up alone (one sphere 1e-17 across,
+#   * a scene the ray tracer refuses on ranks 1 and up alone (one sphere 2e-62 across,
 #     a sphere beyond its coordinate limit), for render and animate (rt_job_create);
 #     with NP 3, ranks 1 and 2 both fail and the message is rank 1's;
 #   * memory, by the test switch VW_FAULT: for the image sums, which rank 0 alone keeps
@@ -115,9 +115,9 @@ must_agree "info, the scene missing on rank 1" 2 "rank 1: .*balls1.nff" \
 
 # The applications' set-up. Ranks 1 and up read tiny1.nff, rank 0 tiny0.nff.
 ge1="[ $rank -ge 1 ] && n=1 || n=0"
-{ sed -n '1,/^f /p' "$dir/balls.nff"; echo "s 0 0 0 1e-17"; } >"$dir/tiny1.nff"
+{ sed -n '1,/^f /p' "$dir/balls.nff"; echo "s 0 0 0 1e-62"; } >"$dir/tiny1.nff"
 cp "$dir/balls.nff" "$dir/tiny0.nff"
-grep -q "^s 0 0 0 1e-17" "$dir/tiny1.nff" && grep -q "^v" "$dir/tiny1.nff" ||
+grep -q "^s 0 0 0 1e-62" "$dir/tiny1.nff" && grep -q "^v" "$dir/tiny1.nff" ||
     { echo "FAIL: could not make tiny1.nff"; fail=1; }
 rm -f "$dir/r.png"
 must_agree "render, a scene too small for the ray tracer on ranks 1 and up" 2 \
@@ -127,7 +127,7 @@ must_agree "render, a scene too small for the ray tracer on ranks 1 and up" 2 \
 must_agree "animate, a scene too small for the ray tracer on ranks 1 and up" 2 \
     "^vwalls animate: rank 1: the scene is [-0-9.e+]* across" \
     "$ge1; \"$vwalls\" animate \"$dir/tiny\$n.nff\" \"$dir/edits\" -o \"$dir/a%d.png\" $small"
-{ cat "$dir/balls.nff"; echo "s 2e18 0 0 1"; } >"$dir/far1.nff"
+{ cat "$dir/balls.nff"; echo "s 2e37 0 0 1"; } >"$dir/far1.nff"
 cp "$dir/balls.nff" "$dir/far0.nff"
 must_agree "render, a sphere beyond the coordinate limit on ranks 1 and up" 2 \
     "^vwalls render: rank 1: the scene lies [-0-9.e+]* from the origin on an axis" \

@@ -200,30 +200,41 @@ if(NOT rc1 EQUAL 0 OR NOT rc2 EQUAL 0 OR NOT same EQUAL 0)
   message(FATAL_ERROR "--angle 179.99: exit ${rc2}, file ${rc1}, PNG same as the file's: "
                       "${same} (0: yes) (${err}${err2})")
 endif()
-# Scales: one sphere, its eye and its light multiplied by S. Up to 1e17 and down to 1e-14
-# the same rays as at S = 1; at 1e18 the eye is beyond Embree's limit (1.8e18, where it
-# used to assert and abort the process), at 1e-16 the scene too small for its floats
-# (the image used to come out as noise): exit 2, a message, no file.
-function(scaled_scene path s)
+# Scales: a sphere, a floor, a cone, the eye and the light multiplied by S. Embree sees
+# the scene brought near unit size by a power of two (rt_embree_scale), so up to 1e35 and
+# down to 1e-57 the rays are those at S = 1 (once, at 1e12, the floor and the cone
+# vanished: Embree's floats overflowed; at 1e-15 the floor broke up). Beyond the range
+# (RT_MAX_COORD, RT_MIN_SIZE), with the sphere alone: exit 2, a message, no file.
+function(scaled_scene path s full)
   file(WRITE ${path} "v\nfrom 3${s} 3${s} 3${s}\nat 0 0 0\nup 0 0 1\nangle 45\nhither 0\n"
                      "resolution 16 16\nb 0.1 0.2 0.3\nl 4${s} 3${s} 2${s}\n"
                      "f 0.8 0.6 0.3 1 0.5 10 0 1\ns 0 0 0 1${s}\n")
+  if(full)
+    file(APPEND ${path} "f 0.3 0.8 0.3 1 0 0 0 1\n"
+                        "p 4 -5${s} -5${s} -1${s} 5${s} -5${s} -1${s} 5${s} 5${s} -1${s} -5${s} 5${s} -1${s}\n"
+                        "f 0.8 0.3 0.3 1 0.5 10 0 1\nc 2${s} 0 0 0.5${s} 2${s} 0 1${s} 0.2${s}\n")
+  endif()
 endfunction()
-foreach(case "e17;0" "e-14;0" "e18;the eye lies 3e+18 from the origin" "e-16;the scene is 3.4641e-16 across")
+scaled_scene(${WORK}/scale1.nff "" 1)
+execute_process(COMMAND ${VWALLS} render ${WORK}/scale1.nff -o ${WORK}/scale1.png --quiet
+                        --cells 2x2x2 --stats ${WORK}/scale1.json RESULT_VARIABLE rc1)
+file(READ ${WORK}/scale1.json j1)
+string(REGEX MATCH "\"rays\": {[^}]*}" r1 "${j1}")
+foreach(case "e12;0" "e35;0" "e-15;0" "e-57;0" "e37;the eye lies 3e+37 from the origin"
+             "e-61;the scene is 3.4641e-61 across")
   list(GET case 0 s)
   list(GET case 1 want)
-  scaled_scene(${WORK}/scale${s}.nff ${s})
   file(REMOVE ${WORK}/scale.png)
+  if(want STREQUAL "0")
+    scaled_scene(${WORK}/scale${s}.nff ${s} 1)
+  else()
+    scaled_scene(${WORK}/scale${s}.nff ${s} 0)
+  endif()
   execute_process(COMMAND ${VWALLS} render ${WORK}/scale${s}.nff -o ${WORK}/scale.png --quiet
                           --cells 2x2x2 --stats ${WORK}/scale${s}.json
                   RESULT_VARIABLE rc ERROR_VARIABLE err)
   if(want STREQUAL "0")
-    scaled_scene(${WORK}/scale1.nff "")
-    execute_process(COMMAND ${VWALLS} render ${WORK}/scale1.nff -o ${WORK}/scale1.png --quiet
-                            --cells 2x2x2 --stats ${WORK}/scale1.json RESULT_VARIABLE rc1)
-    file(READ ${WORK}/scale1.json j1)
     file(READ ${WORK}/scale${s}.json js)
-    string(REGEX MATCH "\"rays\": {[^}]*}" r1 "${j1}")
     string(REGEX MATCH "\"rays\": {[^}]*}" rs "${js}")
     if(NOT rc EQUAL 0 OR NOT rc1 EQUAL 0 OR NOT r1 STREQUAL rs OR r1 STREQUAL "")
       message(FATAL_ERROR "scale 1${s}: exit ${rc}, ${rs} against ${r1} at scale 1 (${err})")
@@ -234,6 +245,44 @@ foreach(case "e17;0" "e-14;0" "e18;the eye lies 3e+18 from the origin" "e-16;the
       message(FATAL_ERROR "scale 1${s}: exit ${rc}, expected 2, '${want}' and no file (${err})")
     endif()
   endif()
+endforeach()
+# Scaled by a power of two, the same scene gives the same image, byte for byte, on one cell
+# and on 2x2x2: every number is the exact double times 2^100 or 2^-190, and the whole
+# computation, Embree's floats and the shading's doubles, is exact under such a scaling.
+function(pow_scene path from l r floor cone)
+  file(WRITE ${path} "v\nfrom ${from}\nat 0 0 0\nup 0 0 1\nangle 45\nhither 0\n"
+                     "resolution 16 16\nb 0.1 0.2 0.3\nl ${l}\n"
+                     "f 0.8 0.6 0.3 1 0.5 10 0 1\ns 0 0 0 ${r}\n"
+                     "f 0.3 0.8 0.3 1 0 0 0 1\np 4 ${floor}\n"
+                     "f 0.8 0.3 0.3 1 0.5 10 0 1\nc ${cone}\n")
+endfunction()
+scaled_scene(${WORK}/pow0.nff "" 1)
+pow_scene(${WORK}/pow100.nff
+  "3.802951800684688e+30 3.802951800684688e+30 3.802951800684688e+30"
+  "5.070602400912918e+30 3.802951800684688e+30 2.535301200456459e+30"
+  "1.2676506002282294e+30"
+  "-6.338253001141147e+30 -6.338253001141147e+30 -1.2676506002282294e+30 6.338253001141147e+30 -6.338253001141147e+30 -1.2676506002282294e+30 6.338253001141147e+30 6.338253001141147e+30 -1.2676506002282294e+30 -6.338253001141147e+30 6.338253001141147e+30 -1.2676506002282294e+30"
+  "2.535301200456459e+30 0 0 6.338253001141147e+29 2.535301200456459e+30 0 1.2676506002282294e+30 2.535301200456459e+29")
+pow_scene(${WORK}/pow-190.nff
+  "1.9117102933589427e-57 1.9117102933589427e-57 1.9117102933589427e-57"
+  "2.5489470578119236e-57 1.9117102933589427e-57 1.2744735289059618e-57"
+  "6.372367644529809e-58"
+  "-3.1861838222649046e-57 -3.1861838222649046e-57 -6.372367644529809e-58 3.1861838222649046e-57 -3.1861838222649046e-57 -6.372367644529809e-58 3.1861838222649046e-57 3.1861838222649046e-57 -6.372367644529809e-58 -3.1861838222649046e-57 3.1861838222649046e-57 -6.372367644529809e-58"
+  "1.2744735289059618e-57 0 0 3.1861838222649046e-58 1.2744735289059618e-57 0 6.372367644529809e-58 1.2744735289059619e-58")
+execute_process(COMMAND ${VWALLS} render ${WORK}/pow0.nff -o ${WORK}/pow0.png --quiet
+                RESULT_VARIABLE rc0 ERROR_VARIABLE err0)
+foreach(k 100 -190)
+  foreach(c 1 2x2x2)
+    file(REMOVE ${WORK}/pow${k}.png)
+    execute_process(COMMAND ${VWALLS} render ${WORK}/pow${k}.nff -o ${WORK}/pow${k}.png --quiet
+                            --cells ${c} RESULT_VARIABLE rc ERROR_VARIABLE err)
+    execute_process(COMMAND ${CMAKE_COMMAND} -E compare_files ${WORK}/pow0.png ${WORK}/pow${k}.png
+                    RESULT_VARIABLE same)
+    if(NOT rc0 EQUAL 0 OR NOT rc EQUAL 0 OR NOT same EQUAL 0)
+      message(FATAL_ERROR "scaled by 2^${k} on ${c} cells: exit ${rc} (${rc0} unscaled), PNG "
+                          "the same as unscaled: ${same} (0: yes) (${err0}${err})")
+    endif()
+  endforeach()
 endforeach()
 # A pre-pass option without a pre-pass is said to do nothing (and renders); with one, not.
 foreach(case "--balance-iters;3;warn" "--prepass;2;warn" "--balance-load;segments;warn"

@@ -463,7 +463,7 @@ static int test_cone(void)
     o.g.cone.r1 = 0.3;
     void *dev = rt_device_new();
     rt_cell_geo g;
-    EXPECT(rt_cell_geo_build(dev, &o, 1, &g) == VW_OK, "build");
+    EXPECT(rt_cell_geo_build(dev, &o, 1, 1.0, &g) == VW_OK, "build");
     int hits = 0, n = 0;
     for (int i = 0; i < 200; i++) {
         double s = (i % 20 + 0.5) / 20.0, phi = (i / 20) * 0.6283 + 0.1;
@@ -551,7 +551,7 @@ static int test_watertight(void)
         }
     void *dev = rt_device_new();
     rt_cell_geo g;
-    EXPECT(rt_cell_geo_build(dev, tri, nt, &g) == VW_OK, "build");
+    EXPECT(rt_cell_geo_build(dev, tri, nt, 1.0, &g) == VW_OK, "build");
     /* The target points: on the mesh's inner edges (in float, as Embree holds the
        vertices), at their ends (the vertices) and at random places along them. */
     uint64_t seed = 99;

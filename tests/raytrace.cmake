@@ -8,6 +8,7 @@ target_link_libraries(vw_test_raytrace PRIVATE vwalls_apps)
 set(VW_RT_MIXED ${PROJECT_SOURCE_DIR}/tests/raytrace/mixed.nff)
 
 add_test(NAME raytrace_cone COMMAND vw_test_raytrace cone)
+add_test(NAME raytrace_scale COMMAND vw_test_raytrace scale)
 add_test(NAME raytrace_analytic COMMAND vw_test_raytrace analytic)
 # The eye rays span the NFF angle, up to the reader's limit of 180 degrees.
 add_test(NAME raytrace_view COMMAND vw_test_raytrace view)

@@ -5,6 +5,8 @@
  *   analytic [OFFSET]     one diffuse sphere and one light against the formula, 1/255
  *                         (the scene moved by OFFSET on every axis: float error)
  *   cone                  the cone/cylinder intersection against sampled points
+ *   scale                 a sphere, a triangle and a cone give the same hits, bit for bit,
+ *                         at every power-of-two scale Embree is handed (rt_embree_scale)
  *   watertight            rays aimed at a mesh's shared edges and vertices hit it
  *   concave SCENE         each polygon's triangle records cover it and nothing else
  *   view                  the eye rays span the angle an NFF 'v' block gives, all of
@@ -516,6 +518,86 @@ static int test_cone(void)
     return vw_test_failures ? 1 : 0;
 }
 
+/* The same objects (a sphere, a triangle, a cone) and rays give the same answers, bit
+   for bit, whatever power of two the geometry is handed to Embree at: the object, t,
+   u, v of the first hit, and the shadow query over the same intervals. Also the
+   scale's contract: 1 where Embree's floats are at ease, else the power of two that
+   brings `far` into [1, 2). */
+static int test_scale(void)
+{
+    EXPECT(rt_embree_scale(1.0) == 1.0 && rt_embree_scale(0x1p20) == 1.0 &&
+               rt_embree_scale(0x1p-10) == 1.0,
+           "unit-sized scenes are handed over as they are");
+    EXPECT(rt_embree_scale(0) == 1.0 && rt_embree_scale(INFINITY) == 1.0 &&
+               rt_embree_scale(NAN) == 1.0,
+           "no scale from a far of 0, infinity or NaN");
+    static const double fars[] = {3e12, 0x1p21, 1e-15, 0x1p-11, 5e35, 1e-60};
+    for (size_t i = 0; i < sizeof fars / sizeof fars[0]; i++) {
+        double sc = rt_embree_scale(fars[i]), m;
+        int e;
+        m = frexp(sc, &e);
+        EXPECT(m == 0.5 && fars[i] * sc >= 1 && fars[i] * sc < 2,
+               "far %g: scale %a is not the power of two that brings it into [1, 2)", fars[i], sc);
+    }
+    rt_object o[3];
+    memset(o, 0, sizeof o);
+    o[0].kind = RT_SPHERE;
+    o[0].g.sphere.c[0] = 0.3, o[0].g.sphere.c[1] = -0.2, o[0].g.sphere.c[2] = 0.1;
+    o[0].g.sphere.r = 0.7;
+    o[1].kind = RT_TRIANGLE;
+    static const double tv[3][3] = {{-2, -2, -0.9}, {2.5, -1.5, -0.8}, {0.2, 2.5, -1.1}};
+    memcpy(o[1].g.tri.v, tv, sizeof tv);
+    o[2].kind = RT_CONE;
+    static const double cb[3] = {1.2, 0.4, -0.9}, ca[3] = {1.0, 0.9, 0.8};
+    memcpy(o[2].g.cone.base, cb, sizeof cb);
+    memcpy(o[2].g.cone.apex, ca, sizeof ca);
+    o[2].g.cone.r0 = 0.5;
+    o[2].g.cone.r1 = 0.2;
+    static const double scales[] = {1.0, 0x1p-30, 0x1p30};
+    void *dev = rt_device_new();
+    rt_cell_geo g[3];
+    for (int k = 0; k < 3; k++) EXPECT(rt_cell_geo_build(dev, o, 3, scales[k], &g[k]) == VW_OK, "build");
+    uint64_t rng = 12345;
+    int hits[3] = {0, 0, 0}, nrays = 3000;
+    for (int i = 0; i < nrays; i++) {
+        double org[3], dir[3], len = 0;
+        for (int a = 0; a < 3; a++) {
+            rng = rng * 6364136223846793005ull + 1442695040888963407ull;
+            org[a] = 4.0 * ((double)(rng >> 11) / 9007199254740992.0) - 2.0 + (a == 2 ? 3.0 : 0.0);
+            rng = rng * 6364136223846793005ull + 1442695040888963407ull;
+            dir[a] = (double)(rng >> 11) / 9007199254740992.0 - 0.5 - (a == 2 ? 0.8 : 0.0);
+            len += dir[a] * dir[a];
+        }
+        for (int a = 0; a < 3; a++) dir[a] /= sqrt(len);
+        double tn = 0.01 * (i % 7), tf = i % 5 ? INFINITY : 2.0 + (i % 11);
+        rt_hit h[3];
+        int got[3], occ[3];
+        for (int k = 0; k < 3; k++) {
+            got[k] = rt_cell_geo_intersect(&g[k], org, dir, tn, tf, &h[k]);
+            occ[k] = rt_cell_geo_occluded(&g[k], org, dir, tn, tf);
+        }
+        for (int k = 1; k < 3; k++) {
+            EXPECT(got[k] == got[0] && occ[k] == occ[0], "ray %d, scale %a: hit %d occluded %d, "
+                   "at scale 1 %d %d", i, scales[k], got[k], occ[k], got[0], occ[0]);
+            if (got[k] && got[0])
+                EXPECT(h[k].obj - g[k].obj == h[0].obj - g[0].obj && h[k].t == h[0].t &&
+                           h[k].u == h[0].u && h[k].v == h[0].v,
+                       "ray %d, scale %a: object %d t %.17g, at scale 1 object %d t %.17g", i,
+                       scales[k], (int)(h[k].obj - g[k].obj), h[k].t, (int)(h[0].obj - g[0].obj),
+                       h[0].t);
+        }
+        if (got[0]) hits[h[0].obj - g[0].obj]++;
+    }
+    /* Every kind was hit often enough for the comparison to mean something. */
+    EXPECT(hits[0] > 100 && hits[1] > 100 && hits[2] > 20, "hits: sphere %d, triangle %d, cone %d",
+           hits[0], hits[1], hits[2]);
+    for (int k = 0; k < 3; k++) rt_cell_geo_free(&g[k]);
+    rt_device_free(dev);
+    printf("scale: %d rays; hits: sphere %d, triangle %d, cone %d, the same at 2^-30 and 2^30\n",
+           nrays, hits[0], hits[1], hits[2]);
+    return vw_test_failures ? 1 : 0;
+}
+
 /* Rays aimed at the shared edges and vertices of a mesh (a bumpy heightfield of
    2 x 40 x 40 triangles, each with its own copy of the shared vertices, as
    rt_cell_geo_build makes them) must hit it, and the shadow query must agree: a ray
@@ -646,6 +728,7 @@ int main(int argc, char **argv)
     if (argc >= 3 && !strcmp(argv[1], "identical")) return test_identical(argv[2], argc > 3 ? argv[3] : NULL);
     if (argc >= 2 && !strcmp(argv[1], "analytic")) return test_analytic(argc > 2 ? atof(argv[2]) : 0);
     if (argc >= 2 && !strcmp(argv[1], "cone")) return test_cone();
+    if (argc >= 2 && !strcmp(argv[1], "scale")) return test_scale();
     if (argc >= 2 && !strcmp(argv[1], "view")) return test_view();
     if (argc >= 3 && !strcmp(argv[1], "illum")) return test_illum(argv[2]);
     if (argc >= 2 && !strcmp(argv[1], "watertight")) return test_watertight();

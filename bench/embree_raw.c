@@ -131,7 +131,7 @@ int main(int argc, char **argv)
     bench b;
     memset(&b, 0, sizeof b);
     double t0 = now();
-    if (rt_cell_geo_build(dev, objs, n, 1.0, &b.geo) != VW_OK) return 1;
+    if (rt_cell_geo_build(dev, objs, n, &rt_float_frame_identity, &b.geo) != VW_OK) return 1;
     double t1 = now();
     b.lights = sh->lights;
     b.nlights = sh->nlights;

@@ -12,9 +12,11 @@ add_test(NAME raytrace_scale COMMAND vw_test_raytrace scale)
 add_test(NAME raytrace_analytic COMMAND vw_test_raytrace analytic)
 # The eye rays span the NFF angle, up to the reader's limit of 180 degrees.
 add_test(NAME raytrace_view COMMAND vw_test_raytrace view)
-# The same scene 1e4 times its size from the origin: a shadow ray must start clear of its
-# own surface by more than Embree's float error there (eps, rt_job_create).
-add_test(NAME raytrace_analytic_far COMMAND vw_test_raytrace analytic 1e4)
+# The same scene 1e10 times its size from the origin: Embree sees it measured from the
+# world box's centre (rt_float_frame; at 1e5 it was 76/255 off, at 1e8 178/255), and a
+# shadow ray starts clear of its own surface by more than the doubles' rounding there
+# (eps, rt_float_frame_norm1).
+add_test(NAME raytrace_analytic_far COMMAND vw_test_raytrace analytic 1e10)
 # Rays aimed at the edges and vertices a mesh's triangles share do not slip through.
 add_test(NAME raytrace_watertight COMMAND vw_test_raytrace watertight)
 # MTL illum: Ks weights the mirror ray from illum 3 on (and without an illum), not for
@@ -34,14 +36,20 @@ add_test(NAME raytrace_identical_wall_hit COMMAND vw_test_raytrace identical
 # The same under the stress switch (random delays and reordering of deliveries).
 add_test(NAME raytrace_stress_balls COMMAND vw_test_raytrace identical gen:balls:2 64x64)
 add_test(NAME raytrace_stress_mixed COMMAND vw_test_raytrace identical ${VW_RT_MIXED} 64x64)
+# The two scenes above a billion units from the origin (raytrace_cli: the same PNG too).
+add_test(NAME raytrace_identical_far_mixed COMMAND vw_test_raytrace identical
+         ${PROJECT_SOURCE_DIR}/tests/raytrace/far_mixed.nff 96x96)
+add_test(NAME raytrace_identical_far_wall_hit COMMAND vw_test_raytrace identical
+         ${PROJECT_SOURCE_DIR}/tests/raytrace/far_wall_hit.nff 8x6)
 set(VW_RT_TSAN "TSAN_OPTIONS=suppressions=${PROJECT_SOURCE_DIR}/tests/raytrace/tsan.supp")
 set_tests_properties(raytrace_cone raytrace_analytic raytrace_analytic_far raytrace_identical_balls
-  raytrace_identical_mixed raytrace_identical_wall_hit PROPERTIES ENVIRONMENT "${VW_RT_TSAN}")
+  raytrace_identical_mixed raytrace_identical_wall_hit raytrace_identical_far_mixed
+  raytrace_identical_far_wall_hit PROPERTIES ENVIRONMENT "${VW_RT_TSAN}")
 # Threads-engine tests: ./run test-sanitizers runs them under TSan (rays handed from
 # cell to cell inline and by message, under the stress switch too).
 set_tests_properties(raytrace_cone raytrace_analytic raytrace_analytic_far raytrace_identical_balls
   raytrace_identical_mixed raytrace_identical_wall_hit raytrace_stress_balls raytrace_stress_mixed
-  PROPERTIES LABELS "threads")
+  raytrace_identical_far_mixed raytrace_identical_far_wall_hit PROPERTIES LABELS "threads")
 set_tests_properties(raytrace_stress_balls PROPERTIES ENVIRONMENT "VW_STRESS=7;${VW_RT_TSAN}")
 set_tests_properties(raytrace_stress_mixed PROPERTIES
   ENVIRONMENT "VW_STRESS=1994;VW_STRESS_SPLIT=1;${VW_RT_TSAN}")

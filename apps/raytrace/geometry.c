@@ -12,10 +12,13 @@
  * coincident primitives tie, and which one Embree reports depends on its tree: such
  * z-fighting is outside the invariant (docs/known-issues.md).
  *
- * Embree sees the scene multiplied by a power of two, `scale` (rt_embree_scale): its
- * float tests multiply three or four coordinates, which overflow for a scene 1e12 across
- * and vanish for one 1e-15 across, so such a scene is brought near unit size. The
- * product with a power of two is exact, so the tests find the same hits, at t * scale.
+ * Embree sees the scene in a float frame (rt_float_frame): measured from an origin
+ * inside it when it lies far from (0, 0, 0) for its size, so its floats keep their bits
+ * for the scene's detail, and multiplied by a power of two: Embree's tests multiply
+ * three or four coordinates, which overflow for a scene 1e12 across and vanish for one
+ * 1e-15 across, so such a scene is brought near unit size. The product with a power of
+ * two is exact, so the tests find the same hits, at t * scale; t does not change with
+ * the origin.
  */
 #include <embree3/rtcore.h>
 #include <math.h>
@@ -116,8 +119,8 @@ static void cone_bounds(const struct RTCBoundsFunctionArguments *args)
     vw_box b;
     rt_object_bounds(o, 0, &b);
     for (int a = 0; a < 3; a++) {
-        b.lo[a] *= g->scale;
-        b.hi[a] *= g->scale;
+        b.lo[a] = (b.lo[a] - g->ff.origin[a]) * g->ff.scale;
+        b.hi[a] = (b.hi[a] - g->ff.origin[a]) * g->ff.scale;
     }
     /* Round outward so the float box contains the double one. */
     args->bounds_o->lower_x = nextafterf((float)b.lo[0], -INFINITY);
@@ -136,9 +139,9 @@ static void cone_intersect(const struct RTCIntersectFunctionNArguments *args)
     struct RTCRayHit *rh = (struct RTCRayHit *)args->rayhit; /* N == 1: rtcIntersect1 */
     double t;
     if (!cone_hit(&g->obj[g->cone_map[args->primID]], c->org, c->dir, rh->ray.tnear,
-                  rh->ray.tfar, g->scale, &t))
+                  rh->ray.tfar, g->ff.scale, &t))
         return;
-    rh->ray.tfar = (float)(t * g->scale);
+    rh->ray.tfar = (float)(t * g->ff.scale);
     rh->hit.u = rh->hit.v = 0;
     rh->hit.Ng_x = rh->hit.Ng_y = rh->hit.Ng_z = 0;
     rh->hit.primID = args->primID;
@@ -154,7 +157,7 @@ static void cone_occluded(const struct RTCOccludedFunctionNArguments *args)
     struct RTCRay *r = (struct RTCRay *)args->ray;
     double t;
     if (cone_hit(&g->obj[g->cone_map[args->primID]], c->org, c->dir, r->tnear, r->tfar,
-                 g->scale, &t))
+                 g->ff.scale, &t))
         r->tfar = -INFINITY;
 }
 
@@ -170,11 +173,12 @@ static vw_status attach(rt_cell_geo *g, RTCGeometry geom, int kind)
     return VW_OK;
 }
 
-vw_status rt_cell_geo_build(void *device, const rt_object *objects, size_t n, double scale,
-                            rt_cell_geo *g)
+vw_status rt_cell_geo_build(void *device, const rt_object *objects, size_t n,
+                            const rt_float_frame *ff, rt_cell_geo *g)
 {
     memset(g, 0, sizeof *g);
-    g->scale = scale;
+    g->ff = *ff;
+    const double *o0 = ff->origin, scale = ff->scale;
     g->geom_kind[0] = g->geom_kind[1] = g->geom_kind[2] = -1;
     g->obj = malloc((n ? n : 1) * sizeof *g->obj);
     g->sph_map = malloc((n ? n : 1) * sizeof *g->sph_map);
@@ -220,7 +224,7 @@ vw_status rt_cell_geo_build(void *device, const rt_object *objects, size_t n, do
         if (!v) return VW_E_NOMEM;
         for (size_t i = 0; i < ns; i++) {
             const rt_object *o = &g->obj[g->sph_map[i]];
-            for (int a = 0; a < 3; a++) v[4 * i + a] = (float)(o->g.sphere.c[a] * scale);
+            for (int a = 0; a < 3; a++) v[4 * i + a] = (float)((o->g.sphere.c[a] - o0[a]) * scale);
             v[4 * i + 3] = (float)(o->g.sphere.r * scale);
         }
         if ((st = attach(g, geom, RT_SPHERE)) != VW_OK) return st;
@@ -238,7 +242,7 @@ vw_status rt_cell_geo_build(void *device, const rt_object *objects, size_t n, do
             const rt_object *o = &g->obj[g->tri_map[i]];
             for (int c = 0; c < 3; c++) {
                 for (int a = 0; a < 3; a++)
-                    v[9 * i + 3 * c + a] = (float)(o->g.tri.v[c][a] * scale);
+                    v[9 * i + 3 * c + a] = (float)((o->g.tri.v[c][a] - o0[a]) * scale);
                 ix[3 * i + c] = (unsigned)(3 * i + c);
             }
         }
@@ -269,13 +273,15 @@ void rt_cell_geo_free(rt_cell_geo *g)
     memset(g, 0, sizeof *g);
 }
 
-/* The ray as Embree sees it: the origin and t scaled, the direction as it is. */
+/* The ray as Embree sees it: its origin in the float frame, t scaled, the direction as
+   it is. */
 static void make_ray(struct RTCRay *r, const double org[3], const double dir[3], double tn,
-                     double tf, double scale)
+                     double tf, const rt_float_frame *ff)
 {
-    r->org_x = (float)(org[0] * scale);
-    r->org_y = (float)(org[1] * scale);
-    r->org_z = (float)(org[2] * scale);
+    double scale = ff->scale;
+    r->org_x = (float)((org[0] - ff->origin[0]) * scale);
+    r->org_y = (float)((org[1] - ff->origin[1]) * scale);
+    r->org_z = (float)((org[2] - ff->origin[2]) * scale);
     r->dir_x = (float)dir[0];
     r->dir_y = (float)dir[1];
     r->dir_z = (float)dir[2];
@@ -296,7 +302,7 @@ int rt_cell_geo_intersect(const rt_cell_geo *g, const double org[3], const doubl
     c.org = org;
     c.dir = dir;
     struct RTCRayHit rh;
-    make_ray(&rh.ray, org, dir, tnear, tfar, g->scale);
+    make_ray(&rh.ray, org, dir, tnear, tfar, &g->ff);
     rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
     rh.hit.primID = RTC_INVALID_GEOMETRY_ID;
     rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
@@ -306,7 +312,7 @@ int rt_cell_geo_intersect(const rt_cell_geo *g, const double org[3], const doubl
     const uint32_t *map = kind == RT_SPHERE ? g->sph_map
                           : kind == RT_TRIANGLE ? g->tri_map : g->cone_map;
     hit->obj = &g->obj[map[rh.hit.primID]];
-    hit->t = rh.ray.tfar / g->scale; /* exact: a power of two */
+    hit->t = rh.ray.tfar / g->ff.scale; /* exact: a power of two */
     hit->u = rh.hit.u;
     hit->v = rh.hit.v;
     return 1;
@@ -321,7 +327,7 @@ int rt_cell_geo_occluded(const rt_cell_geo *g, const double org[3], const double
     c.org = org;
     c.dir = dir;
     struct RTCRay r;
-    make_ray(&r, org, dir, tnear, tfar, g->scale);
+    make_ray(&r, org, dir, tnear, tfar, &g->ff);
     rtcOccluded1((RTCScene)g->scene, &c.base, &r);
     return r.tfar == -INFINITY;
 }
@@ -330,6 +336,33 @@ double rt_embree_scale(double far)
 {
     if (!(far > 0) || !isfinite(far) || (far >= 0x1p-10 && far <= 0x1p20)) return 1.0;
     return ldexp(1.0, -ilogb(far));
+}
+
+const rt_float_frame rt_float_frame_identity = {{0, 0, 0}, 1.0};
+
+rt_float_frame rt_float_frame_of(const double eye[3], const vw_box *world)
+{
+    rt_float_frame ff = rt_float_frame_identity;
+    double diag2 = 0, dist2 = 0, c[3];
+    for (int a = 0; a < 3; a++) {
+        c[a] = 0.5 * (world->lo[a] + world->hi[a]);
+        diag2 += (world->hi[a] - world->lo[a]) * (world->hi[a] - world->lo[a]);
+        dist2 += c[a] * c[a];
+    }
+    if (dist2 > 16 * diag2) memcpy(ff.origin, c, sizeof c); /* |c| > 4 diagonals */
+    double far = 0;
+    for (int a = 0; a < 3; a++) {
+        far = fmax(far, fabs(eye[a] - ff.origin[a]));
+        far = fmax(far, fmax(fabs(world->lo[a] - ff.origin[a]), fabs(world->hi[a] - ff.origin[a])));
+    }
+    ff.scale = rt_embree_scale(far);
+    return ff;
+}
+
+double rt_float_frame_norm1(const rt_float_frame *ff, const double p[3])
+{
+    double rel = fabs(p[0] - ff->origin[0]) + fabs(p[1] - ff->origin[1]) + fabs(p[2] - ff->origin[2]);
+    return fmax(rel, 1e-7 * (fabs(p[0]) + fabs(p[1]) + fabs(p[2])));
 }
 
 void *rt_device_new(void)
@@ -360,17 +393,17 @@ typedef struct rt_geo_entry {
 } rt_geo_entry;
 
 struct rt_geo_cache {
-    double scale; /* every geometry's (rt_embree_scale) */
+    rt_float_frame ff; /* every geometry's */
     pthread_mutex_t mu;
     pthread_cond_t cv; /* an entry left the building state */
     rt_geo_entry *head;
 };
 
-rt_geo_cache *rt_geo_cache_new(double scale)
+rt_geo_cache *rt_geo_cache_new(const rt_float_frame *ff)
 {
     rt_geo_cache *c = calloc(1, sizeof *c);
     if (!c) return NULL;
-    c->scale = scale;
+    c->ff = *ff;
     pthread_mutex_init(&c->mu, NULL);
     pthread_cond_init(&c->cv, NULL);
     return c;
@@ -452,7 +485,7 @@ vw_status rt_geo_acquire(rt_geo_cache *c, void *device, const rt_object *objects
     c->head = e;
     pthread_mutex_unlock(&c->mu);
 
-    vw_status st = rt_cell_geo_build(device, objects, n, c->scale, &e->geo);
+    vw_status st = rt_cell_geo_build(device, objects, n, &c->ff, &e->geo);
 
     pthread_mutex_lock(&c->mu);
     e->key = st == VW_OK ? e->geo.obj : NULL; /* (a failed entry is never compared) */

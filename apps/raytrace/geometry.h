@@ -14,7 +14,7 @@ typedef struct rt_cell_geo {
     int geom_kind[3];            /* Embree geomID -> rt_kind */
     vw_box bounds;               /* of the objects (world coordinates); empty (lo > hi)
                                     without any */
-    double scale;                /* Embree's coordinates are the world's times this */
+    rt_float_frame ff;           /* Embree's coordinates: (world's - ff.origin) * ff.scale */
 } rt_cell_geo;
 
 typedef struct rt_hit {
@@ -23,16 +23,15 @@ typedef struct rt_hit {
     float u, v;                  /* barycentrics of a triangle hit */
 } rt_hit;
 
-/* scale: a power of two, the same for every cell of a job (rt_embree_scale). */
-vw_status rt_cell_geo_build(void *device, const rt_object *objects, size_t n, double scale,
-                            rt_cell_geo *g);
+vw_status rt_cell_geo_build(void *device, const rt_object *objects, size_t n,
+                            const rt_float_frame *ff, rt_cell_geo *g);
 void rt_cell_geo_free(rt_cell_geo *g);
 /* Built cells shared within a process: the copies of a farmed or duplicated cell have
    the same records, so they read one scene (Embree's queries are thread-safe) instead
    of each worker building and keeping its own. Entries are counted references; the
    first worker to ask for some records builds them while the others wait. */
 typedef struct rt_geo_cache rt_geo_cache;
-rt_geo_cache *rt_geo_cache_new(double scale); /* the scale its geometries are built at */
+rt_geo_cache *rt_geo_cache_new(const rt_float_frame *ff); /* its geometries' frame */
 void rt_geo_cache_free(rt_geo_cache *c); /* every entry must have been released */
 /* The geometry of objects[0..n): a built one with the very same records, or built now.
    Release with rt_geo_release. */
@@ -57,6 +56,20 @@ void rt_cone_normal(const rt_object *o, const double p[3], double n[3]);
    Embree's floats are at ease (so most scenes give Embree their own numbers), else the
    power that brings far into [1, 2). */
 double rt_embree_scale(double far);
+/* The frame of a job whose rays start at the eye or inside the world box (world
+   coordinates): the origin is the box's centre when the box lies further from (0, 0, 0)
+   than four times its diagonal, else (0, 0, 0), so that most scenes give Embree their
+   own numbers; the scale is rt_embree_scale of the largest coordinate of the eye and the
+   box measured from that origin. */
+rt_float_frame rt_float_frame_of(const double eye[3], const vw_box *world);
+/* The magnitude the ray tracer's margins (rt_shared.eps, overlap, a cell's reach) are
+   proportional to, for a point p where rays start: |p - ff.origin| in the 1-norm, which
+   Embree's float error (2^-24) is relative to, and at least 1e-7 of |p|, which the
+   doubles' own rounding (2^-53) is relative to: the margins, 1e-6 of it and more, then
+   stay a thousand times above both. Without an origin it is |p|. */
+double rt_float_frame_norm1(const rt_float_frame *ff, const double p[3]);
+/* The identity frame (origin 0, scale 1), for tests and tools that trace raw scenes. */
+extern const rt_float_frame rt_float_frame_identity;
 void *rt_device_new(void);
 void rt_device_free(void *device);
 

@@ -268,19 +268,21 @@ static vw_status job_prepare(rt_job *j, const vw_scene *s, const rt_params *p, r
         world.hi[a] = hi[a] + pad;
     }
     if (p->world) world = *p->world;
+    sh->ff = rt_float_frame_of(cam.from, &world);
     /* A cell's search runs past its far wall by `overlap` (walk_ray), so that a hit on
        the wall, which Embree's float arithmetic can place a little on either side of it,
        is not missed by both cells. The overlap is ten times that error, which is about
        1e-7 of the magnitudes involved, at most 3m (every ray starts at the eye or inside
-       the world, whose coordinate sums m bounds; see cell_reach). Objects are
+       the world, whose coordinate sums m bounds, measured in Embree's float frame from
+       its origin; see cell_reach). Objects are
        placed with their bounds widened by twice that, so a cell holds every object a
        ray can hit within the overlap past its walls: what it finds there is the ray's
        first hit, as one cell would find it. */
-    double m = fabs(cam.from[0]) + fabs(cam.from[1]) + fabs(cam.from[2]);
+    double m = rt_float_frame_norm1(&sh->ff, cam.from);
     for (int i = 0; i < 8; i++) {
-        double n = fabs((i & 1) ? world.hi[0] : world.lo[0]) +
-                   fabs((i & 2) ? world.hi[1] : world.lo[1]) + fabs((i & 4) ? world.hi[2] : world.lo[2]);
-        if (n > m) m = n;
+        double corner[3] = {(i & 1) ? world.hi[0] : world.lo[0], (i & 2) ? world.hi[1] : world.lo[1],
+                            (i & 4) ? world.hi[2] : world.lo[2]};
+        m = fmax(m, rt_float_frame_norm1(&sh->ff, corner));
     }
     /* Every ray starts at the eye or inside the world box, all of it within `far` of the
        origin on every axis: Embree sees it scaled near unit size by that (and would
@@ -313,7 +315,7 @@ static vw_status job_prepare(rt_job *j, const vw_scene *s, const rt_params *p, r
         return st;
     }
     sh->device = rt_device_new();
-    sh->geo_cache = sh->device ? rt_geo_cache_new(rt_embree_scale(far)) : NULL;
+    sh->geo_cache = sh->device ? rt_geo_cache_new(&sh->ff) : NULL;
     if (!sh->device || !sh->geo_cache) {
         snprintf(err, errlen, "cannot create the Embree device");
         return VW_E_STATE;

@@ -496,17 +496,18 @@ static void cell_free(void *state, void *user)
    cell's volume or more empty (the test is not worth its cost for less).
    The margin: Embree intersects in floats, the ray and the objects rounded to 24 bits,
    so a hit it reports can lie about 1e-7 of the magnitudes involved (the origin's
-   coordinates, t, the objects' coordinates) off the double-precision ray. Every ray
-   starts at the eye or inside the world box, so those magnitudes are at most three
-   times the larger of the eye's and the world corners' coordinate sums (1-norms); the
-   margin is 1e-5 of that, a hundred times the error. */
+   coordinates, t, the objects' coordinates, in its float frame) off the double-precision
+   ray. Every ray starts at the eye or inside the world box, so those magnitudes are at
+   most three times the larger of the eye's and the world corners' coordinate sums
+   (1-norms from the frame's origin); the margin is 1e-5 of that, a hundred times the
+   error. */
 static void cell_reach(vw_ctx *ctx, rt_cell *c)
 {
     const vw_decomp *d = vw_ctx_decomp(ctx);
     vw_box w = vw_decomp_world(d), b = vw_ctx_cell_box(ctx);
     const double *F = vw_decomp_frame(d);
-    const double *eye = c->sh->view.eye;
-    double m = fabs(eye[0]) + fabs(eye[1]) + fabs(eye[2]);
+    const rt_float_frame *ff = &c->sh->ff;
+    double m = rt_float_frame_norm1(ff, c->sh->view.eye);
     vw_box cell = {{INFINITY, INFINITY, INFINITY}, {-INFINITY, -INFINITY, -INFINITY}};
     for (int i = 0; i < 8; i++) {
         const vw_box *boxes[2] = {&b, &w};
@@ -514,13 +515,11 @@ static void cell_reach(vw_ctx *ctx, rt_cell *c)
             const vw_box *x = boxes[k];
             double q[3] = {(i & 1) ? x->hi[0] : x->lo[0], (i & 2) ? x->hi[1] : x->lo[1],
                            (i & 4) ? x->hi[2] : x->lo[2]};
-            double p[3], norm = 0;
-            for (int a = 0; a < 3; a++) { /* frame -> world: p = F^T q */
+            double p[3];
+            for (int a = 0; a < 3; a++) /* frame -> world: p = F^T q */
                 p[a] = F ? F[0 * 3 + a] * q[0] + F[1 * 3 + a] * q[1] + F[2 * 3 + a] * q[2] : q[a];
-                norm += fabs(p[a]);
-            }
             if (k == 1) {
-                if (norm > m) m = norm;
+                m = fmax(m, rt_float_frame_norm1(ff, p));
                 continue;
             }
             for (int a = 0; a < 3; a++) {

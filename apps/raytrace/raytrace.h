@@ -92,6 +92,15 @@ typedef struct rt_light {
 /* What every cell and the output handler of one process share (the module's user
    pointer). Read-only while the world runs, except the output side (accum, done),
    which only the output handler writes, one call at a time. */
+/* Where Embree's float coordinates come from: x_embree = (x - origin) * scale, the same
+   for every cell of a job (rt_float_frame_of), so that a hit never depends on the layout.
+   Floats keep 24 bits: measured from an origin inside a scene far from (0, 0, 0), and
+   brought near unit size by a power of two, the coordinates lose the least of them. */
+typedef struct rt_float_frame {
+    double origin[3];
+    double scale;    /* a power of two (rt_embree_scale) */
+} rt_float_frame;
+
 typedef struct rt_shared {
     rt_view view;
     rt_light *lights;
@@ -102,6 +111,7 @@ typedef struct rt_shared {
     double bpad;     /* objects' bounds are widened by this before placement */
     double overlap;  /* a cell searches this far past its far wall (<= bpad / 2) */
     void *device;    /* RTCDevice, one per process, shared by every cell */
+    rt_float_frame ff; /* where Embree's float coordinates come from */
     struct rt_geo_cache *geo_cache; /* the built cells of this process, shared by the
                                        copies of a cell (geometry.h) */
     int sample;      /* primary pixels: every sample-th row and column only (the load
@@ -176,8 +186,9 @@ typedef struct rt_job rt_job;
 /* The scenes the ray tracer takes, refused by rt_job_create (VW_E_INVAL) beyond: the eye
    and the world box within RT_MAX_COORD of the origin on every axis, and a scene at least
    RT_MIN_SIZE across (a scene that is a single point is allowed: it shows nothing).
-   Embree sees the scene brought near unit size by a power of two (rt_embree_scale), so
-   its floats neither overflow nor vanish; the limits keep the shading's double products
+   Embree sees the scene in a float frame, measured from an origin inside it and brought
+   near unit size by a power of two (rt_float_frame, geometry.h), so its floats neither
+   overflow nor vanish; the limits keep the shading's double products
    of four lengths (a triangle's normal) from doing so, by a wide margin: tests/raytrace
    renders the same image, byte for byte, from the same scene scaled by 2^100 and 2^-190. */
 #define RT_MAX_COORD 1e36

@@ -284,6 +284,25 @@ foreach(k 100 -190)
     endif()
   endforeach()
 endforeach()
+# Far from the origin: the test scenes moved a billion units (far_mixed.nff, far_wall_hit.nff)
+# render the same PNG as where they were. Embree sees them measured from the world box's
+# centre (rt_float_frame); before, its floats kept no fraction there: background only.
+foreach(name mixed wall_hit)
+  foreach(where "" far_)
+    file(REMOVE ${WORK}/${where}${name}.png)
+    execute_process(COMMAND ${VWALLS} render ${CMAKE_CURRENT_LIST_DIR}/${where}${name}.nff
+                            -o ${WORK}/${where}${name}.png --quiet --cells 2x2x2 --size 48x48
+                    RESULT_VARIABLE rc ERROR_VARIABLE err)
+    if(NOT rc EQUAL 0)
+      message(FATAL_ERROR "${where}${name}.nff: exit ${rc} (${err})")
+    endif()
+  endforeach()
+  execute_process(COMMAND ${CMAKE_COMMAND} -E compare_files ${WORK}/${name}.png
+                          ${WORK}/far_${name}.png RESULT_VARIABLE same)
+  if(NOT same EQUAL 0)
+    message(FATAL_ERROR "far_${name}.nff: not the PNG of ${name}.nff")
+  endif()
+endforeach()
 # A pre-pass option without a pre-pass is said to do nothing (and renders); with one, not.
 foreach(case "--balance-iters;3;warn" "--prepass;2;warn" "--balance-load;segments;warn"
              "--prepass;2;--balance;tensor;quiet")

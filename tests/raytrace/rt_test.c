@@ -465,7 +465,7 @@ static int test_cone(void)
     o.g.cone.r1 = 0.3;
     void *dev = rt_device_new();
     rt_cell_geo g;
-    EXPECT(rt_cell_geo_build(dev, &o, 1, 1.0, &g) == VW_OK, "build");
+    EXPECT(rt_cell_geo_build(dev, &o, 1, &rt_float_frame_identity, &g) == VW_OK, "build");
     int hits = 0, n = 0;
     for (int i = 0; i < 200; i++) {
         double s = (i % 20 + 0.5) / 20.0, phi = (i / 20) * 0.6283 + 0.1;
@@ -556,7 +556,10 @@ static int test_scale(void)
     static const double scales[] = {1.0, 0x1p-30, 0x1p30};
     void *dev = rt_device_new();
     rt_cell_geo g[3];
-    for (int k = 0; k < 3; k++) EXPECT(rt_cell_geo_build(dev, o, 3, scales[k], &g[k]) == VW_OK, "build");
+    for (int k = 0; k < 3; k++) {
+        rt_float_frame ff = {{0, 0, 0}, scales[k]};
+        EXPECT(rt_cell_geo_build(dev, o, 3, &ff, &g[k]) == VW_OK, "build");
+    }
     uint64_t rng = 12345;
     int hits[3] = {0, 0, 0}, nrays = 3000;
     for (int i = 0; i < nrays; i++) {
@@ -633,7 +636,7 @@ static int test_watertight(void)
         }
     void *dev = rt_device_new();
     rt_cell_geo g;
-    EXPECT(rt_cell_geo_build(dev, tri, nt, 1.0, &g) == VW_OK, "build");
+    EXPECT(rt_cell_geo_build(dev, tri, nt, &rt_float_frame_identity, &g) == VW_OK, "build");
     /* The target points: on the mesh's inner edges (in float, as Embree holds the
        vertices), at their ends (the vertices) and at random places along them. */
     uint64_t seed = 99;

@@ -118,9 +118,11 @@ static void cone_bounds(const struct RTCBoundsFunctionArguments *args)
     const rt_object *o = &g->obj[g->cone_map[args->primID]];
     vw_box b;
     rt_object_bounds(o, 0, &b);
-    for (int a = 0; a < 3; a++) {
-        b.lo[a] = (b.lo[a] - g->ff.origin[a]) * g->ff.scale;
-        b.hi[a] = (b.hi[a] - g->ff.origin[a]) * g->ff.scale;
+    for (int a = 0; a < 3; a++) { /* into the float frame, widened by the subtraction's rounding */
+        const double *o0 = g->ff.origin;
+        double elo = 0x1p-51 * (fabs(b.lo[a]) + fabs(o0[a])), ehi = 0x1p-51 * (fabs(b.hi[a]) + fabs(o0[a]));
+        b.lo[a] = (b.lo[a] - o0[a] - elo) * g->ff.scale;
+        b.hi[a] = (b.hi[a] - o0[a] + ehi) * g->ff.scale;
     }
     /* Round outward so the float box contains the double one. */
     args->bounds_o->lower_x = nextafterf((float)b.lo[0], -INFINITY);

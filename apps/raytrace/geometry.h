@@ -68,6 +68,8 @@ rt_float_frame rt_float_frame_of(const double eye[3], const vw_box *world);
    doubles' own rounding (2^-53) is relative to: the margins, 1e-6 of it and more, then
    stay a thousand times above both. Without an origin it is |p|. */
 double rt_float_frame_norm1(const rt_float_frame *ff, const double p[3]);
+/* The frame with this origin and scale (a power of two). */
+rt_float_frame rt_float_frame_make(const double origin[3], double scale);
 /* The identity frame (origin 0, scale 1), for tests and tools that trace raw scenes. */
 extern const rt_float_frame rt_float_frame_identity;
 void *rt_device_new(void);

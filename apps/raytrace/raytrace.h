@@ -98,7 +98,9 @@ typedef struct rt_light {
    brought near unit size by a power of two, the coordinates lose the least of them. */
 typedef struct rt_float_frame {
     double origin[3];
-    double scale;    /* a power of two (rt_embree_scale) */
+    double scale;     /* a power of two (rt_embree_scale) */
+    double inv_scale; /* 1 / scale, exact */
+    int moved;        /* origin or scale not the identity's: the queries convert */
 } rt_float_frame;
 
 typedef struct rt_shared {

@@ -557,7 +557,8 @@ static int test_scale(void)
     void *dev = rt_device_new();
     rt_cell_geo g[3];
     for (int k = 0; k < 3; k++) {
-        rt_float_frame ff = {{0, 0, 0}, scales[k]};
+        static const double zero[3] = {0, 0, 0};
+        rt_float_frame ff = rt_float_frame_make(zero, scales[k]);
         EXPECT(rt_cell_geo_build(dev, o, 3, &ff, &g[k]) == VW_OK, "build");
     }
     uint64_t rng = 12345;

@@ -50,7 +50,6 @@ int rt_cell_geo_occluded(const rt_cell_geo *g, const double org[3], const double
 /* The unit outward normal of a cone's side at p (inward for RT_INSIDE cones). */
 void rt_cone_normal(const rt_object *o, const double p[3], double n[3]);
 
-/* One RTCDevice per process, shared by every cell (Embree's device is thread-safe). */
 /* The power of two Embree's coordinates are multiplied by, for a scene whose
    coordinates (and eye) lie at most `far` from the origin: 1 from 2^-10 to 2^20, where
    Embree's floats are at ease (so most scenes give Embree their own numbers), else the
@@ -72,6 +71,7 @@ double rt_float_frame_norm1(const rt_float_frame *ff, const double p[3]);
 rt_float_frame rt_float_frame_make(const double origin[3], double scale);
 /* The identity frame (origin 0, scale 1), for tests and tools that trace raw scenes. */
 extern const rt_float_frame rt_float_frame_identity;
+/* One RTCDevice per process, shared by every cell (Embree's device is thread-safe). */
 void *rt_device_new(void);
 void rt_device_free(void *device);
 

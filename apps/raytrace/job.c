@@ -285,9 +285,8 @@ static vw_status job_prepare(rt_job *j, const vw_scene *s, const rt_params *p, r
         m = fmax(m, rt_float_frame_norm1(&sh->ff, corner));
     }
     /* Every ray starts at the eye or inside the world box, all of it within `far` of the
-       origin on every axis: Embree sees it scaled near unit size by that (and would
-       assert on an origin beyond 1.8e18 unscaled); RT_MAX_COORD bounds the shading's
-       doubles. */
+       origin on every axis, which RT_MAX_COORD bounds for the shading's doubles (Embree
+       sees it in its float frame, sh->ff). */
     double far = 0;
     for (int a = 0; a < 3; a++)
         far = fmax(far, fmax(fabs(cam.from[a]), fmax(fabs(world.lo[a]), fabs(world.hi[a]))));

@@ -89,9 +89,6 @@ typedef struct rt_light {
     double pos[3], color[3];
 } rt_light;
 
-/* What every cell and the output handler of one process share (the module's user
-   pointer). Read-only while the world runs, except the output side (accum, done),
-   which only the output handler writes, one call at a time. */
 /* Where Embree's float coordinates come from: x_embree = (x - origin) * scale, the same
    for every cell of a job (rt_float_frame_of), so that a hit never depends on the layout.
    Floats keep 24 bits: measured from an origin inside a scene far from (0, 0, 0), and
@@ -103,6 +100,9 @@ typedef struct rt_float_frame {
     int moved;        /* origin or scale not the identity's: the queries convert */
 } rt_float_frame;
 
+/* What every cell and the output handler of one process share (the module's user
+   pointer). Read-only while the world runs, except the output side (accum, done),
+   which only the output handler writes, one call at a time. */
 typedef struct rt_shared {
     rt_view view;
     rt_light *lights;
@@ -190,9 +190,9 @@ typedef struct rt_job rt_job;
    RT_MIN_SIZE across (a scene that is a single point is allowed: it shows nothing).
    Embree sees the scene in a float frame, measured from an origin inside it and brought
    near unit size by a power of two (rt_float_frame, geometry.h), so its floats neither
-   overflow nor vanish; the limits keep the shading's double products
-   of four lengths (a triangle's normal) from doing so, by a wide margin: tests/raytrace
-   renders the same image, byte for byte, from the same scene scaled by 2^100 and 2^-190. */
+   overflow nor vanish; the limits keep the shading's double products of four lengths (a
+   triangle's normal) from doing so, by a wide margin: tests/raytrace renders the same
+   image, byte for byte, from the same scene scaled by 2^100 and 2^-190. */
 #define RT_MAX_COORD 1e36
 #define RT_MIN_SIZE 1e-60
 

@@ -539,6 +539,20 @@ static int test_scale(void)
         EXPECT(m == 0.5 && fars[i] * sc >= 1 && fars[i] * sc < 2,
                "far %g: scale %a is not the power of two that brings it into [1, 2)", fars[i], sc);
     }
+    /* The frame of a job: the identity near the origin, the box's centre far from it. */
+    const double eye[3] = {3, 3, 3}, far_eye[3] = {1e9 + 3, 3, 3};
+    const vw_box near_box = {{-2, -1, -1}, {2, 1, 1}}, far_box = {{1e9 - 2, -1, -1}, {1e9 + 2, 1, 1}};
+    rt_float_frame f0 = rt_float_frame_of(eye, &near_box), f1 = rt_float_frame_of(far_eye, &far_box);
+    EXPECT(!f0.moved && f0.scale == 1 && f0.origin[0] == 0, "near the origin: not the identity");
+    EXPECT(f1.moved && f1.scale == 1 && f1.origin[0] == 1e9 && f1.origin[1] == 0 &&
+               f1.inv_scale == 1,
+           "far from it: origin %g %g %g scale %g", f1.origin[0], f1.origin[1], f1.origin[2],
+           f1.scale);
+    /* The margins' magnitude: 6 from the frame's origin, but the doubles' rounding at 1e9
+       (1e-7 of the coordinates' sum) is larger there. */
+    EXPECT(rt_float_frame_norm1(&f0, eye) == 9 &&
+               rt_float_frame_norm1(&f1, far_eye) == 1e-7 * ((1e9 + 3) + 3 + 3),
+           "magnitudes %g and %g", rt_float_frame_norm1(&f0, eye), rt_float_frame_norm1(&f1, far_eye));
     rt_object o[3];
     memset(o, 0, sizeof o);
     o[0].kind = RT_SPHERE;

@@ -6,7 +6,8 @@
  *                         (the scene moved by OFFSET on every axis: float error)
  *   cone                  the cone/cylinder intersection against sampled points
  *   scale                 a sphere, a triangle and a cone give the same hits, bit for bit,
- *                         at every power-of-two scale Embree is handed (rt_embree_scale)
+ *                         at every power-of-two scale Embree is handed (rt_embree_scale);
+ *                         the float frame a job picks (rt_float_frame_of)
  *   watertight            rays aimed at a mesh's shared edges and vertices hit it
  *   concave SCENE         each polygon's triangle records cover it and nothing else
  *   view                  the eye rays span the angle an NFF 'v' block gives, all of

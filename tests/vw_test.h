@@ -12,6 +12,16 @@
 
 static int vw_test_checks;
 
+/* splitmix64: a well-mixed 64-bit function of z (z plus the golden ratio, then two
+   multiply-xorshift rounds), for tests that derive their data from a seed. */
+static inline uint64_t vw_test_mix(uint64_t z)
+{
+    z += 0x9e3779b97f4a7c15ull;
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+    return z ^ (z >> 31);
+}
+
 #define CHECK(cond)                                                                     \
     do {                                                                                \
         vw_test_checks++;                                                               \

@@ -120,7 +120,8 @@ static void cone_bounds(const struct RTCBoundsFunctionArguments *args)
     rt_object_bounds(o, 0, &b);
     for (int a = 0; a < 3; a++) { /* into the float frame, widened by the subtraction's rounding */
         const double *o0 = g->ff.origin;
-        double elo = 0x1p-51 * (fabs(b.lo[a]) + fabs(o0[a])), ehi = 0x1p-51 * (fabs(b.hi[a]) + fabs(o0[a]));
+        double elo = 0x1p-51 * (fabs(b.lo[a]) + fabs(o0[a]));
+        double ehi = 0x1p-51 * (fabs(b.hi[a]) + fabs(o0[a]));
         b.lo[a] = (b.lo[a] - o0[a] - elo) * g->ff.scale;
         b.hi[a] = (b.hi[a] - o0[a] + ehi) * g->ff.scale;
     }
@@ -377,7 +378,8 @@ rt_float_frame rt_float_frame_of(const double eye[3], const vw_box *world)
 
 double rt_float_frame_norm1(const rt_float_frame *ff, const double p[3])
 {
-    double rel = fabs(p[0] - ff->origin[0]) + fabs(p[1] - ff->origin[1]) + fabs(p[2] - ff->origin[2]);
+    const double *o = ff->origin;
+    double rel = fabs(p[0] - o[0]) + fabs(p[1] - o[1]) + fabs(p[2] - o[2]);
     return fmax(rel, 1e-7 * (fabs(p[0]) + fabs(p[1]) + fabs(p[2])));
 }
 

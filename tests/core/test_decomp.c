@@ -10,10 +10,9 @@
 static uint64_t rng = 12345;
 static double urand(void)
 {
-    uint64_t z = (rng += 0x9e3779b97f4a7c15ull);
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
-    return (double)((z ^ (z >> 31)) >> 11) * 0x1.0p-53;
+    uint64_t z = vw_test_mix(rng);
+    rng += 0x9e3779b97f4a7c15ull;
+    return (double)(z >> 11) * 0x1.0p-53;
 }
 
 static int inside(const vw_box *b, const double q[3])

@@ -33,25 +33,20 @@ typedef struct storm {
     long output_seen; /* touched only by the output handler (serialised) */
 } storm;
 
-static uint64_t mix(uint64_t z)
-{
-    z += 0x9e3779b97f4a7c15ull;
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
-    return z ^ (z >> 31);
-}
-
 static void fill(spark *s, uint64_t key, uint32_t hops)
 {
     s->key = key;
     s->hops = hops;
-    s->len = (uint32_t)(mix(key ^ 1) % sizeof s->payload);
-    for (uint32_t i = 0; i < s->len; i++) s->payload[i] = (unsigned char)mix(key + i);
+    s->len = (uint32_t)(vw_test_mix(key ^ 1) % sizeof s->payload);
+    for (uint32_t i = 0; i < s->len; i++) s->payload[i] = (unsigned char)vw_test_mix(key + i);
 }
 
-static int children(const spark *s) { return s->hops ? (int)(mix(s->key ^ 2) % 4) : 0; }
+static int children(const spark *s) { return s->hops ? (int)(vw_test_mix(s->key ^ 2) % 4) : 0; }
 
-static int dest_of(uint64_t key, int ncells) { return (int)(mix(key ^ 3) % (uint64_t)ncells); }
+static int dest_of(uint64_t key, int ncells)
+{
+    return (int)(vw_test_mix(key ^ 3) % (uint64_t)ncells);
+}
 
 /* The sequential reference: how many sparks a root creates in all, their key sum, and
    how many echoes (a spark with 3 children also greets all neighbours of its cell). */
@@ -68,7 +63,7 @@ static void expect(const vw_decomp *d, uint64_t key, uint32_t hops, int64_t *cou
         for (int f = 0; f < 6; f++) *echoes += vw_decomp_neighbours(d, cell, f, NULL, 0);
     }
     for (int c = 0; c < n; c++)
-        expect(d, mix(s.key + 100 + (uint64_t)c), hops - 1, count, sum, echoes);
+        expect(d, vw_test_mix(s.key + 100 + (uint64_t)c), hops - 1, count, sum, echoes);
 }
 
 typedef struct storm_cell {
@@ -95,7 +90,8 @@ static int step(vw_ctx *ctx, void *state)
     if (vw_ctx_replica(ctx) > 0) return 0; /* the roots are the master's */
     if (sc->roots_sent == st->roots_per_cell) return 0;
     spark s;
-    uint64_t key = mix(st->seed ^ ((uint64_t)vw_ctx_cell(ctx) << 20) ^ (uint64_t)sc->roots_sent);
+    uint64_t key =
+        vw_test_mix(st->seed ^ ((uint64_t)vw_ctx_cell(ctx) << 20) ^ (uint64_t)sc->roots_sent);
     fill(&s, key, 1 + (uint32_t)(key % 6));
     vw_send_cell(ctx, dest_of(key, st->ncells), MSG_SPARK, &s);
     sc->roots_sent++;
@@ -122,7 +118,7 @@ static void on_spark(vw_ctx *ctx, void *state, const void *msg)
     int cell = vw_ctx_cell(ctx), replica = vw_ctx_replica(ctx);
     for (int c = 0; c < n; c++) {
         spark k;
-        uint64_t key = mix(s->key + 100 + (uint64_t)c);
+        uint64_t key = vw_test_mix(s->key + 100 + (uint64_t)c);
         fill(&k, key, s->hops - 1);
         int dest = dest_of(key, st->ncells);
         /* Every other child is handed off inline when its cell is on this worker
@@ -189,7 +185,7 @@ int main(int argc, char **argv)
             int64_t want = 0, sum = 0, echoes = 0;
             for (int c = 0; c < ncells; c++)
                 for (int r = 0; r < st.roots_per_cell; r++) {
-                    uint64_t key = mix(st.seed ^ ((uint64_t)c << 20) ^ (uint64_t)r);
+                    uint64_t key = vw_test_mix(st.seed ^ ((uint64_t)c << 20) ^ (uint64_t)r);
                     expect(d, key, 1 + (uint32_t)(key % 6), &want, &sum, &echoes);
                 }
             vw_config cfg;

@@ -38,25 +38,23 @@ typedef struct storm {
     int fail_build_rank;  /* cell_build fails on this rank's cells (-1: none) */
 } storm;
 
-static uint64_t mix(uint64_t z)
-{
-    z += 0x9e3779b97f4a7c15ull;
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
-    return z ^ (z >> 31);
-}
-
 static void fill(token *t, uint64_t key, uint32_t hops)
 {
     t->key = key;
     t->hops = hops;
-    t->len = (uint32_t)(mix(key ^ 1) % sizeof t->payload);
-    for (uint32_t i = 0; i < t->len; i++) t->payload[i] = (unsigned char)mix(key + i);
+    t->len = (uint32_t)(vw_test_mix(key ^ 1) % sizeof t->payload);
+    for (uint32_t i = 0; i < t->len; i++) t->payload[i] = (unsigned char)vw_test_mix(key + i);
 }
 
-static int nchildren(const token *t) { return t->hops ? 1 + (int)(mix(t->key ^ 2) % 2) : 0; }
-static int dest_of(uint64_t key, int ncells) { return (int)(mix(key ^ 3) % (uint64_t)ncells); }
-static uint64_t child_key(const token *t, int c) { return mix(t->key + 100 + (uint64_t)c); }
+static int nchildren(const token *t)
+{
+    return t->hops ? 1 + (int)(vw_test_mix(t->key ^ 2) % 2) : 0;
+}
+static int dest_of(uint64_t key, int ncells)
+{
+    return (int)(vw_test_mix(key ^ 3) % (uint64_t)ncells);
+}
+static uint64_t child_key(const token *t, int c) { return vw_test_mix(t->key + 100 + (uint64_t)c); }
 static int64_t low(uint64_t k) { return (int64_t)(k & 0xffffffu); }
 
 /* The reference: deliveries per cell, key sum, output count and output key sum. */
@@ -74,7 +72,7 @@ static void expect(uint64_t key, uint32_t hops, int ncells, int64_t *per_cell, i
 
 static uint64_t root_key(const storm *st, int cell, int r)
 {
-    return mix(st->seed ^ ((uint64_t)cell << 24) ^ (uint64_t)r);
+    return vw_test_mix(st->seed ^ ((uint64_t)cell << 24) ^ (uint64_t)r);
 }
 
 typedef struct tcell {

@@ -148,7 +148,7 @@ static vw_status owners(rt_job *j)
     nparts = nparts > h ? h : nparts;
     owners_map map = {j, d, 0, {0, 0}, {0, 0}};
     vw_box world = vw_decomp_world(d);
-    map.outline = rt_view_outline(&j->sh.view, &world, vw_decomp_frame(d), map.lo, map.hi);
+    map.outline = rt_view_outline(&j->sh.view, &world, d, map.lo, map.hi);
     owners_part part[RT_MAX_PARTS];
     for (int i = 0; i < nparts; i++)
         part[i] = (owners_part){&map, (int)((int64_t)h * i / nparts),
@@ -604,7 +604,6 @@ static void draw_walls(const rt_job *j, uint8_t *out)
     int nc = vw_decomp_cell_count(d);
     /* Walls: the edges of every cell box, clipped to the half-space in front of the eye. */
     static const uint8_t white[3] = {255, 255, 255};
-    const double *F = vw_decomp_frame(d);
     double near = 1e-6;
     for (int c = 0; c < nc; c++) {
         vw_box b = vw_decomp_cell_box(d, c);
@@ -612,9 +611,7 @@ static void draw_walls(const rt_job *j, uint8_t *out)
         for (int i = 0; i < 8; i++) {
             double q[3] = {(i & 1) ? b.hi[0] : b.lo[0], (i & 2) ? b.hi[1] : b.lo[1],
                            (i & 4) ? b.hi[2] : b.lo[2]};
-            for (int a = 0; a < 3; a++)
-                P[i][a] = F ? F[0 * 3 + a] * q[0] + F[1 * 3 + a] * q[1] + F[2 * 3 + a] * q[2]
-                            : q[a];
+            vw_decomp_from_frame(d, q, P[i]);
         }
         for (int i = 0; i < 8; i++)
             for (int bit = 1; bit < 8; bit <<= 1) {

@@ -459,7 +459,7 @@ static vw_status primary_pixels(vw_ctx *ctx, rt_cell *c)
         return VW_OK;
     }
     double lo[2], hi[2];
-    int all_front = rt_view_outline(v, &b, vw_decomp_frame(d), lo, hi);
+    int all_front = rt_view_outline(v, &b, d, lo, hi);
     if (all_front) {
         /* Pixel px is centred at px + 0.5; one pixel of margin absorbs rounding. */
         x0 = (int)fmax(0, floor(lo[0]) - 1);
@@ -505,7 +505,6 @@ static void cell_reach(vw_ctx *ctx, rt_cell *c)
 {
     const vw_decomp *d = vw_ctx_decomp(ctx);
     vw_box w = vw_decomp_world(d), b = vw_ctx_cell_box(ctx);
-    const double *F = vw_decomp_frame(d);
     const rt_float_frame *ff = &c->sh->ff;
     double m = rt_float_frame_norm1(ff, c->sh->view.eye);
     vw_box cell = {{INFINITY, INFINITY, INFINITY}, {-INFINITY, -INFINITY, -INFINITY}};
@@ -516,8 +515,7 @@ static void cell_reach(vw_ctx *ctx, rt_cell *c)
             double q[3] = {(i & 1) ? x->hi[0] : x->lo[0], (i & 2) ? x->hi[1] : x->lo[1],
                            (i & 4) ? x->hi[2] : x->lo[2]};
             double p[3];
-            for (int a = 0; a < 3; a++) /* frame -> world: p = F^T q */
-                p[a] = F ? F[0 * 3 + a] * q[0] + F[1 * 3 + a] * q[1] + F[2 * 3 + a] * q[2] : q[a];
+            vw_decomp_from_frame(d, q, p);
             if (k == 1) {
                 m = fmax(m, rt_float_frame_norm1(ff, p));
                 continue;

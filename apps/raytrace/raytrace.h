@@ -67,9 +67,10 @@ void rt_view_ray(const rt_view *v, int px, int py, double dir[3]);
    returns 0 when p is not in front of the eye. */
 int rt_view_project(const rt_view *v, const double p[3], double *sx, double *sy);
 /* The screen rectangle [lo, hi] (pixel units, as rt_view_project) that holds the
-   outline of box b, given in the coordinates of frame F (row-major world -> frame, or
-   NULL); returns 0 when part of the box is not in front of the eye (no rectangle). */
-int rt_view_outline(const rt_view *v, const vw_box *b, const double *F, double lo[2], double hi[2]);
+   outline of box b, given in the frame coordinates of decomposition d; returns 0 when
+   part of the box is not in front of the eye (no rectangle). */
+int rt_view_outline(const rt_view *v, const vw_box *b, const vw_decomp *d, double lo[2],
+                    double hi[2]);
 
 /* ---- the module ------------------------------------------------------------------------ */
 

@@ -71,7 +71,8 @@ int rt_view_project(const rt_view *v, const double p[3], double *sx, double *sy)
     return 1;
 }
 
-int rt_view_outline(const rt_view *v, const vw_box *b, const double *F, double lo[2], double hi[2])
+int rt_view_outline(const rt_view *v, const vw_box *b, const vw_decomp *d, double lo[2],
+                    double hi[2])
 {
     lo[0] = lo[1] = INFINITY;
     hi[0] = hi[1] = -INFINITY;
@@ -79,8 +80,7 @@ int rt_view_outline(const rt_view *v, const vw_box *b, const double *F, double l
         double q[3] = {(i & 1) ? b->hi[0] : b->lo[0], (i & 2) ? b->hi[1] : b->lo[1],
                        (i & 4) ? b->hi[2] : b->lo[2]};
         double p[3], sx, sy;
-        for (int a = 0; a < 3; a++) /* frame -> world: p = F^T q */
-            p[a] = F ? F[0 * 3 + a] * q[0] + F[1 * 3 + a] * q[1] + F[2 * 3 + a] * q[2] : q[a];
+        vw_decomp_from_frame(d, q, p);
         if (!rt_view_project(v, p, &sx, &sy) || !isfinite(sx) || !isfinite(sy)) return 0;
         lo[0] = fmin(lo[0], sx);
         hi[0] = fmax(hi[0], sx);

@@ -82,6 +82,8 @@ VW_API const vw_kd_node *vw_decomp_nodes(const vw_decomp *d, int *nnodes);
 /* Row-major world->frame rotation; NULL when the frame is the identity. */
 VW_API const double *vw_decomp_frame(const vw_decomp *d);
 VW_API void vw_decomp_to_frame(const vw_decomp *d, const double p[3], double out[3]);
+/* The inverse: frame point q in world coordinates (F^T q, the frame being orthonormal). */
+VW_API void vw_decomp_from_frame(const vw_decomp *d, const double q[3], double out[3]);
 /* Bounds in frame coordinates of a world-coordinate box (conservative under rotation). */
 VW_API void vw_decomp_box_to_frame(const vw_decomp *d, const vw_box *b, vw_box *out);
 

@@ -122,11 +122,10 @@ vw_status vw_load_field_add_point(vw_load_field *f, const double p[3], double w)
 }
 
 /* k^3 points of weight load/k^3 at the centres of a k-sub-grid of cell c (frame box ->
-   world coordinates: p = F^T q). */
+   world coordinates: vw_decomp_from_frame). */
 static vw_status add_uniform(vw_load_field *f, const vw_decomp *d, int c, double load, int k)
 {
     vw_box b = vw_decomp_cell_box(d, c);
-    const double *F = vw_decomp_frame(d);
     double w = load / ((double)k * k * k);
     for (int i = 0; i < k; i++)
         for (int j = 0; j < k; j++)
@@ -135,8 +134,7 @@ static vw_status add_uniform(vw_load_field *f, const vw_decomp *d, int c, double
                 int ix[3] = {i, j, l};
                 for (int a = 0; a < 3; a++)
                     q[a] = b.lo[a] + (b.hi[a] - b.lo[a]) * ((double)ix[a] + 0.5) / k;
-                for (int a = 0; a < 3; a++)
-                    p[a] = F ? F[0 * 3 + a] * q[0] + F[1 * 3 + a] * q[1] + F[2 * 3 + a] * q[2] : q[a];
+                vw_decomp_from_frame(d, q, p);
                 vw_status st = vw_load_field_add_point(f, p, w);
                 if (st != VW_OK) return st;
             }

@@ -49,16 +49,14 @@ static vw_status tensor_in_frame(const vw_load_field *f, const double *F, const 
     return st;
 }
 
-/* The world box in world coordinates' corners, as points (frame -> world: p = F^T q). */
+/* The world box in world coordinates' corners, as points (vw_decomp_from_frame). */
 static void world_corners(const vw_decomp *cur, double P[8][3])
 {
     vw_box b = vw_decomp_world(cur);
-    const double *F = vw_decomp_frame(cur);
     for (int i = 0; i < 8; i++) {
         double q[3] = {(i & 1) ? b.hi[0] : b.lo[0], (i & 2) ? b.hi[1] : b.lo[1],
                        (i & 4) ? b.hi[2] : b.lo[2]};
-        for (int a = 0; a < 3; a++)
-            P[i][a] = F ? F[0 * 3 + a] * q[0] + F[1 * 3 + a] * q[1] + F[2 * 3 + a] * q[2] : q[a];
+        vw_decomp_from_frame(cur, q, P[i]);
     }
 }
 

@@ -306,6 +306,17 @@ void vw_decomp_layout_string(const vw_decomp *d, char *buf, size_t len)
         snprintf(buf, len, "%d", d->ncells);
 }
 
+void vw_decomp_from_frame(const vw_decomp *d, const double q[3], double out[3])
+{
+    if (!d->has_frame) {
+        out[0] = q[0], out[1] = q[1], out[2] = q[2];
+        return;
+    }
+    const double *F = d->frame;
+    double x = q[0], y = q[1], z = q[2];
+    for (int a = 0; a < 3; a++) out[a] = F[0 * 3 + a] * x + F[1 * 3 + a] * y + F[2 * 3 + a] * z;
+}
+
 void vw_decomp_to_frame(const vw_decomp *d, const double p[3], double out[3])
 {
     if (!d->has_frame) {

@@ -185,9 +185,12 @@ static void check_decomp(const vw_decomp *d)
     for (int i = 0; i < 2000; i++) {
         double q[3], p[3];
         for (int a = 0; a < 3; a++) q[a] = world.lo[a] + urand() * (world.hi[a] - world.lo[a]);
-        /* q is in frame coordinates; p = F^T q in world coordinates */
-        for (int a = 0; a < 3; a++)
-            p[a] = F ? F[a] * q[0] + F[3 + a] * q[1] + F[6 + a] * q[2] : q[a];
+        /* q is in frame coordinates; p = F^T q in world coordinates, as the library's
+           inverse of vw_decomp_to_frame gives it too */
+        frame_to_world(F, q, p);
+        double pp[3];
+        vw_decomp_from_frame(d, q, pp);
+        CHECK(memcmp(p, pp, sizeof p) == 0);
         double qq[3];
         vw_decomp_to_frame(d, p, qq);
         int holders = 0, holder = -1;

@@ -5,10 +5,12 @@
 #include "transport/mpi_internal.h"
 #include "vwalls/engine.h"
 
+#include <errno.h>
 #include <limits.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 #include <unistd.h>
 
 static int we_initialised; /* MPI_Init_thread was called by vw_engine_init / autoinit */
@@ -93,11 +95,22 @@ vw_status vw__mpi_autoinit(char *msg, size_t len)
     return st;
 }
 
+/* The pause before MPI_Abort: MPICH's launcher (Hydra) tears the job down as soon as it
+   hears of the abort, and under load its proxy had not yet relayed the line this process
+   had written to its stderr pipe in 3 runs of 50 (tests/mpi/wire.sh, the other core
+   busy). A tenth of a second lets the proxy read it first; an aborting job can afford it. */
+#define VW_ABORT_PAUSE_NS 100000000L
+
 void vw_engine_abort(int status, const char *msg)
 {
     if (msg) fprintf(stderr, "%s\n", msg);
     fflush(NULL);
-    if (mpi_up()) MPI_Abort(MPI_COMM_WORLD, status ? status : 1);
+    if (mpi_up()) {
+        struct timespec pause = {0, VW_ABORT_PAUSE_NS};
+        while (nanosleep(&pause, &pause) != 0 && errno == EINTR) {
+        }
+        MPI_Abort(MPI_COMM_WORLD, status ? status : 1);
+    }
     _exit(status ? status : 1);
 }
 

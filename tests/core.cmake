@@ -80,13 +80,15 @@ set_tests_properties(core_farm core_farm_stress PROPERTIES LABELS "core;threads"
 
 # Corner cases of the worker loop: a step() that sends and reports no work, the meter
 # after its list of noted units filled up, runs after one whose threads did not start,
-# hand-offs tried outside a run, a cell_build that fails (its state is not the runtime's).
+# hand-offs tried outside a run, a cell_build that fails (its state is not the runtime's),
+# a run that fails part-way (vw_ctx_fail, a packet that cannot be allocated).
 vw_core_test(test_runtime)
-target_link_options(test_runtime PRIVATE -Wl,--wrap=pthread_create)
-foreach(t step-send meter thread-fail build-enter build-fail)
+target_link_options(test_runtime PRIVATE -Wl,--wrap=pthread_create -Wl,--wrap=malloc)
+foreach(t step-send meter thread-fail build-enter build-fail run-fail)
   add_test(NAME core_runtime_${t} COMMAND test_runtime ${t})
   set_tests_properties(core_runtime_${t} PROPERTIES LABELS "core;threads" TIMEOUT 60)
 endforeach()
 add_test(NAME core_runtime_step-send_stress COMMAND test_runtime step-send)
-set_tests_properties(core_runtime_step-send_stress PROPERTIES LABELS "core;threads" TIMEOUT 60
-                     ENVIRONMENT "VW_STRESS=5")
+add_test(NAME core_runtime_run-fail_stress COMMAND test_runtime run-fail)
+set_tests_properties(core_runtime_step-send_stress core_runtime_run-fail_stress PROPERTIES
+                     LABELS "core;threads" TIMEOUT 60 ENVIRONMENT "VW_STRESS=5")

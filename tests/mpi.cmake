@@ -103,8 +103,9 @@ endif()
 # memory adding objects, an unknown object, a bad copy or mapping, cell_build failing on
 # that rank's cells at commit or in run's commit, named: "rank 1: building cell 2 failed"):
 # every rank fails that step with the failing rank's message and exits, none waits for
-# the others.
-foreach(step create add update replicas redecompose commit run)
+# the others. So does a run that a handler fails on one rank (vw_ctx_fail) while every
+# step() sends for ever: every rank drops its work from the next wave on.
+foreach(step create add update replicas redecompose commit run handler)
   vw_mpi_script_test(mpi_local_fail_${step} 3 local_fail.sh 60 ${step} 3 $<TARGET_FILE:test_mpi_storm>)
 endforeach()
 

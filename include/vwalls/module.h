@@ -154,6 +154,26 @@ VW_API void vw_ctx_restore(vw_ctx *ctx, int cell, int replica);
 /* Add n to the module's counter idx for this cell. */
 VW_API void vw_count(vw_ctx *ctx, int idx, int64_t n);
 
+/* A handler or step() that cannot go on (memory it needs and cannot get) fails the run:
+   from then on the run drops the module's work on every worker (and, under MPI, on
+   every process, from the next termination wave): handlers are no longer called for
+   the messages still arriving, step() is not called, output handlers get nothing. The
+   messages are still counted, so the run ends as always, and vw_world_run returns
+   status (VW_OK is taken as VW_E_STATE) on every process, vw_world_errmsg saying
+   "cell C: <the message, printf-style>" (under MPI "rank R: cell C: ..." of the lowest
+   failing rank). The first failure of a run is kept. What the dropped work would have
+   done is lost: a module whose state it leaves half-updated should not be run again.
+   The caller returns as usual after it. Only in handlers and step(): cell_build returns
+   its status, and a call from it or from load() stops the process as a misuse.
+   Output handlers, which get no context, keep their own failure flag for the caller
+   to check after the run. The runtime fails a run the same way when it cannot
+   allocate a packet for a message being sent. */
+VW_API void vw_ctx_fail(vw_ctx *ctx, vw_status status, const char *fmt, ...)
+#if defined(__GNUC__) || defined(__clang__)
+    __attribute__((format(printf, 3, 4)))
+#endif
+    ;
+
 #ifdef __cplusplus
 }
 #endif

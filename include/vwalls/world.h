@@ -97,7 +97,10 @@ VW_API vw_status vw_world_commit(vw_world *w);
    NULL for a kind of size 0. */
 VW_API vw_status vw_world_post(vw_world *w, int cell, int kind, const void *msg);
 /* Runs every cell to quiescence (no message in flight, every step() idle); commits
-   first when objects or the decomposition changed since the last commit. */
+   first when objects or the decomposition changed since the last commit. A run that a
+   callback failed (vw_ctx_fail, module.h) or that could not allocate a packet drops
+   the rest of the module's work, still ends, and returns that status (on every
+   process, agreed). */
 VW_API vw_status vw_world_run(vw_world *w);
 
 /* Replace the decomposition (and optionally the mapping) between runs: objects are

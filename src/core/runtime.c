@@ -20,6 +20,7 @@
 #include "core/world_internal.h"
 #include "vwalls/engine.h"
 
+#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -72,10 +73,7 @@ static size_t msg_stride(size_t size) { return sizeof(vw__msg_header) + ((size +
 vw__packet *vw__packet_new(int dest, int src, size_t cap)
 {
     vw__packet *p = malloc(sizeof *p + cap);
-    if (!p) {
-        fprintf(stderr, "vwalls: out of memory allocating a %zu-byte packet\n", cap);
-        abort();
-    }
+    if (!p) return NULL;
     p->next = NULL;
     p->dest = dest;
     p->src = src;
@@ -83,6 +81,32 @@ vw__packet *vw__packet_new(int dest, int src, size_t cap)
     p->used = 0;
     p->cap = cap;
     return p;
+}
+
+/* ---- a failed run -------------------------------------------------------------------- */
+
+static void run_fail_v(vw_world *w, vw_status st, const char *fmt, va_list ap)
+{
+    if (st == VW_OK) st = VW_E_STATE; /* a failure must not read as success */
+    int expected = 0;
+    if (atomic_compare_exchange_strong(&w->run_failed, &expected, 1)) {
+        vsnprintf(w->run_msg, sizeof w->run_msg, fmt, ap);
+        w->run_err = st;
+    }
+    atomic_store(&w->dropping, 1);
+}
+
+void vw__run_fail(vw_world *w, vw_status st, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    run_fail_v(w, st, fmt, ap);
+    va_end(ap);
+}
+
+static inline int dropping(const vw_world *w)
+{
+    return atomic_load_explicit(&w->dropping, memory_order_relaxed);
 }
 
 /* ---- delivery ---------------------------------------------------------------------- */
@@ -106,7 +130,7 @@ void vw__run_output(vw_world *w, const vw__packet *p)
 {
     pthread_mutex_lock(&w->output_mu);
     size_t off = 0;
-    for (uint32_t i = 0; i < p->nmsgs; i++) {
+    for (uint32_t i = 0; i < p->nmsgs && !dropping(w); i++) {
         const vw__msg_header *h = (const vw__msg_header *)(p->data + off);
         const vw_msg_kind *k = &w->m->kinds[h->kind];
         if (k->output) k->output(w->user, p->data + off + sizeof *h);
@@ -251,7 +275,14 @@ static void enqueue(vw_ctx *ctx, int slot, int dest, int cell, int kind, const v
     if (!p) {
         size_t cap = w->cfg.stress_split ? stride
                                          : (w->cfg.packet_bytes > stride ? w->cfg.packet_bytes : stride);
-        p = wk->out[slot] = vw__packet_new(dest, wk->global, cap);
+        p = vw__packet_new(dest, wk->global, cap);
+        if (!p) {
+            /* The message is lost, so the run is failed: nothing was counted for it. */
+            vw__run_fail(w, VW_E_NOMEM, "worker %d: out of memory for a %zu-byte packet",
+                         wk->global, cap);
+            return;
+        }
+        wk->out[slot] = p;
     }
     if (dest != VW__OUTPUT) {
         /* Traffic by destination class, for the mapping's locality figures. */
@@ -495,7 +526,11 @@ int vw_send_face(vw_ctx *ctx, int face, int kind, const void *msg)
     int n = vw_decomp_neighbours(ctx->w->decomp, ctx->cell, face, nb, 64);
     if (n > 64) {
         int *all = malloc(sizeof(int) * (size_t)n);
-        if (!all) abort();
+        if (!all) {
+            vw__run_fail(ctx->w, VW_E_NOMEM, "cell %d: out of memory listing %d neighbours",
+                         ctx->cell, n);
+            return 0;
+        }
         vw_decomp_neighbours(ctx->w->decomp, ctx->cell, face, all, n);
         for (int i = 0; i < n; i++) vw_send_cell(ctx, all[i], kind, msg);
         free(all);
@@ -518,6 +553,22 @@ void vw_send_output(vw_ctx *ctx, int kind, const void *msg)
     if (kind >= 0 && kind < m->nkinds && !m->kinds[kind].output)
         misuse(ctx, "sent message kind %d to the output, but the kind has no output handler", kind, 0);
     enqueue(ctx, ctx->w->gworkers, VW__OUTPUT, -1, kind, msg);
+}
+
+void vw_ctx_fail(vw_ctx *ctx, vw_status status, const char *fmt, ...)
+{
+    if (!ctx->in_run)
+        misuse(ctx, "called vw_ctx_fail from cell %d outside a run (cell_build returns its "
+                    "status instead)", ctx->cell, 0);
+    char what[360];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(what, sizeof what, fmt ? fmt : "failed", ap);
+    va_end(ap);
+    if (ctx->cell >= 0)
+        vw__run_fail(ctx->w, status, "cell %d: %s", ctx->cell, what);
+    else
+        vw__run_fail(ctx->w, status, "%s", what);
 }
 
 void vw_count(vw_ctx *ctx, int idx, int64_t n)
@@ -560,7 +611,8 @@ static void handle_packet(vw__worker *wk, vw_ctx *ctx, vw__packet *p)
         ctx->cell = ctx->home_cell = h->cell;
         ctx->rep = ctx->home_rep = rep;
         const vw_msg_kind *k = &w->m->kinds[h->kind];
-        if (k->handle) k->handle(ctx, state, p->data + off + sizeof *h);
+        /* A failed run drops the module's work; the message still counts as handled. */
+        if (k->handle && !dropping(w)) k->handle(ctx, state, p->data + off + sizeof *h);
         off += msg_stride(h->size);
     }
     meter_stop(wk);
@@ -574,7 +626,7 @@ static void handle_packet(vw__worker *wk, vw_ctx *ctx, vw__packet *p)
 static int run_step(vw__worker *wk, vw_ctx *ctx)
 {
     vw_world *w = wk->w;
-    if (!w->m->step || wk->ncells == 0) return 0;
+    if (!w->m->step || wk->ncells == 0 || dropping(w)) return 0;
     if (atomic_load(&wk->outstanding) > w->cfg.cap_bytes) return -1;
     for (int tries = 0; tries < wk->ncells; tries++) {
         int cell = wk->cells[wk->step_cursor], rep = wk->cell_rep[wk->step_cursor];
@@ -756,6 +808,10 @@ vw_status vw__runtime_run(vw_world *w)
         return st;
     }
     atomic_store(&w->finished, 0);
+    atomic_store(&w->dropping, 0);
+    atomic_store(&w->run_failed, 0);
+    w->run_err = VW_OK;
+    w->run_msg[0] = 0;
     /* With a transport, its thread (this one) is counted too: see the top of the file. */
     atomic_store(&w->active, w->nworkers + (w->transport ? 1 : 0));
     for (int i = 0; i < w->nworkers; i++) w->workers[i].busy = 1;
@@ -790,7 +846,16 @@ vw_status vw__runtime_run(vw_world *w)
     w->runs++;
     vw__stats_local(w);
     if (w->transport && st == VW_OK) st = w->transport->sync(w);
-    return st;
+    if (st != VW_OK) return st;
+    /* A failed run fails on every process, with the message of the lowest failing one
+       (vw_world_agree's "rank R: "); the pool's end ordered its workers' writes of
+       run_err and run_msg before these reads. */
+    st = atomic_load(&w->run_failed) ? w->run_err : VW_OK;
+    char msg[512];
+    snprintf(msg, sizeof msg, "%s", w->run_msg);
+    if (w->transport) st = vw_world_agree(w, st, msg, sizeof msg);
+    if (st != VW_OK) return vw__world_error(w, st, "%s", msg);
+    return VW_OK;
 }
 
 /* ---- building cells in parallel ----------------------------------------------------- */

@@ -582,6 +582,7 @@ vw_status vw_world_post(vw_world *w, int cell, int kind, const void *msg)
     size_t size = w->m->kinds[kind].size;
     size_t stride = sizeof(vw__msg_header) + ((size + 7) & ~(size_t)7);
     vw__packet *p = vw__packet_new(dest, -1, stride);
+    if (!p) return vw__world_error(w, VW_E_NOMEM, "out of memory posting a message");
     vw__msg_header *h = (vw__msg_header *)p->data;
     h->cell = cell;
     h->kind = (uint16_t)kind;

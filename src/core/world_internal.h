@@ -203,6 +203,17 @@ struct vw_world {
     vw__packet *posted;        /* messages posted before run */
     atomic_long active;
     atomic_int finished;
+    /* A failed run (vw_ctx_fail, or a packet the runtime could not allocate). From the
+       first failure on the run drops the module's work: handlers, steps and output
+       handlers are no longer called, while the messages are still counted, so the run
+       reaches quiescence as before. `dropping` says so to the workers (the MPI
+       transport also sets it when a wave reports another process dropping); the first
+       failure of this process writes run_err and run_msg (run_failed 0 -> 1), which
+       vw_world_run returns, agreed between processes. Reset at every run. */
+    atomic_int dropping;
+    atomic_int run_failed;
+    vw_status run_err;
+    char run_msg[400];
     /* The worker threads, started at the first build or run and kept until the world
        is freed (an iterative solver runs hundreds of times): under pool_mu, run_gen
        counts the jobs dispatched, pool_left the workers still in the current one. */
@@ -257,7 +268,11 @@ void vw__runtime_stop(vw_world *w);
    units that failed, whatever the thread timing, as a worker stops at its first
    failure and builds its units in that order. */
 vw_status vw__runtime_build(vw_world *w, int *cell, int *rep);
+/* A packet of cap bytes, or NULL when out of memory. */
 vw__packet *vw__packet_new(int dest, int src, size_t cap);
+/* Fails the current run of this process (the first call of the run sets its status and
+   message; see vw_world.dropping). Any thread, during a run. */
+void vw__run_fail(vw_world *w, vw_status st, const char *fmt, ...) __attribute__((format(printf, 3, 4)));
 void vw__deliver(vw_world *w, vw__worker *from, vw__packet *p);
 /* Queues a packet for a worker of this process, counting it in w->active; rng (may be
    NULL) drives the stress switch's reordering. */

@@ -234,6 +234,8 @@ static int receive(vw_world *w, mpi_tp *t)
         if (n < (int)WIRE_HDR) fatal(w, "received a truncated packet");
         size_t cap = (size_t)n - WIRE_HDR;
         vw__packet *p = vw__packet_new(0, 0, cap);
+        /* MPI has no way to take a message without the room for it: the job ends. */
+        if (!p) fatal(w, "out of memory receiving a packet");
         MPI_Recv((char *)p + WIRE_OFF, n, MPI_BYTE, s.MPI_SOURCE, TAG_DATA, t->comm, MPI_STATUS_IGNORE);
         p->next = NULL;
         p->cap = cap;
@@ -317,7 +319,9 @@ static vw_status tp_run(vw_world *w)
     if (!is_main && t->level < MPI_THREAD_SERIALIZED)
         fatal(w, "vw_world_run called from a thread other than the one that initialised MPI, "
                  "which MPI_THREAD_FUNNELED forbids");
-    int64_t in[3], out[3], prev[3] = {1, -1, -1};
+    /* A wave sums (not idle, S, R, dropping): the last tells every process that one of
+       them failed its run, so all stop the module's work (vw_world.dropping). */
+    int64_t in[4], out[4], prev[3] = {1, -1, -1};
     MPI_Request wave = MPI_REQUEST_NULL;
     double wave_start = 0;
     int rounds = 0;
@@ -335,6 +339,7 @@ static vw_status tp_run(vw_world *w)
             MPI_Test(&wave, &done, MPI_STATUS_IGNORE);
             if (done) {
                 t->waves++;
+                if (out[3] && !atomic_load(&w->dropping)) atomic_store(&w->dropping, 1);
                 if (out[0] == 0 && out[1] == out[2] && prev[0] == 0 && prev[1] == out[1] &&
                     prev[2] == out[2])
                     break;
@@ -352,7 +357,8 @@ static vw_status tp_run(vw_world *w)
                 in[0] = !idle;
                 in[1] = (int64_t)atomic_load(&t->sent);
                 in[2] = (int64_t)t->received;
-                MPI_Iallreduce(in, out, 3, MPI_INT64_T, MPI_SUM, t->comm, &wave);
+                in[3] = atomic_load(&w->dropping);
+                MPI_Iallreduce(in, out, 4, MPI_INT64_T, MPI_SUM, t->comm, &wave);
                 wave_start = now;
             }
         }

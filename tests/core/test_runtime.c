@@ -21,10 +21,16 @@
  *   thread-fail  a run whose worker threads cannot all be started fails, and the next
  *              runs, with threads, deliver everything: a chain of hops between two
  *              workers, started by a message posted before the failed run.
+ *   run-fail   a handler or a step() that calls vw_ctx_fail, and a packet the runtime
+ *              cannot allocate, fail the run: it ends (though the steps would send for
+ *              ever), returns the status with "cell C: message" (the first failure),
+ *              calls no handler, step or output handler after it, and the next run
+ *              delivers everything again.
  *
- * usage: test_runtime step-send|meter|thread-fail|build-enter|build-fail   (also honours VW_STRESS; step-send
- * also runs under mpirun)
- * (pthread_create is wrapped at link time, so thread-fail can make it fail.)
+ * usage: test_runtime step-send|meter|thread-fail|build-enter|build-fail|run-fail
+ * (also honours VW_STRESS; step-send also runs under mpirun)
+ * (pthread_create and malloc are wrapped at link time, so thread-fail and run-fail can
+ * make them fail.)
  */
 #include <errno.h>
 #include <pthread.h>
@@ -35,7 +41,7 @@
 #include "vw_test.h"
 #include "vwalls/vwalls.h"
 
-enum { MSG_PING, MSG_WORK, MSG_HOP, NKINDS };
+enum { MSG_PING, MSG_WORK, MSG_HOP, MSG_FLOOD, NKINDS };
 enum { CNT_PINGS, CNT_OUTPUTS, CNT_HOPS, NCOUNTERS };
 
 /* Failing pthread_create (EAGAIN, as when threads run out): 0 never, 1 always, 2 every
@@ -143,10 +149,72 @@ static void on_hop(vw_ctx *ctx, void *state, const void *msg)
     }
 }
 
+/* ---- run-fail ---- */
+
+enum { FLOOD_NONE, FLOOD_HANDLER, FLOOD_STEP, FLOOD_PACKET };
+static int flood;                      /* how run-fail's run fails */
+static int fail_after = 3000;          /* ... after this many hops or steps */
+static atomic_int flood_hops, flood_steps, fail_cell = -1, late_calls;
+static atomic_int failing;             /* set by the failing call, before vw_ctx_fail */
+static atomic_int fail_packets;        /* malloc fails for packets (> 30,000 bytes) */
+
+void *__real_malloc(size_t n);
+void *__wrap_malloc(size_t n);
+void *__wrap_malloc(size_t n)
+{
+    if (n > 30000 && atomic_load(&fail_packets)) return NULL;
+    return __real_malloc(n);
+}
+
+/* A hop that goes on for ever, to the next cell (not with FLOOD_STEP, whose steps run
+   only when the inboxes are empty); with FLOOD_HANDLER the fail_after-th one fails the
+   run. */
+static void on_flood_hop(vw_ctx *ctx, void *state, const void *msg)
+{
+    (void)state, (void)msg;
+    if (atomic_load(&failing)) atomic_fetch_add(&late_calls, 1);
+    int n = atomic_fetch_add(&flood_hops, 1) + 1;
+    if (flood == FLOOD_HANDLER && n == fail_after) {
+        atomic_store(&fail_cell, vw_ctx_cell(ctx));
+        vw_ctx_fail(ctx, VW_E_NOMEM, "no room for hop %d", n);
+        vw_ctx_fail(ctx, VW_E_INPUT, "a second failure, not reported");
+        atomic_store(&failing, 1);
+        return;
+    }
+    if (flood == FLOOD_STEP) return;
+    int ncells = vw_decomp_cell_count(vw_ctx_decomp(ctx));
+    vw_send_cell(ctx, (vw_ctx_cell(ctx) + 1) % ncells, MSG_FLOOD, NULL);
+    vw_send_output(ctx, MSG_FLOOD, NULL);
+}
+
+static void out_flood(void *user, const void *msg)
+{
+    (void)user, (void)msg;
+    if (atomic_load(&failing)) atomic_fetch_add(&late_calls, 1);
+}
+
+/* Every cell sends a hop at every call, for ever: only a failure ends such a run. */
+static int step_flood(vw_ctx *ctx, void *state)
+{
+    (void)state;
+    if (flood == FLOOD_NONE) return 0;
+    if (atomic_load(&failing)) atomic_fetch_add(&late_calls, 1);
+    int n = atomic_fetch_add(&flood_steps, 1) + 1;
+    if (flood == FLOOD_STEP && n == fail_after) {
+        atomic_store(&fail_cell, vw_ctx_cell(ctx));
+        vw_ctx_fail(ctx, VW_E_INPUT, "step %d found bad input", n);
+        atomic_store(&failing, 1);
+        return 1;
+    }
+    vw_send_cell(ctx, vw_ctx_cell(ctx), MSG_FLOOD, NULL);
+    return 1;
+}
+
 static const vw_msg_kind kinds[NKINDS] = {
     [MSG_PING] = {"ping", 0, on_ping, out_ping, 0},
     [MSG_WORK] = {"work", sizeof(work), on_work, NULL, 0},
     [MSG_HOP] = {"hop", sizeof(int32_t), on_hop, NULL, 0},
+    [MSG_FLOOD] = {"flood", 0, on_flood_hop, out_flood, 0},
 };
 static const char *const counters[NCOUNTERS] = {"pings", "outputs", "hops"};
 
@@ -409,6 +477,69 @@ static int test_build_fail(void)
     TEST_DONE();
 }
 
+/* The run of world w (of `workers` workers) fails: with `want` (status) and errmsg
+   "cell C: <text>" where C is the failing cell. Nothing of the module runs after the
+   failing call but the calls the other workers had begun: one each at most. */
+static void expect_failed_run(vw_world *w, int workers, vw_status want, const char *text,
+                              const char *how)
+{
+    atomic_store(&failing, 0);
+    atomic_store(&late_calls, 0);
+    atomic_store(&fail_cell, -1);
+    atomic_store(&flood_hops, 0);
+    atomic_store(&flood_steps, 0);
+    vw_status st = vw_world_run(w);
+    EXPECT(st == want, "%s: the run returned %d, not %d", how, (int)st, (int)want);
+    char msg[128];
+    if (atomic_load(&fail_cell) >= 0)
+        snprintf(msg, sizeof msg, "cell %d: %s", atomic_load(&fail_cell), text);
+    else
+        snprintf(msg, sizeof msg, "%s", text);
+    EXPECT(strstr(vw_world_errmsg(w), msg) != NULL, "%s: errmsg '%s', not '%s'", how,
+           vw_world_errmsg(w), msg);
+    EXPECT(atomic_load(&late_calls) <= workers - 1, "%s: %d calls of the module after the failure",
+           how, atomic_load(&late_calls));
+}
+
+static int test_run_fail(void)
+{
+    static const char *const hows[] = {"", "a handler fails", "a step fails",
+                                       "no memory for packets"};
+    static const char *const texts[] = {"", "no room for hop 3000", "step 3000 found bad input",
+                                        "out of memory for a 32768-byte packet"};
+    static const vw_status statuses[] = {VW_OK, VW_E_NOMEM, VW_E_INPUT, VW_E_NOMEM};
+    module.step = step_flood;
+    for (int workers = 1; workers <= 4; workers *= 2) {
+        for (int how = FLOOD_HANDLER; how <= FLOOD_PACKET; how++) {
+            shared sh = {0};
+            vw_decomp *d;
+            vw_world *w = make_world("2x2x2", workers, &sh, &d);
+            char what[64];
+            snprintf(what, sizeof what, "%d workers, %s", workers, hows[how]);
+            /* The runtime's own failure: no memory for a packet (the floods' packets are
+               32 KiB); the steps and hops would flood for ever without it. */
+            flood = how == FLOOD_PACKET ? FLOOD_HANDLER : how;
+            fail_after = how == FLOOD_PACKET ? 1 << 30 : 3000;
+            atomic_store(&fail_packets, how == FLOOD_PACKET);
+            expect_failed_run(w, workers, statuses[how], texts[how], what);
+            atomic_store(&fail_packets, 0);
+            /* The world runs again: a chain of hops arrives whole. */
+            flood = FLOOD_NONE;
+            int64_t before = vw_world_counter(w, CNT_HOPS);
+            int32_t hops = 300;
+            CHECK_EQ_INT(vw_world_post(w, 0, MSG_HOP, &hops), VW_OK);
+            EXPECT(vw_world_run(w) == VW_OK, "%s: the next run failed: %s", what, vw_world_errmsg(w));
+            EXPECT(vw_world_counter(w, CNT_HOPS) - before == hops + 1, "%s: the next run had %lld "
+                   "of %d hops", what, (long long)(vw_world_counter(w, CNT_HOPS) - before), hops + 1);
+            vw_world_free(w);
+            vw_decomp_free(d);
+        }
+    }
+    module.step = NULL;
+    flood = FLOOD_NONE;
+    TEST_DONE();
+}
+
 int main(int argc, char **argv)
 {
     const char *what = argc > 1 ? argv[1] : "";
@@ -417,6 +548,7 @@ int main(int argc, char **argv)
     if (!strcmp(what, "thread-fail")) return test_thread_fail();
     if (!strcmp(what, "build-enter")) return test_build_enter();
     if (!strcmp(what, "build-fail")) return test_build_fail();
-    fprintf(stderr, "usage: test_runtime step-send|meter|thread-fail|build-enter|build-fail\n");
+    if (!strcmp(what, "run-fail")) return test_run_fail();
+    fprintf(stderr, "usage: test_runtime step-send|meter|thread-fail|build-enter|build-fail|run-fail\n");
     return 2;
 }

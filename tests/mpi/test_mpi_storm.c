@@ -36,6 +36,9 @@ typedef struct storm {
     int64_t output_sum;   /* output handler only (serialised, rank 0) */
     int kill_rank;        /* -1: nobody dies */
     int fail_build_rank;  /* cell_build fails on this rank's cells (-1: none) */
+    int fail_run;         /* rank + 1 whose handler fails the run (0: none); then every
+                             cell's step() sends tokens for ever, so the run can only end
+                             if every rank drops its work */
 } storm;
 
 static void fill(token *t, uint64_t key, uint32_t hops)
@@ -97,7 +100,7 @@ static int step(vw_ctx *ctx, void *state)
 {
     tcell *tc = state;
     storm *st = vw_ctx_user(ctx);
-    if (tc->roots_sent == st->roots) return 0;
+    if (tc->roots_sent == st->roots && !st->fail_run) return 0;
     uint64_t key = root_key(st, vw_ctx_cell(ctx), tc->roots_sent++);
     token t;
     fill(&t, key, 2 + (uint32_t)(key % 5));
@@ -112,6 +115,8 @@ static void on_token(vw_ctx *ctx, void *state, const void *msg)
     storm *st = vw_ctx_user(ctx);
     static _Atomic long handled;
     if (st->kill_rank == vw_ctx_process(ctx) && ++handled == 500) raise(SIGKILL);
+    if (st->fail_run == vw_ctx_process(ctx) + 1 && ++handled == 2000)
+        vw_ctx_fail(ctx, VW_E_NOMEM, "no room for token %ld", (long)handled);
     token check;
     fill(&check, t->key, t->hops);
     if (check.len != t->len || memcmp(check.payload, t->payload, t->len) != 0 ||
@@ -298,7 +303,9 @@ static void test_mismatch(int workers)
    (out of memory, a cell that cannot be built): create (a bad worker speed), add (more
    objects than memory), update (an unknown object), replicas (a worker that does not
    exist), redecompose (a mapping to one), commit (cell_build fails on that rank's
-   cells), run (the same, in the commit that run makes). Every rank goes on like any
+   cells), run (the same, in the commit that run makes), handler (a message handler
+   calls vw_ctx_fail in the run, while every cell's step() sends for ever). Every rank
+   goes on like any
    program: it stops at the first step that fails, frees what it has and finishes MPI.
    The step must fail on every rank with the failing rank's message, or the others
    would wait for it in the next collective call (and it for them in MPI_Finalize). */
@@ -310,7 +317,8 @@ static int local_failure(const char *step, int bad, int workers)
     vw_decomp *d;
     CHECK_EQ_INT(vw_decomp_create_grid(&box, dims, &d), VW_OK);
     int nc = vw_decomp_cell_count(d), gw = vw_engine_size() * workers;
-    storm st = {1, nc, 1, 0, -1, here && (!strcmp(step, "commit") || !strcmp(step, "run")) ? bad : -1};
+    storm st = {1, nc, 1, 0, -1, here && (!strcmp(step, "commit") || !strcmp(step, "run")) ? bad : -1,
+                !strcmp(step, "handler") ? bad + 1 : 0};
     vw_module mod = storm_module;
     mod.object_size = 3 * sizeof(double);
     mod.object_bounds = point_bounds;
@@ -346,12 +354,12 @@ static int local_failure(const char *step, int bad, int workers)
         s = vw_world_redecompose(w, d, map);
         free(map);
     }
-    if (s == VW_OK && strcmp(step, "run") != 0) {
+    if (s == VW_OK && strcmp(step, "run") != 0 && strcmp(step, "handler") != 0) {
         failed = "commit";
         s = vw_world_commit(w);
     }
     if (s == VW_OK) {
-        failed = "run";
+        failed = !strcmp(step, "handler") ? "handler" : "run";
         s = vw_world_run(w);
     }
     char want[64];
@@ -362,8 +370,10 @@ static int local_failure(const char *step, int bad, int workers)
     while (cell < nc && (cell % gw) / workers != bad) cell++;
     if (!strcmp(step, "commit") || !strcmp(step, "run"))
         snprintf(want, sizeof want, "rank %d: building cell %d failed: ", bad, cell);
+    if (!strcmp(step, "handler")) snprintf(want, sizeof want, "rank %d: cell ", bad);
     const char *msg = vw_world_errmsg(w);
-    int ok = s != VW_OK && !strcmp(failed, step) && strstr(msg, want) == msg;
+    int ok = s != VW_OK && !strcmp(failed, step) && strstr(msg, want) == msg &&
+             (strcmp(step, "handler") != 0 || strstr(msg, ": no room for token 2000"));
     fprintf(stderr, "test_mpi_storm: process %d: %s failed (%s): %s%s\n", rank, failed,
             vw_status_message(s), msg, ok ? "" : " [UNEXPECTED]");
     vw_world_free(w);

@@ -101,19 +101,15 @@ typedef struct rad_cell {
     double absorbed[3], shot[3], won[3];
 } rad_cell;
 
-/* Out of memory while the solve runs: the runtime has no way to stop a run part-way,
-   so the process ends here (docs/known-issues.md). The build (cell_build) fails
-   cleanly instead, and most of a cell's memory is taken there. */
-static void out_of_memory(size_t n)
+/* Memory the solve takes while a run is under way (cell_build takes most of a cell's,
+   and fails the commit when it cannot). When it cannot be had the run fails
+   (vw_ctx_fail: every process drops its work, and vw_world_run returns VW_E_NOMEM), and
+   the caller drops what it was doing: NULL, and p is left as it was. */
+static void *grow(vw_ctx *ctx, void *p, size_t n)
 {
-    fprintf(stderr, "vwalls radiosity: out of memory (%zu bytes)\n", n);
-    abort();
-}
-
-static void *xrealloc(void *p, size_t n)
-{
-    void *q = realloc(p, n ? n : 1);
-    if (!q) out_of_memory(n);
+    const rad_solver *S = vw_ctx_user(ctx);
+    void *q = S->fault_solve_nomem ? NULL : realloc(p, n ? n : 1);
+    if (!q) vw_ctx_fail(ctx, VW_E_NOMEM, "out of memory (%zu bytes) in the solve", n);
     return q;
 }
 
@@ -254,7 +250,7 @@ static void fine_sum(const rad_cell *c, const rad_elem *x, double inc[3], double
    inherit the parent's radiosity and share its incident power by area. Either way the
    energy ledger is untouched: it counts power per patch and per cell, never per
    element. */
-static void split_elem(rad_cell *c, int e)
+static int split_elem(vw_ctx *ctx, rad_cell *c, int e)
 {
     rad_elem par = c->el[e];
     c->el[e].alive = 0;
@@ -262,7 +258,10 @@ static void split_elem(rad_cell *c, int e)
     for (int a = 0; a < 2; a++)
         for (int b = 0; b < 2; b++) {
             int k = add_elem(c, par.patch, par.level + 1, 2 * par.gi + a, 2 * par.gj + b, par.B);
-            if (k == -2) out_of_memory(sizeof *c->el * (size_t)c->capel);
+            if (k == -2) {
+                vw_ctx_fail(ctx, VW_E_NOMEM, "out of memory splitting an element of %d", c->nel);
+                return -1;
+            }
             if (k < 0) continue;
             rad_elem *x = &c->el[k];
             x->root = par.root;
@@ -277,6 +276,7 @@ static void split_elem(rad_cell *c, int e)
             for (int i = a0; i < a0 + w; i++)
                 for (int j = b0; j < b0 + w; j++) c->scl[(size_t)x->root * (size_t)c->nsub + (size_t)(i * c->side + j)] = k;
         }
+    return 0;
 }
 
 /* Luminance of the reflected radiosity of x's quadrant (qa, qb) from its fine cells;
@@ -314,7 +314,8 @@ static void subdivide(vw_ctx *ctx, rad_cell *c, double rel, double floor_, int m
     int n = c->nel, nsplit = 0;
     if (max_level > c->fine) max_level = c->fine;
     if (max_level <= 0) return;
-    char *mark = xrealloc(NULL, (size_t)(n ? n : 1));
+    char *mark = grow(ctx, NULL, (size_t)(n ? n : 1));
+    if (!mark) return;
     memset(mark, 0, (size_t)(n ? n : 1));
     static const int dx[4] = {1, -1, 0, 0}, dy[4] = {0, 0, 1, -1};
     for (int e = 0; e < n; e++) {
@@ -347,8 +348,11 @@ static void subdivide(vw_ctx *ctx, rad_cell *c, double rel, double floor_, int m
             if (diff > 2 * rel * 0.5 * (Ya + Yb) && diff > floor_) mark[e] = 1;
         }
     }
-    for (int e = 0; e < n; e++)
-        if (mark[e]) split_elem(c, e), nsplit++;
+    for (int e = 0; e < n; e++) {
+        if (!mark[e]) continue;
+        if (split_elem(ctx, c, e) < 0) break;
+        nsplit++;
+    }
     free(mark);
     vw_count(ctx, RAD_C_SPLITS, nsplit);
 }
@@ -563,20 +567,28 @@ static int ctz64(uint64_t x)
 #endif
 }
 
-/* The calling worker's scratch for rasterising a shot (see rad_worker_slot). */
+/* The calling worker's scratch for rasterising a shot (see rad_worker_slot), or NULL
+   when it cannot be had (the run has failed). */
 static rad_worker_slot *scratch(vw_ctx *ctx, const rad_cell *c)
 {
     rad_worker_slot *sl = &c->S->slots[vw_ctx_worker(ctx)];
     size_t np = (size_t)c->S->hc.npix;
     if (!sl->z.depth) {
-        sl->z.depth = xrealloc(NULL, sizeof(double) * np);
-        sl->z.owner = xrealloc(NULL, sizeof(int32_t) * np);
-        sl->z.stamp = calloc(np, sizeof(uint32_t));
-        sl->z.written = calloc((np + 63) / 64, sizeof(uint64_t));
-        if (!sl->z.stamp || !sl->z.written) abort();
+        /* All four or none: the z-buffer is known to be there by its depth. */
+        double *depth = grow(ctx, NULL, sizeof(double) * np);
+        int32_t *owner = depth ? grow(ctx, NULL, sizeof(int32_t) * np) : NULL;
+        uint32_t *stamp = owner ? grow(ctx, NULL, sizeof(uint32_t) * np) : NULL;
+        uint64_t *written = stamp ? grow(ctx, NULL, sizeof(uint64_t) * ((np + 63) / 64)) : NULL;
+        if (!written) {
+            free(depth), free(owner), free(stamp);
+            return NULL;
+        }
+        memset(stamp, 0, sizeof(uint32_t) * np);
+        memset(written, 0, sizeof(uint64_t) * ((np + 63) / 64));
+        sl->z.depth = depth, sl->z.owner = owner, sl->z.stamp = stamp, sl->z.written = written;
         sl->z.cur = 0;
     }
-    if (c->fine && !sl->pcls) sl->pcls = xrealloc(NULL, sizeof(int) * np);
+    if (c->fine && !sl->pcls && !(sl->pcls = grow(ctx, NULL, sizeof(int) * np))) return NULL;
     return sl;
 }
 
@@ -588,7 +600,7 @@ static void forward(vw_ctx *ctx, rad_cell *c, const rad_shot_hdr *h, const doubl
     vw_box own = vw_ctx_cell_box(ctx);
     unsigned char *buf = NULL;
     if (!full) {
-        buf = xrealloc(NULL, sizeof *h + S->bitmap_bytes);
+        if (!(buf = grow(ctx, NULL, sizeof *h + S->bitmap_bytes))) return;
         memcpy(buf, h, sizeof *h);
         memcpy(buf + sizeof *h, bits, S->bitmap_bytes);
     }
@@ -815,6 +827,7 @@ static void process_shot(vw_ctx *ctx, rad_cell *c, const rad_shot_hdr *h, uint8_
     const rad_hemicube *hc = &S->hc;
     if (!full && c->nel > 0) {
         rad_worker_slot *sl = scratch(ctx, c);
+        if (!sl) return;
         rad_zbuf *z = &sl->z;
         c->pcls = sl->pcls;
         if (++z->cur == 0) {
@@ -837,7 +850,7 @@ static void process_shot(vw_ctx *ctx, rad_cell *c, const rad_shot_hdr *h, uint8_
                 c->pvis[p] = rad_dot(r, h->n) > eps;
             }
         }
-        if (!c->hv) c->hv = xrealloc(NULL, sizeof(double) * 3 * RAD_MAXV);
+        if (!c->hv && !(c->hv = grow(ctx, NULL, sizeof(double) * 3 * RAD_MAXV))) return;
         int64_t nr = 0;
         /* With fine cells only the level-0 elements are rasterised, split or not: every
            shot then wins the same pixels as without subdivision (no receiver smaller
@@ -871,7 +884,9 @@ static void process_shot(vw_ctx *ctx, rad_cell *c, const rad_shot_hdr *h, uint8_
                 if (x->won == 0) {
                     if (ntouched == captouched) {
                         captouched = captouched ? 2 * captouched : 256;
-                        c->touched = xrealloc(c->touched, sizeof(int) * (size_t)captouched);
+                        int *t = grow(ctx, c->touched, sizeof(int) * (size_t)captouched);
+                        if (!t) return;
+                        c->touched = t;
                     }
                     c->touched[ntouched++] = z->owner[px];
                 }
@@ -941,17 +956,21 @@ static void on_shot_common(vw_ctx *ctx, rad_cell *c, const rad_shot_hdr *h, cons
         if (c->pend[k].id == h->id) break;
     if (k == c->npend) {
         if (c->npend == c->cappend) {
-            c->cappend = c->cappend ? 2 * c->cappend : 8;
-            c->pend = xrealloc(c->pend, sizeof *c->pend * (size_t)c->cappend);
-            for (int i = c->npend; i < c->cappend; i++) c->pend[i].bits = NULL;
+            int cap = c->cappend ? 2 * c->cappend : 8;
+            rad_pend *pend = grow(ctx, c->pend, sizeof *c->pend * (size_t)cap);
+            if (!pend) return;
+            c->pend = pend;
+            for (int i = c->cappend; i < cap; i++) c->pend[i].bits = NULL;
+            c->cappend = cap;
         }
+        if (!c->pend[c->npend].bits && !(c->pend[c->npend].bits = grow(ctx, NULL, S->bitmap_bytes)))
+            return;
         rad_pend *pd = &c->pend[c->npend++];
         pd->id = h->id;
         pd->h = *h;
         pd->received = 0;
         pd->full = 0;
         pd->ready = 0;
-        if (!pd->bits) pd->bits = xrealloc(NULL, S->bitmap_bytes);
         memset(pd->bits, 0, S->bitmap_bytes);
         /* How many bitmaps to wait for: the participating upstream neighbours. */
         const vw_decomp *d = vw_ctx_decomp(ctx);
@@ -1076,7 +1095,7 @@ static int step(vw_ctx *ctx, void *state)
     c->budget--;
     note_work(c);
     vw_count(ctx, RAD_C_SHOTS, 1);
-    if (!c->mask) c->mask = xrealloc(NULL, c->S->bitmap_bytes);
+    if (!c->mask && !(c->mask = grow(ctx, NULL, c->S->bitmap_bytes))) return 0;
     memset(c->mask, 0, c->S->bitmap_bytes);
     process_shot(ctx, c, &h, c->mask, 0);
     return 1;
@@ -1177,8 +1196,7 @@ static void on_restore_elem(vw_ctx *ctx, void *state, const void *msg)
         int a = -1;
         for (int l = r->level - 1; l >= 0 && a < 0; l--)
             a = ht_find(c, r->poly, r->piece, l, r->gi >> (r->level - l), r->gj >> (r->level - l), 1);
-        if (a < 0) return;
-        split_elem(c, a);
+        if (a < 0 || split_elem(ctx, c, a) < 0) return;
     }
 }
 
@@ -1199,24 +1217,38 @@ static void out_report(void *user, const void *msg)
     }
 }
 
+/* Appends a record of `size` bytes to the collect's array a (*n of *cap used) and
+   returns the array, moved or not. An output handler has no context to fail the run
+   with, so a record that finds no room is counted in S->collect_nomem, and
+   rad_solver_collect fails. */
+static void *collect_into(rad_solver *S, void *a, size_t *n, size_t *cap, size_t size,
+                          const void *msg)
+{
+    if (S->collect_nomem) return a;
+    if (*n == *cap) {
+        size_t ncap = *cap ? 2 * *cap : 1024;
+        void *q = S->fault_collect_nomem ? NULL : realloc(a, ncap * size);
+        if (!q) {
+            S->collect_nomem = ncap * size;
+            return a;
+        }
+        a = q;
+        *cap = ncap;
+    }
+    memcpy((unsigned char *)a + (*n)++ * size, msg, size);
+    return a;
+}
+
 static void out_patch(void *user, const void *msg)
 {
     rad_solver *S = user;
-    if (S->npatches == S->cappatches) {
-        S->cappatches = S->cappatches ? 2 * S->cappatches : 1024;
-        S->patches = xrealloc(S->patches, sizeof *S->patches * S->cappatches);
-    }
-    memcpy(&S->patches[S->npatches++], msg, sizeof *S->patches);
+    S->patches = collect_into(S, S->patches, &S->npatches, &S->cappatches, sizeof *S->patches, msg);
 }
 
 static void out_elem(void *user, const void *msg)
 {
     rad_solver *S = user;
-    if (S->nelems == S->capelems) {
-        S->capelems = S->capelems ? 2 * S->capelems : 1024;
-        S->elems = xrealloc(S->elems, sizeof *S->elems * S->capelems);
-    }
-    memcpy(&S->elems[S->nelems++], msg, sizeof *S->elems);
+    S->elems = collect_into(S, S->elems, &S->nelems, &S->capelems, sizeof *S->elems, msg);
 }
 
 void rad_module_setup(rad_solver *s)

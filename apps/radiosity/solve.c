@@ -488,6 +488,8 @@ vw_status rad_solver_create(const rad_mesh *m, const vw_decomp *d, const rad_opt
         s->nslots = s->slots ? gw : 0;
         if (s->slots) memset(s->slots, 0, gw * sizeof *s->slots);
         s->stepwork = calloc((size_t)vw_decomp_cell_count(d), 1);
+        s->fault_solve_nomem = vw_test_fault("solve-nomem");
+        s->fault_collect_nomem = vw_test_fault("collect-nomem");
         if (local == VW_OK && (!s->slots || !s->stepwork)) local = VW_E_NOMEM;
         if (local != VW_OK)
             snprintf(err, errlen, "cannot set up the radiosity world: %s", vw_status_message(local));
@@ -635,11 +637,23 @@ static int cmp_patch(const void *a, const void *b)
 vw_status rad_solver_collect(rad_solver *s, char *err, size_t errlen)
 {
     s->nelems = s->npatches = 0;
+    s->collect_nomem = 0;
     rad_collect_msg m = {0, 0};
     int ncells = vw_decomp_cell_count(s->d);
     for (int c = 0; c < ncells; c++) vw_world_post(s->w, c, RAD_K_COLLECT, &m);
     vw_status st = run_world(s, err, errlen);
     if (st != VW_OK) return st;
+    /* The output handlers' failure (rank 0's), agreed: every process joins the next
+       collective step or none does. */
+    char msg[160] = "";
+    if (s->collect_nomem)
+        snprintf(msg, sizeof msg, "out of memory (%zu bytes) collecting the solution",
+                 s->collect_nomem);
+    st = vw_world_agree(s->w, s->collect_nomem ? VW_E_NOMEM : VW_OK, msg, sizeof msg);
+    if (st != VW_OK) {
+        snprintf(err, errlen, "radiosity run failed: %s", msg);
+        return st;
+    }
     if (vw_world_is_output(s->w)) {
         qsort(s->elems, s->nelems, sizeof *s->elems, cmp_elem);
         qsort(s->patches, s->npatches, sizeof *s->patches, cmp_patch);

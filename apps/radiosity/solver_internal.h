@@ -97,6 +97,12 @@ struct rad_solver {
     size_t nelems, capelems;
     rad_patch_result *patches;
     size_t npatches, cappatches;
+    /* The bytes a collect's output handlers could not get (0: none): they have no
+       context to fail the run with, so rad_solver_collect fails it after. */
+    size_t collect_nomem;
+    /* Test switches (VW_FAULT): every allocation of the solve fails (solve-nomem), or
+       the collect's (collect-nomem). */
+    int fault_solve_nomem, fault_collect_nomem;
     rad_round_fn on_round;
     void *on_round_user;
 };

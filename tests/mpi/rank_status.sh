@@ -19,7 +19,9 @@
 #     (job-accum-nomem); on rank 1 alone for the mapping (map-nomem, rt_job_map), the
 #     farming (farm-nomem, rt_job_farm), animate's records (anim-nomem, rt_anim_create),
 #     the radiosity solver before its world exists (solver-nomem) and after it
-#     (solver-slots-nomem, rad_solver_create).
+#     (solver-slots-nomem, rad_solver_create); during its solve, in a handler on rank 1
+#     (solve-nomem: vw_ctx_fail fails the run on every rank) and in the output handlers
+#     collecting the solution on rank 0 (collect-nomem).
 # And memory that rank 1 alone lacks between the collective steps of a balance or of a
 # frame's edits (which hung the job: the others waited in the next step): render
 # --balance tensor (rt_job_balance: its loads balance-nomem, a rebuild of the cells
@@ -150,6 +152,12 @@ for f in solver solver-slots; do
         "^vwalls radiosity: rank 1: cannot set up $what: out of memory" \
         "[ $rank = 1 ] && export VW_FAULT=$f-nomem; \"$vwalls\" radiosity \"$dir/cornell.nff\" -o \"$dir/l.ply\" --cells 2x2x2 --workers 1 --max-shots 4 --quiet"
 done
+must_agree "radiosity, no memory in a handler of the solve on rank 1" 1 \
+    "^vwalls radiosity: radiosity run failed: rank 1: cell [0-9]*: out of memory ([0-9]* bytes) in the solve" \
+    "[ $rank = 1 ] && export VW_FAULT=solve-nomem; \"$vwalls\" radiosity \"$dir/cornell.nff\" -o \"$dir/l.ply\" --cells 2x2x2 --workers 1 --max-shots 40 --quiet"
+must_agree "radiosity, no memory for the collected solution (rank 0 alone collects it)" 1 \
+    "^vwalls radiosity: radiosity run failed: rank 0: out of memory ([0-9]* bytes) collecting the solution" \
+    "VW_FAULT=collect-nomem \"$vwalls\" radiosity \"$dir/cornell.nff\" -o \"$dir/l.ply\" --cells 2x2x2 --workers 1 --max-shots 40 --quiet"
 [ ! -e "$dir/l.ply" ] || { echo "FAIL: radiosity, no memory: output written"; fail=1; }
 
 # Balancing and editing, rank 1 short of memory between collective steps.

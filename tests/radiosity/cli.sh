@@ -120,6 +120,21 @@ VW_FAULT=ledger "$V" radiosity "$T/cornell.nff" -o "$T/l.ply" --csv "$T/l.csv" -
 grep -q "energy ledger off by inf (relative): no output written" "$T/err" || fail "ledger off: message: $(cat "$T/err")"
 for f in l.ply l.csv l.png l.json l.trace l.ck; do [ ! -e "$T/$f" ] || fail "ledger off: $f written"; done
 ls "$T" | grep -q "tmp\." && fail "ledger off: temporary file left behind"
+# Memory that runs out during the solve (the test switch VW_FAULT: solve-nomem fails every
+# allocation of the solve's handlers and steps, collect-nomem those of the collected
+# solution): status 1, the reason, no output. It used to end the process with SIGABRT.
+for f in solve collect; do
+  [ $f = solve ] && want="cell [0-9]*: out of memory ([0-9]* bytes) in the solve" ||
+    want="out of memory ([0-9]* bytes) collecting the solution"
+  for sub in "" "--subdivide 0.5"; do
+    VW_FAULT=$f-nomem "$V" radiosity "$T/cornell.nff" -o "$T/m.ply" --csv "$T/m.csv" --image "$T/m.png" \
+      --stats "$T/m.json" --size 16x16 --max-shots 40 --cells 2x2x2 --workers 2 $sub --quiet 2>"$T/err"; rc=$?
+    [ $rc -eq 1 ] || fail "$f-nomem $sub: exit $rc"
+    grep -q "^vwalls radiosity: radiosity run failed: $want\$" "$T/err" || fail "$f-nomem $sub: message: $(cat "$T/err")"
+    for x in m.ply m.csv m.png m.json; do [ ! -e "$T/$x" ] || fail "$f-nomem $sub: $x written"; done
+  done
+done
+ls "$T" | grep -q "tmp\." && fail "no memory: temporary file left behind"
 # Looking straight down (+y up would be parallel to the view): +z is up instead.
 "$V" radiosity "$T/cornell.nff" --image "$T/v.png" --view 278,540,280,278,0,280,100 \
   --size 16x16 --max-shots 4 --quiet 2>"$T/err" || fail "vertical --view: $(cat "$T/err")"

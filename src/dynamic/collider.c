@@ -170,9 +170,10 @@ static void handle_contact(vw_ctx *ctx, void *state, const void *msg)
     if (c->ncontacts == c->capcontacts) {
         size_t cap = c->capcontacts ? 2 * c->capcontacts : 64;
         vw_contact *n = realloc(c->contacts, cap * sizeof *n);
-        if (!n) { /* a lost contact would accept a colliding move: fail loudly */
+        if (!n) { /* a lost contact would accept a colliding move: the query fails */
             pthread_mutex_unlock(&c->mu);
-            abort();
+            vw_ctx_fail(ctx, VW_E_NOMEM, "out of memory for %zu contacts", cap);
+            return;
         }
         c->contacts = n;
         c->capcontacts = cap;

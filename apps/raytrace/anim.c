@@ -186,9 +186,20 @@ vw_status rt_anim_apply(rt_anim *a, const vw_edit *edits, size_t n, int check, i
     size_t nchanged = 0;
     if (errlen) err[0] = 0;
     vw_status st = vw_dynscene_apply(a->ds, edits, n, check, sweep, results, &changed, &nchanged);
-    if (st != VW_OK) snprintf(err, errlen, "applying edits: %s", vw_status_message(st));
+    if (st != VW_OK) {
+        /* Failed on every process alike (the dynscene agrees): "rank R: what" becomes
+           "rank R: applying edits: what", the form of the agreement below, which would
+           name this process instead. */
+        const char *m = vw_dynscene_errmsg(a->ds), *colon = strstr(m, ": ");
+        if (!strncmp(m, "rank ", 5) && colon)
+            snprintf(err, errlen, "%.*s: applying edits: %s", (int)(colon - m), m, colon + 2);
+        else
+            snprintf(err, errlen, "applying edits: %s", m);
+        rs->apply_s += now() - t0;
+        return st;
+    }
     double t1 = now();
-    for (size_t i = 0; st == VW_OK && i < n; i++) {
+    for (size_t i = 0; i < n; i++) {
         if (results[i].outcome == VW_OUT_ACCEPTED) rs->accepted++;
         else if (results[i].outcome == VW_OUT_COLLISION) rs->collisions++;
         else if (results[i].outcome == VW_OUT_SWEEP) rs->sweeps++;
@@ -281,6 +292,8 @@ vw_status rt_anim_render(rt_anim *a, rt_anim_stats *rs, char *err, size_t errlen
         vw_decomp *copy = NULL;
         st = cw ? vw_decomp_clone(d, &copy) : VW_E_NOMEM;
         for (int c = 0; st == VW_OK && c < nc; c++) cw[c] = vw_world_cell_worker(w, c);
+        /* The copies are this process's own; the redecomposition is collective. */
+        st = vw_world_agree(w, st, NULL, 0);
         if (st == VW_OK) st = vw_world_redecompose(w, copy, cw);
         vw_decomp_free(copy);
         free(cw);

@@ -199,7 +199,12 @@ typedef struct vw_result {
    current check/sweep switches; one distributed query decides them all. results[i]
    tells the outcome of edits[i]. Accepted edits change the scene and the collider.
    *changed (malloc'ed) lists the ids whose geometry changed, ascending, once each.
-   An edit naming an object twice in one batch is allowed (decided in order). */
+   An edit naming an object twice in one batch is allowed (decided in order).
+   Collective under MPI: memory one process lacks fails the call on every process
+   (agreed before each collective step), vw_dynscene_errmsg saying why ("rank R: ...");
+   the edits accepted before the failing batch stay. */
+/* Why the last vw_dynscene_apply failed ("" when it did not). */
+VW_API const char *vw_dynscene_errmsg(const vw_dynscene *ds);
 VW_API vw_status vw_dynscene_apply(vw_dynscene *ds, const vw_edit *edits, size_t n, int check,
                                    int sweep, vw_result *results, int **changed,
                                    size_t *nchanged);

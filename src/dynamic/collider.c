@@ -217,6 +217,16 @@ static vw_status find_mailboxes(vw_collider *c)
     return VW_OK;
 }
 
+/* find_mailboxes, agreed before the caller's next collective step: its allocation is
+   this process's own, while "a process without cells" (VW_E_INVAL) is the same answer on
+   every process (the mapping is). */
+static vw_status mailboxes(vw_collider *c)
+{
+    vw_status st = find_mailboxes(c);
+    vw_status all = vw_world_agree(c->world, st == VW_E_INVAL ? VW_OK : st, NULL, 0);
+    return all != VW_OK ? all : st;
+}
+
 /* More processes than cells (mpirun -np 2 with one cell): a process without a cell has
    no mailbox, and could not learn the contacts. The collider needs no particular walls,
    only the placement rule, so it then divides its own copy of the decomposition: the
@@ -273,8 +283,11 @@ static vw_status give_every_process_a_cell(vw_collider *c, const vw_decomp *d)
             cur = nd;
         }
     }
+    /* The division was computed on each process alone; the redecomposition is
+       collective. */
+    st = vw_world_agree(c->world, st, NULL, 0);
     if (st == VW_OK) st = vw_world_redecompose(c->world, cur, cw);
-    if (st == VW_OK) st = find_mailboxes(c);
+    if (st == VW_OK) st = mailboxes(c);
     vw_decomp_free(cur);
     free(nodes), free(cw), free(hosts);
     return st;
@@ -294,7 +307,7 @@ vw_status vw_collider_create(const vw_decomp *d, const vw_config *cfg, double to
     c->tol = tol > 0 ? tol : 0;
     pthread_mutex_init(&c->mu, NULL);
     vw_status st = vw_world_create(&collider_module, c, d, cfg, &c->world);
-    if (st == VW_OK && find_mailboxes(c) != VW_OK) st = give_every_process_a_cell(c, d);
+    if (st == VW_OK && (st = mailboxes(c)) == VW_E_INVAL) st = give_every_process_a_cell(c, d);
     if (st != VW_OK) {
         vw_collider_free(c);
         return st;
@@ -329,7 +342,7 @@ vw_status vw_collider_redecompose(vw_collider *c, const vw_decomp *d, const int 
 {
     if (!c || !d) return VW_E_INVAL;
     vw_status st = vw_world_redecompose(c->world, d, cell_worker);
-    if (st == VW_OK && find_mailboxes(c) != VW_OK) st = give_every_process_a_cell(c, d);
+    if (st == VW_OK && (st = mailboxes(c)) == VW_E_INVAL) st = give_every_process_a_cell(c, d);
     return st;
 }
 
@@ -352,8 +365,7 @@ vw_status vw_collider_query(vw_collider *c, const vw_probe *probes, size_t n, vw
     const vw_decomp *d = vw_world_decomp(c->world);
     int nc = vw_decomp_cell_count(d);
     int *cells = malloc(sizeof(int) * (size_t)nc);
-    if (!cells) return VW_E_NOMEM;
-    vw_status st = VW_OK;
+    vw_status st = cells ? VW_OK : VW_E_NOMEM;
     for (size_t i = 0; i < n && st == VW_OK; i++) {
         const vw_probe *p = &probes[i];
         vw_box b;
@@ -375,6 +387,8 @@ vw_status vw_collider_query(vw_collider *c, const vw_probe *probes, size_t n, vw
     }
     free(cells);
     c->ncontacts = 0;
+    /* The probes were posted on each process alone; the run is collective. */
+    st = vw_world_agree(c->world, st, NULL, 0);
     if (st == VW_OK) st = vw_world_run(c->world);
     if (st != VW_OK) return st;
     if (c->ncontacts) qsort(c->contacts, c->ncontacts, sizeof *c->contacts, contact_cmp);

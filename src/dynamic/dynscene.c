@@ -10,6 +10,7 @@
  * touched starts a new query (its start depends on the earlier outcome).
  */
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include "dynamic/dynamic_internal.h"
@@ -42,6 +43,10 @@ struct vw_dynscene {
     vw_box world;
     double tol;
     int brute;
+    /* Test switches (VW_FAULT), read at create: a batch's bookkeeping (batch-nomem) or
+       the room for its accepted edits (commit-nomem) cannot be had. */
+    int fault_batch, fault_commit;
+    char errmsg[256]; /* why the last vw_dynscene_apply failed */
 };
 
 /* ---- geometry ----------------------------------------------------------------------- */
@@ -294,6 +299,8 @@ vw_status vw_dynscene_create(vw_scene *s, const vw_dynscene_params *p, vw_dynsce
     ds->capvertices = s->nvertices;
     ds->world = vw_decomp_world(p->decomp);
     ds->brute = p->brute_force;
+    ds->fault_batch = vw_test_fault("dynscene-batch-nomem");
+    ds->fault_commit = vw_test_fault("dynscene-commit-nomem");
     double diag = 0;
     for (int a = 0; a < 3; a++) diag += pow(ds->world.hi[a] - ds->world.lo[a], 2);
     ds->tol = p->tol > 0 ? p->tol : 1e-9 * sqrt(diag);
@@ -435,10 +442,10 @@ static int prepare(vw_dynscene *ds, const vw_edit *e, int next_id, vw_result *r,
             return 0;
         }
         pd->id = e->id;
-        if (geom_get(ds, e->id, &pd->g) != VW_OK) {
-            invalid(r, "out of memory editing object %d", e->id);
-            return 0;
-        }
+        /* Memory is this process's own: the batch fails (on every process, agreed),
+           where an edit taken as invalid here alone would leave the processes with
+           different scenes. */
+        if (geom_get(ds, e->id, &pd->g) != VW_OK) return -1;
         if (e->op == VW_EDIT_REMOVE) {
             pd->remove = 1;
             return 1;
@@ -599,11 +606,67 @@ static vw_status commit_edit(vw_dynscene *ds, pending *pd, const vw_shape *end)
     return st;
 }
 
+/* This process's own part of a step (its bookkeeping, allocated alone) ends in
+   agreement before the next collective call: every process gets the lowest failing
+   rank's status, so all stop, or none waits for one that stopped (vwalls/world.h). */
+static vw_status agree(vw_dynscene *ds, vw_status st, const char *what)
+{
+    char msg[sizeof ds->errmsg];
+    snprintf(msg, sizeof msg, "%s: %s", what, vw_status_message(st));
+    st = vw_world_agree(vw_collider_world(ds->col), st, msg, sizeof msg);
+    if (st != VW_OK && !ds->errmsg[0]) snprintf(ds->errmsg, sizeof ds->errmsg, "%s", msg);
+    return st;
+}
+
+const char *vw_dynscene_errmsg(const vw_dynscene *ds) { return ds ? ds->errmsg : "no scene"; }
+
+/* Room for the accepted edits of a batch, made before the first of them is committed:
+   commit_edit then allocates nothing on this process alone between the collider's
+   collective updates. */
+static vw_status reserve_commits(vw_dynscene *ds, const pending *pd, const vw_result *res,
+                                 const unsigned char *ok, size_t n)
+{
+    if (ds->fault_commit) return VW_E_NOMEM;
+    size_t adds = 0, vertices = 0;
+    int maxid = ds->nids;
+    for (size_t i = 0; i < n; i++) {
+        if (!ok[i] || res[i].outcome != VW_OUT_ACCEPTED) continue;
+        if (pd[i].add) {
+            adds++;
+            if (pd[i].id + 1 > maxid) maxid = pd[i].id + 1;
+            continue;
+        }
+        const objinfo *o = &ds->obj[pd[i].id];
+        if (!pd[i].remove && o->kind == VW_PRIM_POLYGON && !o->own_vertices)
+            vertices += (size_t)ds->s->polygons[o->index].count;
+    }
+    vw_scene *s = ds->s;
+    if (s->nspheres + adds > ds->capspheres) {
+        size_t cap = ds->capspheres ? ds->capspheres : 16;
+        while (cap < s->nspheres + adds) cap *= 2;
+        vw_sphere *sp = realloc(s->spheres, cap * sizeof *sp);
+        if (!sp) return VW_E_NOMEM;
+        s->spheres = sp;
+        ds->capspheres = cap;
+    }
+    if (s->nvertices + vertices > ds->capvertices) {
+        size_t cap = ds->capvertices > s->nvertices ? ds->capvertices : s->nvertices;
+        while (cap < s->nvertices + vertices) cap = cap ? 2 * cap : 64;
+        double(*nv)[3] = realloc(s->vertices, cap * sizeof *nv);
+        if (!nv) return VW_E_NOMEM;
+        s->vertices = nv;
+        ds->capvertices = cap;
+    }
+    vw_status st = grow_ids(ds, maxid);
+    if (st == VW_OK) st = grow_slots(ds, ds->nslots + adds);
+    return st;
+}
+
 /* Decides and commits edits [0, n) whose ids are distinct. */
 static vw_status run_batch(vw_dynscene *ds, const vw_edit *edits, size_t n, int check, int sweep,
                            vw_result *res, unsigned char *changed_bits, size_t *nbits)
 {
-    pending *pd = calloc(n ? n : 1, sizeof *pd);
+    pending *pd = ds->fault_batch ? NULL : calloc(n ? n : 1, sizeof *pd);
     unsigned char *ok = calloc(n ? n : 1, 1);
     batch b = {0};
     vw_shape *ends = NULL;
@@ -611,7 +674,12 @@ static vw_status run_batch(vw_dynscene *ds, const vw_edit *edits, size_t n, int 
     vw_status st = (pd && ok) ? VW_OK : VW_E_NOMEM;
     int next_id = ds->nids;
     for (size_t i = 0; i < n && st == VW_OK; i++) {
-        ok[i] = (unsigned char)prepare(ds, &edits[i], next_id, &res[i], &pd[i]);
+        int ready = prepare(ds, &edits[i], next_id, &res[i], &pd[i]);
+        if (ready < 0) {
+            st = VW_E_NOMEM;
+            break;
+        }
+        ok[i] = (unsigned char)ready;
         if (!ok[i]) continue;
         if (pd[i].add) next_id++;
         if (pd[i].remove) continue;
@@ -670,6 +738,8 @@ static vw_status run_batch(vw_dynscene *ds, const vw_edit *edits, size_t n, int 
     }
     vw_contact *ct = NULL;
     size_t nct = 0;
+    /* The probes were made alone; the query is collective. */
+    st = agree(ds, st, "preparing a batch of edits");
     if (st == VW_OK && check) {
         if (ds->brute)
             st = brute_contacts(ds, &b, &ct, &nct);
@@ -732,7 +802,10 @@ static vw_status run_batch(vw_dynscene *ds, const vw_edit *edits, size_t n, int 
             moved[pd[i].id] = 1;
         }
     }
-    /* Commit the accepted edits, in order (adds take their ids in order). */
+    /* Commit the accepted edits, in order (adds take their ids in order): their room
+       first, agreed, since each commit updates the collider (collective). */
+    if (st == VW_OK) st = reserve_commits(ds, pd, res, ok, n);
+    st = agree(ds, st, "deciding a batch of edits");
     for (size_t i = 0; i < n && st == VW_OK; i++) {
         if (!ok[i] || res[i].outcome != VW_OUT_ACCEPTED) continue;
         st = commit_edit(ds, &pd[i], ends ? ends + pd[i].probe0 : NULL);
@@ -764,7 +837,8 @@ vw_status vw_dynscene_apply(vw_dynscene *ds, const vw_edit *edits, size_t n, int
        no byte: sized by the ids named, "remove 2000000000" cost 4 GB. */
     size_t maxid = (size_t)ds->nids + n + 1;
     unsigned char *bits = calloc(maxid, 1), *seen = calloc(maxid, 1);
-    vw_status st = (bits && seen) ? VW_OK : VW_E_NOMEM;
+    ds->errmsg[0] = 0;
+    vw_status st = agree(ds, (bits && seen) ? VW_OK : VW_E_NOMEM, "the edits' bookkeeping");
     size_t nbits = 0, i = 0;
     while (st == VW_OK && i < n) {
         /* The longest run of edits with distinct ids. An add never repeats an id, but it
@@ -791,6 +865,10 @@ vw_status vw_dynscene_apply(vw_dynscene *ds, const vw_edit *edits, size_t n, int
     for (size_t k = 0; k < nbits; k++) m += bits[k];
     int *out = malloc((m ? m : 1) * sizeof *out);
     if (!out && st == VW_OK) st = VW_E_NOMEM;
+    /* The caller's next step may be collective too (a world update). */
+    if (st != VW_OK && !ds->errmsg[0])
+        snprintf(ds->errmsg, sizeof ds->errmsg, "committing the edits: %s", vw_status_message(st));
+    st = agree(ds, st, "listing the changed objects");
     if (st == VW_OK) {
         m = 0;
         for (size_t k = 0; k < nbits; k++)

@@ -27,6 +27,17 @@ grep -q '"animation"' s.json || fail "no animation member in the stats"
 grep -q '"command": "animate"' s.json || fail "stats command"
 grep -q "accepted" out.txt || fail "no summary"
 [ "$(wc -l < log.txt)" -eq 2 ] || fail "log should list both edits"
+# Memory a batch of edits cannot get (the test switch VW_FAULT: a batch's bookkeeping,
+# the room for its accepted edits): status 1 and the reason, not an edit taken as invalid
+# (which, under MPI, would leave one process with another scene).
+for f in batch commit; do
+  [ $f = batch ] && what="preparing a batch of edits" || what="deciding a batch of edits"
+  VW_FAULT=dynscene-$f-nomem "$V" animate scene.nff ok.txt -o 'm%02d.png' --cells 2x2x1 --workers 2 \
+    --quiet 2>err.txt; rc=$?
+  [ $rc -eq 1 ] || fail "dynscene-$f-nomem: status $rc"
+  grep -q "^vwalls animate: applying edits: $what: out of memory\$" err.txt ||
+    fail "dynscene-$f-nomem: message: $(cat err.txt)"
+done
 # --farm: auto is all (every worker holds every cell), idle with --balance; every mode
 # gives the same frames.
 grep -q '"farm": "all"' s.json || fail "default farm is not all: $(grep -o '"farm": "[a-z]*"' s.json)"

@@ -30,7 +30,9 @@
 # animate's edits
 # (rt_anim_apply: the touched cells' marks anim-apply-nomem, room for an added object's
 # records anim-records-nomem) and its rebalance between frames (rt_anim_balance:
-# anim-balance-nomem).
+# anim-balance-nomem); and inside vw_dynscene_apply, a batch's probes and pending edits
+# (dynscene-batch-nomem) and the room for its accepted edits (dynscene-commit-nomem),
+# each agreed before the collider's next collective step.
 # usage: rank_status.sh VWALLS NP "MPIEXEC -n NP [flags]"
 vwalls=$1 np=$2 launch=$3
 dir=$(mktemp -d)
@@ -185,6 +187,12 @@ for f in anim-apply anim-records; do
     must_agree "animate, no memory for the edits' $f bookkeeping on rank 1" 1 \
         "^vwalls animate: rank 1: applying edits: out of memory for the marks and records" \
         "$on1=$f-nomem; \"$vwalls\" animate \"$dir/balls.nff\" \"$dir/$e\" -o \"$dir/a%d.png\" $small"
+done
+for f in batch commit; do
+    [ $f = batch ] && what="preparing a batch of edits" || what="deciding a batch of edits"
+    must_agree "animate, no memory for the dynamic scene's $f on rank 1" 1 \
+        "^vwalls animate: rank 1: applying edits: $what: out of memory" \
+        "$on1=dynscene-$f-nomem; \"$vwalls\" animate \"$dir/balls.nff\" \"$dir/edits\" -o \"$dir/a%d.png\" $small"
 done
 must_agree "animate --balance tensor, no memory for the rebalance on rank 1" 1 \
     "^vwalls animate: rank 1: balancing: the loads: out of memory" \

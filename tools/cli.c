@@ -421,6 +421,14 @@ int vw_cli_same_options(const char *cmd, const char *const *names, const double 
     return -1;
 }
 
+int vw_cli_same_scene(const char *cmd, const vw_scene *scene)
+{
+    uint64_t h = vw_scene_fingerprint(scene);
+    /* Two halves: a double holds 32 bits exactly. */
+    const double v[2] = {(double)(uint32_t)(h >> 32), (double)(uint32_t)h};
+    return vw_cli_same_as_first(cmd, v, 2, "scene");
+}
+
 int vw_cli_same_view(const char *cmd, int width, int height, long depth, const vw_camera *cam,
                      const vw_scene *scene)
 {

@@ -84,6 +84,11 @@ int vw_cli_same_options(const char *cmd, const char *const *names, const double 
    the cells and the objects' bounds). */
 int vw_cli_same_view(const char *cmd, int width, int height, long depth, const vw_camera *cam,
                      const vw_scene *scene);
+/* vw_cli_same_as_first for the scene itself (vw_scene_fingerprint: its objects, vertices,
+   materials, lights and background; not its camera): a file that differs on one host
+   in anything the world's bounds do not show (a material, a normal, an inner vertex)
+   drew or solved wrongly without a word. */
+int vw_cli_same_scene(const char *cmd, const vw_scene *scene);
 
 /* MPI set-up for the command line: initialises MPI when the process was started by a
    launcher (and the build has MPI), so the same binary runs with and without mpirun.

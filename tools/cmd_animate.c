@@ -585,7 +585,8 @@ int vw_anim_main(const char *cmd, int argc, char **argv)
         vw_scene_free(scene);
         goto done;
     }
-    if (vw_cli_same_view(cmd, p.width, p.height, depth, &scene->camera, scene)) {
+    if (vw_cli_same_view(cmd, p.width, p.height, depth, &scene->camera, scene) ||
+        vw_cli_same_scene(cmd, scene)) {
         vw_scene_free(scene);
         goto done;
     }

@@ -361,6 +361,11 @@ int vw_cmd_radiosity(int argc, char **argv)
         vw_scene_free(sc);
         return rst == VW_E_NOMEM ? VW_EXIT_FAIL : VW_EXIT_USAGE;
     }
+    /* A reflectance or an emission that differs on one host solved wrongly. */
+    if (vw_cli_same_scene(CMD, sc)) {
+        vw_scene_free(sc);
+        return VW_EXIT_USAGE;
+    }
     /* Every process makes its own cells and mesh from its own copy of the scene, and
        checks the picture's size against that copy's camera: all agree before the
        solver's world is made, or one that stopped alone would leave the others waiting

@@ -468,7 +468,7 @@ int vw_cmd_render(int argc, char **argv)
     if (camera_problem && rc == VW_EXIT_OK)
         rc = vw_cli_fail(CMD, VW_EXIT_USAGE, err, sizeof err, "--from/--at/--up: %s", camera_problem);
     if ((rc = vw_cli_agree(CMD, rc, err, sizeof err)) != VW_EXIT_OK ||
-        vw_cli_same_view(CMD, width, height, depth, &cam, scene)) {
+        vw_cli_same_view(CMD, width, height, depth, &cam, scene) || vw_cli_same_scene(CMD, scene)) {
         vw_scene_free(scene);
         free(speeds), free(slowdown);
         return rc != VW_EXIT_OK ? rc : VW_EXIT_USAGE;

@@ -330,7 +330,7 @@ vw_status rt_job_create(const vw_scene *s, const rt_params *p, rt_job **out, cha
     vw_config cfg = rt_job_config(p);
     rt_object *objs = NULL;
     size_t nobjs = 0;
-    rt_job *j = calloc(1, sizeof *j);
+    rt_job *j = vw_test_fault("job-nomem") ? NULL : calloc(1, sizeof *j);
     if (j) {
         atomic_init(&j->sh.pixels_done, 0);
         atomic_init(&j->sh.entries, 0);

@@ -122,6 +122,11 @@ VW_API vw_status vw_scene_write_nff_file(const vw_scene *s, const char *path,
 
 /* Queries */
 VW_API size_t vw_scene_count_objects(const vw_scene *s);
+/* A 64-bit hash (FNV-1a) of everything in the scene but its camera: objects, vertices
+   and normals, materials, lights, background, value by value. The same file read by the
+   same binary gives the same fingerprint; the commands compare it between MPI processes
+   (the camera is compared with the command line's overrides, as the view). */
+VW_API uint64_t vw_scene_fingerprint(const vw_scene *s);
 /* Axis-aligned bounds of every primitive together (lights excluded). Spheres count
    as center +- r, cones as both end discs enclosed in boxes of half-size |r|, polygons
    by their vertices. An empty scene gives lo = hi = (0,0,0). */

@@ -5,6 +5,7 @@
  * widened by a tiny pad, so a ray hitting an object near a wall finds it in whichever
  * cell owns that stretch of the ray.
  */
+#include "core/hash.h"
 #include "core/world_internal.h"
 #include "vwalls/engine.h"
 
@@ -495,13 +496,6 @@ int vw_world_cells_of_object(const vw_world *w, size_t id, int *out, int max)
     return n;
 }
 
-static uint64_t fnv1a(uint64_t h, const void *p, size_t n)
-{
-    const unsigned char *b = p;
-    for (size_t i = 0; i < n; i++) h = (h ^ b[i]) * 0x100000001b3ull;
-    return h;
-}
-
 /* What every process of a world must have been given alike, hashed: the walls (cell
    boxes and frame), the mapping, the copies of duplicated cells, the number of objects
    and their bounds. A process given another scene or layout would otherwise send its
@@ -511,28 +505,28 @@ static uint64_t fnv1a(uint64_t h, const void *p, size_t n)
    record's padding bytes may differ where its values do not. */
 static uint64_t world_fingerprint(const vw_world *w)
 {
-    uint64_t h = 0xcbf29ce484222325ull;
-    h = fnv1a(h, &w->ncells, sizeof w->ncells);
+    uint64_t h = VW__FNV_OFFSET;
+    h = vw__fnv1a(h, &w->ncells, sizeof w->ncells);
     for (int c = 0; c < w->ncells; c++) {
         vw_box b = vw_decomp_cell_box(w->decomp, c);
-        h = fnv1a(h, &b, sizeof b);
-        h = fnv1a(h, &w->cell_worker[c], sizeof w->cell_worker[c]);
+        h = vw__fnv1a(h, &b, sizeof b);
+        h = vw__fnv1a(h, &w->cell_worker[c], sizeof w->cell_worker[c]);
         const vw__cell *cl = &w->cells[c];
-        h = fnv1a(h, &cl->nreps, sizeof cl->nreps);
+        h = vw__fnv1a(h, &cl->nreps, sizeof cl->nreps);
         for (int r = 0; r < cl->nreps; r++)
-            h = fnv1a(h, &cl->reps[r].worker, sizeof cl->reps[r].worker);
+            h = vw__fnv1a(h, &cl->reps[r].worker, sizeof cl->reps[r].worker);
         /* The shares (worker speeds): processes that disagreed would make some batches
            twice and others never. */
-        if (cl->share_len) h = fnv1a(h, cl->share_seq, sizeof(int) * (size_t)cl->share_len);
+        if (cl->share_len) h = vw__fnv1a(h, cl->share_seq, sizeof(int) * (size_t)cl->share_len);
     }
     const double *F = vw_decomp_frame(w->decomp);
-    if (F) h = fnv1a(h, F, 9 * sizeof *F);
+    if (F) h = vw__fnv1a(h, F, 9 * sizeof *F);
     uint64_t n = w->nobjects;
-    h = fnv1a(h, &n, sizeof n);
+    h = vw__fnv1a(h, &n, sizeof n);
     for (size_t i = 0; i < w->nobjects; i++) {
         vw_box b;
         w->m->object_bounds(w->objects + i * w->m->object_size, &b, w->user);
-        h = fnv1a(h, &b, sizeof b);
+        h = vw__fnv1a(h, &b, sizeof b);
     }
     return h;
 }

@@ -9,6 +9,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/hash.h"
 #include "io/io_internal.h"
 #include "vwalls/outfile.h"
 
@@ -227,16 +228,9 @@ vw_status vw__sb_add_material(vw__sb *b, const vw_material *m, int *index)
     return VW_OK;
 }
 
-static uint64_t material_hash(const vw_material *m)
-{
-    /* FNV-1a over the bytes: vw_material is all floats, so there is no padding and
-       bit-identical materials hash alike. */
-    const unsigned char *p = (const unsigned char *)m;
-    uint64_t h = 1469598103934665603ull;
-    for (size_t i = 0; i < sizeof *m; i++)
-        h = (h ^ p[i]) * 1099511628211ull;
-    return h;
-}
+/* vw_material is all floats, so there is no padding and bit-identical materials hash
+   alike. */
+static uint64_t material_hash(const vw_material *m) { return vw__fnv1a(VW__FNV_OFFSET, m, sizeof *m); }
 
 static int mat_hash_insert(int *tab, size_t cap, const vw_material *mats, int index)
 {
@@ -499,6 +493,42 @@ VW_API vw_status vw_scene_read_file(const char *path, vw_scene **out, char *err,
 VW_API size_t vw_scene_count_objects(const vw_scene *s)
 {
     return s ? s->nspheres + s->ncones + s->npolygons : 0;
+}
+
+VW_API uint64_t vw_scene_fingerprint(const vw_scene *s)
+{
+    uint64_t h = VW__FNV_OFFSET;
+    if (!s) return h;
+#define H(x) (h = vw__fnv1a(h, &(x), sizeof(x)))
+#define HN(p, n) (h = (p) && (n) ? vw__fnv1a(h, (p), sizeof *(p) * (n)) : h)
+    H(s->background);
+    H(s->nlights);
+    for (size_t i = 0; i < s->nlights; i++) H(s->lights[i].pos), H(s->lights[i].color);
+    H(s->nmaterials);
+    HN(s->materials, s->nmaterials); /* all floats: no padding */
+    H(s->nspheres);
+    for (size_t i = 0; i < s->nspheres; i++) {
+        const vw_sphere *x = &s->spheres[i];
+        H(x->id), H(x->material), H(x->center), H(x->radius);
+    }
+    H(s->ncones);
+    for (size_t i = 0; i < s->ncones; i++) {
+        const vw_cone *x = &s->cones[i];
+        H(x->id), H(x->material), H(x->base), H(x->base_radius), H(x->apex), H(x->apex_radius);
+    }
+    H(s->npolygons);
+    for (size_t i = 0; i < s->npolygons; i++) {
+        const vw_polygon *x = &s->polygons[i];
+        H(x->id), H(x->material), H(x->first), H(x->count), H(x->has_normals);
+    }
+    H(s->nvertices);
+    HN(s->vertices, s->nvertices);
+    H(s->nindices);
+    HN(s->indices, s->nindices);
+    HN(s->normals, s->nindices);
+#undef H
+#undef HN
+    return h;
 }
 
 static void box_empty(double lo[3], double hi[3])

@@ -86,6 +86,46 @@ static void expect_error(const char *text, const char *want)
 
 #define VIEW "v from 0 -5 0 at 0 0 0 up 0 0 1 angle 45 hither 0.1 resolution 8 8\n"
 
+/* vw_scene_fingerprint: the same text gives the same value; every part of a scene but
+   its camera changes it (the commands compare it between MPI processes). */
+static void test_fingerprint(void)
+{
+    static const char *const base =
+        "v from 0 -5 0 at 0 0 0 up 0 0 1 angle 45 hither 0.1 resolution 8 8\n"
+        "b 0.1 0.2 0.3\nl 1 2 3\nf 0.5 0.5 0.5 1 0 0 0 1\ns 0 0 0 1\nc 0 0 0 1 0 0 1 0.5\n"
+        "pp 3\n0 0 0 0 0 1\n1 0 0 0 0 1\n0 1 0 0 0 1\np 4\n0 0 2\n1 0 2\n0.5 0.5 2\n0 1 2\n";
+    /* Each edit: (text to find, its replacement, 1 when the fingerprint must change). */
+    static const struct { const char *from, *to; int changes; } edits[] = {
+        {"from 0 -5 0", "from 0 -6 0", 0},     /* the camera is the view's, not the scene's */
+        {"resolution 8 8", "resolution 9 9", 0},
+        {"b 0.1 0.2 0.3", "b 0.1 0.2 0.4", 1},
+        {"l 1 2 3", "l 1 2 3 0.5 0.5 0.5", 1}, /* a light's colour */
+        {"l 1 2 3", "l 1 2 3\nl 4 5 6", 1},    /* another light */
+        {"f 0.5 0.5 0.5 1", "f 0.5 0.5 0.6 1", 1},
+        {"s 0 0 0 1", "s 0 0 0 1.5", 1},
+        {"c 0 0 0 1 0 0 1 0.5", "c 0 0 0 1 0 0 1 0.25", 1},
+        {"1 0 0 0 0 1", "1 0 0 0 0.1 1", 1},     /* a normal */
+        {"0.5 0.5 2", "0.4 0.5 2", 1},           /* an inner vertex: the bounds stay */
+    };
+    vw_scene *a = read_text("a.nff", base), *b = read_text("b.nff", base);
+    uint64_t fa = vw_scene_fingerprint(a);
+    CHECK(fa == vw_scene_fingerprint(b));
+    CHECK(fa != vw_scene_fingerprint(NULL));
+    for (size_t i = 0; i < sizeof edits / sizeof edits[0]; i++) {
+        char text[1024];
+        const char *at = strstr(base, edits[i].from);
+        CHECK(at != NULL);
+        snprintf(text, sizeof text, "%.*s%s%s", (int)(at - base), base, edits[i].to,
+                 at + strlen(edits[i].from));
+        vw_scene *c = read_text("c.nff", text);
+        EXPECT((vw_scene_fingerprint(c) != fa) == edits[i].changes, "'%s' -> '%s': the fingerprint "
+               "%s", edits[i].from, edits[i].to, edits[i].changes ? "stayed" : "changed");
+        vw_scene_free(c);
+    }
+    vw_scene_free(a);
+    vw_scene_free(b);
+}
+
 int main(int argc, char **argv)
 {
     CHECK(argc == 2);
@@ -358,5 +398,6 @@ int main(int argc, char **argv)
 
     vw_scene_free(s);
     free(text);
+    test_fingerprint();
     TEST_DONE();
 }

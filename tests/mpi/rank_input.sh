@@ -5,7 +5,8 @@
 #   * vwalls animate's edit script is rank 0's, read there and handed to every rank, so
 #     a script that differs (or is missing) on another rank changes nothing;
 #   * a scene missing on one rank stops every rank, naming it, and
-#     another --workers, --depth or camera on one rank is named as such, and so is
+#     another --workers, --depth, camera or scene (a material) on one rank is named as
+#     such, and so is
 #     another radiosity option that changes the solution (--sf, --hemicube, ...);
 #   * gen -o is written by rank 0 alone, and warnings about a scene come from rank 0;
 #   * an output only rank 0 writes (animate's frames, --log, gen -o) into a missing directory,
@@ -102,6 +103,21 @@ run "render, another camera on rank 1" 2 "rank 1: was given another view" \
     sh -c "exec \"$vwalls\" render \"$dir/s$rank.nff\" -o \"$dir/r.png\" $common"
 run "animate, another --depth on rank 1" 2 "rank 1: was given another view" \
     sh -c "exec \"$vwalls\" animate \"$scene\" \"$dir/edits\" -o \"$dir/a%d.png\" --size 48x48 --cells 2x2x2 --depth $wrank"
+rm "$dir/s1.nff"
+# A scene whose first material differs on rank 1: the objects' bounds are the same, so the
+# world's check passed, and the render drew (and the radiosity solved) wrongly without a
+# word.
+sed '0,/^f /s/^f [-0-9.e]*/f 0.123/' "$scene" >"$dir/s1.nff"
+cmp -s "$scene" "$dir/s1.nff" && { echo "FAIL: $scene has no 'f' line"; fail=1; }
+# shellcheck disable=SC2086
+run "render, another material on rank 1" 2 "rank 1: was given another scene" \
+    sh -c "exec \"$vwalls\" render \"$dir/s$rank.nff\" -o \"$dir/r.png\" $common"
+[ ! -e "$dir/r.png" ] || { echo "FAIL: render, another material: output written"; fail=1; }
+"$vwalls" gen cornell -o "$dir/c0.nff" || { echo "FAIL: gen cornell"; fail=1; }
+sed '0,/^f /s/^f [-0-9.e]*/f 0.123/' "$dir/c0.nff" >"$dir/c1.nff"
+run "radiosity, another material on rank 1" 2 "rank 1: was given another scene" \
+    sh -c "exec \"$vwalls\" radiosity \"$dir/c$rank.nff\" -o \"$dir/l.ply\" --cells 2x2x2 --workers 1 --max-shots 4 --quiet"
+[ ! -e "$dir/l.ply" ] || { echo "FAIL: radiosity, another material: output written"; fail=1; }
 rm "$dir/s1.nff"
 
 # Ranks given different worker counts: the message says so (not "invalid argument").

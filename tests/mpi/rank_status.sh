@@ -12,8 +12,9 @@
 # And failures inside the applications' own set-up, before or between the library's
 # collective steps (which used to end the job with status 15 or hang it; each now ends
 # in vw_config_agree or vw_world_agree):
-#   * a scene the ray tracer refuses on ranks 1 and up alone (one sphere 2e-62 across,
-#     a sphere beyond its coordinate limit), for render and animate (rt_job_create);
+#   * a scene that differs on ranks 1 and up (one sphere 2e-62 across, a sphere beyond
+#     the ray tracer's coordinate limit), for render and animate: another scene
+#     (vw_cli_same_scene); memory for the job on rank 1 alone (job-nomem, rt_job_create);
 #     with NP 3, ranks 1 and 2 both fail and the message is rank 1's;
 #   * memory, by the test switch VW_FAULT: for the image sums, which rank 0 alone keeps
 #     (job-accum-nomem); on rank 1 alone for the mapping (map-nomem, rt_job_map), the
@@ -124,18 +125,26 @@ cp "$dir/balls.nff" "$dir/tiny0.nff"
 grep -q "^s 0 0 0 1e-62" "$dir/tiny1.nff" && grep -q "^v" "$dir/tiny1.nff" ||
     { echo "FAIL: could not make tiny1.nff"; fail=1; }
 rm -f "$dir/r.png"
+# Since the scenes are compared (vw_cli_same_scene), a scene the ray tracer refuses on
+# ranks 1 and up alone is stopped as another scene; rt_job_create's own agreement is
+# reached by memory rank 1 alone lacks for the job (job-nomem).
 must_agree "render, a scene too small for the ray tracer on ranks 1 and up" 2 \
-    "^vwalls render: rank 1: the scene is [-0-9.e+]* across: the ray tracer needs at least" \
+    "^vwalls render: rank 1: was given another scene than rank 0" \
     "$ge1; \"$vwalls\" render \"$dir/tiny\$n.nff\" -o \"$dir/r.png\" $small"
 [ ! -e "$dir/r.png" ] || { echo "FAIL: render, tiny scene: output written"; fail=1; }
 must_agree "animate, a scene too small for the ray tracer on ranks 1 and up" 2 \
-    "^vwalls animate: rank 1: the scene is [-0-9.e+]* across" \
+    "^vwalls animate: rank 1: was given another scene than rank 0" \
     "$ge1; \"$vwalls\" animate \"$dir/tiny\$n.nff\" \"$dir/edits\" -o \"$dir/a%d.png\" $small"
 { cat "$dir/balls.nff"; echo "s 2e37 0 0 1"; } >"$dir/far1.nff"
 cp "$dir/balls.nff" "$dir/far0.nff"
 must_agree "render, a sphere beyond the coordinate limit on ranks 1 and up" 2 \
-    "^vwalls render: rank 1: the scene lies [-0-9.e+]* from the origin on an axis" \
+    "^vwalls render: rank 1: was given another scene than rank 0" \
     "$ge1; \"$vwalls\" render \"$dir/far\$n.nff\" -o \"$dir/r.png\" $small"
+for c in render animate; do
+    [ $c = render ] && args="-o \"$dir/r.png\"" || args="\"$dir/edits\" -o \"$dir/a%d.png\""
+    must_agree "$c, no memory for the job on rank 1" 1 "^vwalls $c: rank 1: out of memory" \
+        "[ $rank = 1 ] && export VW_FAULT=job-nomem; \"$vwalls\" $c \"$dir/balls.nff\" $args $small"
+done
 must_agree "render, no memory for the image sums (rank 0 alone keeps them)" 1 \
     "^vwalls render: rank 0: out of memory for the 32x32 image" \
     "VW_FAULT=job-accum-nomem \"$vwalls\" render \"$dir/balls.nff\" -o \"$dir/r.png\" $small"

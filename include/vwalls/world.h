@@ -41,7 +41,9 @@ typedef struct vw_config {
     size_t packet_bytes;     /* flush a packet when it holds this much (default 32 KiB;
                                 at most 1 GiB, VW_E_LIMIT above) */
     size_t cap_bytes;        /* a worker whose unconsumed sent bytes exceed this drains its
-                                inbox before step() creates new work (default 64 MiB) */
+                                inbox before step() creates new work (default 64 MiB; each
+                                packet counts 4 KiB more than its bytes, so the cap also
+                                bounds how many are in flight) */
     /* Stress switches (also from the environment: VW_STRESS=seed, VW_STRESS_SPLIT=1). */
     uint64_t stress_seed;    /* nonzero: delay and reorder deliveries at random */
     int stress_split;        /* one message per packet */

@@ -164,7 +164,7 @@ void vw__deliver(vw_world *w, vw__worker *from, vw__packet *p)
         free(p);
         return;
     }
-    if (from) atomic_fetch_add(&from->outstanding, p->used);
+    if (from) atomic_fetch_add(&from->outstanding, vw__packet_charge(p));
     vw__deliver_local(w, p, from ? &from->rng : NULL);
 }
 
@@ -617,7 +617,7 @@ static void handle_packet(vw__worker *wk, vw_ctx *ctx, vw__packet *p)
     }
     meter_stop(wk);
     if (p->src >= 0 && vw__worker_process(w, p->src) == w->rank)
-        atomic_fetch_sub(&w->workers[p->src - w->rank * w->nworkers].outstanding, p->used);
+        atomic_fetch_sub(&w->workers[p->src - w->rank * w->nworkers].outstanding, vw__packet_charge(p));
 }
 
 /* Calls step() on the worker's cells round-robin; returns 1 if one of them worked,

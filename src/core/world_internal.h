@@ -131,7 +131,8 @@ typedef struct vw__worker {
     pthread_cond_t cv;
     vw__packet *head, *tail;   /* the inbox, guarded by mu */
     int busy;
-    atomic_size_t outstanding; /* bytes this worker sent that are not yet handled */
+    atomic_size_t outstanding; /* bytes this worker sent that are not yet handled
+                                  (vw__packet_charge each packet) */
     vw__packet **out;          /* open packet per destination: [0..G) workers, [G] output */
     int *cells, ncells;        /* the cells this worker hosts (masters and copies) */
     int *cell_rep;             /* per entry of cells: 0 = the master, r = copy reps[r-1] */
@@ -268,6 +269,13 @@ void vw__runtime_stop(vw_world *w);
    units that failed, whatever the thread timing, as a worker stops at its first
    failure and builds its units in that order. */
 vw_status vw__runtime_build(vw_world *w, int *cell, int *rep);
+/* What a packet in flight counts against its sender's cap (vw_config.cap_bytes): its
+   bytes and a fixed charge, so the cap bounds the packets too. Without the charge, a
+   worker that flushed one small message at a time (a step that sends one and returns
+   1) had up to a few hundred thousand packets in flight under MPI, each a request the
+   communication thread tests on every pass (mpi_local_fail_handler took over 30 s). */
+#define VW__PACKET_CHARGE 4096
+static inline size_t vw__packet_charge(const vw__packet *p) { return p->used + VW__PACKET_CHARGE; }
 /* A packet of cap bytes, or NULL when out of memory. */
 vw__packet *vw__packet_new(int dest, int src, size_t cap);
 /* Fails the current run of this process (the first call of the run sets its status and

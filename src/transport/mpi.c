@@ -123,7 +123,7 @@ static void *grow(void *p, int *cap, int need, size_t elem)
 static void tp_send(vw_world *w, vw__worker *from, vw__packet *p)
 {
     mpi_tp *t = tp_of(w);
-    if (from) atomic_fetch_add(&from->outstanding, p->used);
+    if (from) atomic_fetch_add(&from->outstanding, vw__packet_charge(p));
     atomic_fetch_add(&t->sent, 1);
     pthread_mutex_lock(&t->mu);
     p->next = NULL;
@@ -196,7 +196,7 @@ static int complete_sends(vw_world *w, mpi_tp *t)
     for (int i = 0; i < ndone; i++) {
         vw__packet *p = t->sending[t->done_idx[i]];
         if (p->src >= 0 && vw__worker_process(w, p->src) == w->rank)
-            atomic_fetch_sub(&w->workers[p->src - w->rank * w->nworkers].outstanding, p->used);
+            atomic_fetch_sub(&w->workers[p->src - w->rank * w->nworkers].outstanding, vw__packet_charge(p));
         free(p);
         t->sending[t->done_idx[i]] = NULL;
     }
@@ -372,7 +372,7 @@ static vw_status tp_run(vw_world *w)
     for (int i = 0; i < t->nsend; i++) {
         vw__packet *p = t->sending[i];
         if (p->src >= 0 && vw__worker_process(w, p->src) == w->rank)
-            atomic_fetch_sub(&w->workers[p->src - w->rank * w->nworkers].outstanding, p->used);
+            atomic_fetch_sub(&w->workers[p->src - w->rank * w->nworkers].outstanding, vw__packet_charge(p));
         free(p);
     }
     t->nsend = 0;

@@ -423,6 +423,7 @@ int vw_cli_same_options(const char *cmd, const char *const *names, const double 
 
 int vw_cli_same_scene(const char *cmd, const vw_scene *scene)
 {
+    if (vw_engine_size() == 1) return 0; /* the hash reads every byte of the scene */
     uint64_t h = vw_scene_fingerprint(scene);
     /* Two halves: a double holds 32 bits exactly. */
     const double v[2] = {(double)(uint32_t)(h >> 32), (double)(uint32_t)h};

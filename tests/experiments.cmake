@@ -1,11 +1,10 @@
 # experiments.cmake - the smoke version of bench/experiments.sh (the paper's evaluation):
 # tiny sphere scenes and the Cornell box on two layouts, threads engine and (when mpirun
 # works) MPI, balancing rows when the build has --balance. It checks the shape and sanity
-# of the CSV (bench/experiments/check.awk: the expected columns, speedup > 0, efficiency
-# <= 1.05 -- 1.5 where the compute phase is under 0.5 s, as the smoke run's are, since a
-# shared machine's noise alone moves such ratios by tens of percent -- efficiency =
-# speedup / workers, lambda >= 1), never a timing. Needs bash and awk only: the smoke run skips
-# POV-Ray, gnuplot and python3. Label "bench".
+# of the CSV (bench/experiments/check.awk: the expected columns, speedup > 0 and equal to
+# the fastest sequential time over the row's, efficiency = speedup / workers, lambda >= 1),
+# never a timing: an efficiency bound failed here under a doubled load. Needs bash and
+# awk only: the smoke run skips POV-Ray, gnuplot and python3. Label "bench".
 
 set(VW_EXP_DIR ${PROJECT_SOURCE_DIR}/bench/experiments)
 add_test(NAME experiments_smoke

@@ -20,7 +20,7 @@ expect() { # expect FILE STATUS MESSAGE-SUBSTRING
 expect good.csv 0 "ok: 15 rows"
 expect bad-header.csv 1 "header is not the expected columns"
 expect bad-width.csv 1 "row has 29 fields"
-expect bad-efficiency.csv 1 "efficiency above 1.05"
+expect bad-baseline.csv 1 "is not the fastest sequential compute_s / compute_s = 1.032"
 expect bad-lambda.csv 1 "lambda below 1"
 expect bad-speedup.csv 1 "speedup is not positive"
 expect bad-number.csv 1 "compute_s is not a number"

@@ -21,6 +21,10 @@
  * What a program does on one process alone before or between these steps (reading its
  * copy of the input, allocating) needs its own agreement before the next one:
  * vw_config_agree before vw_world_create, vw_world_agree after (vwalls/engine.h).
+ * vw_world_create also refuses, on every process, a process whose module differs from
+ * process 0's in name, record size, message kinds or counters (another build: packets
+ * cross as raw bytes), and vw_world_commit one given another world (walls, mapping,
+ * copies, objects' bounds).
  */
 #ifndef VWALLS_WORLD_H
 #define VWALLS_WORLD_H

@@ -228,6 +228,27 @@ static vw_status copy_speeds(vw_world *w)
     return VW_OK;
 }
 
+/* The module's shape as it reaches the wire, hashed: its name and record size, each
+   message kind's name, size, flags and handlers present, its counters, and the
+   runtime's own message header. Compared between processes when a world is created. */
+static uint64_t module_fingerprint(const vw_module *m)
+{
+    uint64_t h = VW__FNV_OFFSET;
+    uint64_t head[5] = {m->abi, m->object_size, (uint64_t)m->nkinds, (uint64_t)m->ncounters,
+                        sizeof(vw__msg_header)};
+    h = vw__fnv1a(h, head, sizeof head);
+    if (m->name) h = vw__fnv1a(h, m->name, strlen(m->name) + 1);
+    for (int k = 0; k < m->nkinds; k++) {
+        const vw_msg_kind *K = &m->kinds[k];
+        uint64_t v[4] = {K->size, K->flags, K->handle != NULL, K->output != NULL};
+        h = vw__fnv1a(h, v, sizeof v);
+        if (K->name) h = vw__fnv1a(h, K->name, strlen(K->name) + 1);
+    }
+    for (int c = 0; c < m->ncounters; c++)
+        if (m->counters[c]) h = vw__fnv1a(h, m->counters[c], strlen(m->counters[c]) + 1);
+    return h;
+}
+
 vw_status vw_world_create(const vw_module *m, void *user, const vw_decomp *d, const vw_config *c,
                           vw_world **out)
 {
@@ -292,6 +313,16 @@ vw_status vw_world_create(const vw_module *m, void *user, const vw_decomp *d, co
        worker count (checked by the transport here), decomposition and mapping (checked
        at every commit: world_fingerprint). */
     vw_status st = vw__mpi_attach(w);
+    /* Packets cross MPI as raw bytes, read by the receiver's module: processes running
+       other builds (another message kind, another record size) would read each other's
+       messages wrongly without a word. (Attached on every process or on none.) */
+    if (st == VW_OK && w->transport) {
+        int r = vw__mpi_first_differing(w, module_fingerprint(w->m));
+        if (r >= 0)
+            st = vw__world_error(w, VW_E_INVAL, "process %d runs another module than process 0 "
+                                 "(module '%s': its name, object size, message kinds or counters "
+                                 "differ): every process must run the same build", r, w->m->name);
+    }
     w->gworkers = w->nworkers * w->nprocs;
     if (st == VW_OK) {
         w->wstats = calloc((size_t)w->gworkers, sizeof *w->wstats);

@@ -66,6 +66,7 @@ typedef struct mpi_tp {
     int nhold, caphold;
     uint64_t rng;
     uint64_t waves; /* all runs: how many termination waves it took */
+    int garble;     /* VW_FAULT=wire-garble: the next packet to a cell goes out garbled */
 } mpi_tp;
 
 /* MPICH defines MPI_STATUSES_IGNORE as (MPI_Status *)1, which GCC 12's
@@ -148,6 +149,12 @@ static void post_send(vw_world *w, mpi_tp *t, vw__packet *p)
         cap = t->capsend;
         t->done_idx = grow(t->done_idx, &cap, t->nsend + 1, sizeof *t->done_idx);
         t->sending = grow(t->sending, &t->capsend, t->nsend + 1, sizeof *t->sending);
+    }
+    if (t->garble && p->dest != VW__OUTPUT && p->nmsgs) {
+        /* The wire check's test: the first message's kind one past the module's last. */
+        vw__msg_header *h = (vw__msg_header *)p->data;
+        h->kind = (uint16_t)w->m->nkinds;
+        t->garble = 0;
     }
     t->sending[t->nsend] = p;
     MPI_Isend((char *)p + WIRE_OFF, (int)(WIRE_HDR + p->used), MPI_BYTE, to, TAG_DATA, t->comm,
@@ -548,6 +555,7 @@ vw_status vw__mpi_attach(vw_world *w)
     pthread_cond_init(&t->cv, NULL);
     atomic_init(&t->sent, 0);
     t->rng = w->cfg.stress_seed * 0x9e3779b97f4a7c15ull + (uint64_t)rank * 7919u + 3;
+    t->garble = vw_test_fault("wire-garble");
     t->base.name = "mpi";
     t->base.send = tp_send;
     t->base.run = tp_run;

@@ -5,7 +5,7 @@
  * sequential reference, over two runs of the same world. Also: agreement between ranks,
  * a rank that dies in the middle of a run (for the fault tests), and a step of the
  * world's life that fails on one rank only (--fail: every rank must fail it, naming it),
- * and a peer that sends a message kind this process's module does not have (--wire).
+ * a peer whose module differs (--agree) and a peer that sends a garbled packet (--wire).
  *
  * usage: test_mpi_storm [--workers W] [--seeds N] [--agree] [--kill-rank R] [--exit-rank R]
  *                       [--fail STEP --fail-rank R] [--wire]
@@ -299,6 +299,59 @@ static void test_mismatch(int workers)
     }
 }
 
+/* Rank `bad` runs another build of the module: one message kind more, a kind of another
+   size, another record size, another counter or another name. Packets cross MPI as raw
+   bytes, so every process must refuse the world when it is created (the others' messages
+   would be read wrongly), naming that process. */
+static void test_module_mismatch(int workers)
+{
+    int rank = vw_engine_rank(), size = vw_engine_size(), bad = size - 1;
+    static const char *const what_name[] = {"same", "a kind more", "a kind's size",
+                                            "the record size", "a counter", "the name"};
+    static const vw_msg_kind more[NKINDS + 1] = {
+        [MSG_TOKEN] = {"token", sizeof(token), on_token, on_output},
+        [MSG_POSTED] = {"posted", sizeof(int64_t), on_posted, NULL, 0},
+        [NKINDS] = {"newer", sizeof(int64_t), on_posted, NULL, 0},
+    };
+    static const vw_msg_kind wider[NKINDS] = {
+        [MSG_TOKEN] = {"token", sizeof(token), on_token, on_output},
+        [MSG_POSTED] = {"posted", 2 * sizeof(int64_t), on_posted, NULL, 0},
+    };
+    static const char *const other_counters[NCOUNTERS] = {"received", "sum", "corrupt", "output",
+                                                          "posted twice"};
+    vw_box box = {{0, 0, 0}, {1, 1, 1}};
+    int dims[3] = {2, 1, 1};
+    for (int what = 0; what < 6; what++) {
+        vw_module m = storm_module;
+        if (what > 0 && rank == bad) {
+            if (what == 1) m.kinds = more, m.nkinds = NKINDS + 1;
+            if (what == 2) m.kinds = wider;
+            if (what == 3) m.object_size = 3 * sizeof(double), m.object_bounds = point_bounds;
+            if (what == 4) m.counters = other_counters;
+            if (what == 5) m.name = "mpi-storm 2";
+        }
+        vw_decomp *d;
+        CHECK_EQ_INT(vw_decomp_create_grid(&box, dims, &d), VW_OK);
+        storm st = {1, 2, 0, 0, -1, -1};
+        vw_config cfg;
+        vw_config_init(&cfg);
+        cfg.workers = workers;
+        vw_world *w = NULL;
+        vw_status got = vw_world_create(&m, &st, d, &cfg, &w);
+        if (what == 0 || size == 1) {
+            EXPECT(got == VW_OK, "%s: create %d: %s", what_name[what], (int)got, vw_world_errmsg(NULL));
+        } else {
+            char want[64];
+            snprintf(want, sizeof want, "process %d runs another module than process 0", bad);
+            EXPECT(got == VW_E_INVAL && !w && strstr(vw_world_errmsg(NULL), want),
+                   "rank %d, %s: create %d: '%s'", rank, what_name[what], (int)got,
+                   vw_world_errmsg(NULL));
+        }
+        vw_world_free(w);
+        vw_decomp_free(d);
+    }
+}
+
 /* One step of a world's life fails on rank `bad` only, the way a local failure does
    (out of memory, a cell that cannot be built): create (a bad worker speed), add (more
    objects than memory), update (an unknown object), replicas (a worker that does not
@@ -381,10 +434,11 @@ static int local_failure(const char *step, int bad, int workers)
     return 1; /* as a program whose step failed */
 }
 
-/* --wire: rank 1 runs a module with one message kind more than rank 0's (another build
-   of the program, which the world's fingerprint does not see) and sends that kind to
-   rank 0's cell. Rank 0 must stop the job naming the packet's sender, not index its
-   kinds past their end. */
+/* --wire: rank 1 garbles the first packet it sends (VW_FAULT=wire-garble: its first
+   message's kind becomes one past the module's last), as a bug or a corrupted buffer
+   would; another build of the module is refused when the world is created
+   (test_module_mismatch). Rank 0 must stop the job naming the packet's sender, not index
+   its kinds past their end. */
 static vw_status wire_build(vw_ctx *ctx, const void *objs, size_t n, void **state)
 {
     (void)ctx, (void)objs, (void)n;
@@ -399,20 +453,14 @@ static int wire_step(vw_ctx *ctx, void *state)
     if (vw_ctx_process(ctx) != 1 || vw_ctx_cell(ctx) != 1 || sent) return 0;
     sent = 1;
     int64_t v = 7;
-    vw_send_cell(ctx, 0, 2, &v);
+    vw_send_cell(ctx, 0, MSG_POSTED, &v);
     return 1;
 }
 
-static int wire_mismatch(void)
+static int wire_garbled(void)
 {
-    static const vw_msg_kind wkinds[3] = {
-        [MSG_TOKEN] = {"token", sizeof(token), on_token, on_output},
-        [MSG_POSTED] = {"posted", sizeof(int64_t), on_posted, NULL, 0},
-        [2] = {"newer", sizeof(int64_t), on_posted, NULL, 0},
-    };
+    if (vw_engine_rank() == 1) setenv("VW_FAULT", "wire-garble", 1); /* read by the transport */
     vw_module m = storm_module;
-    m.kinds = wkinds;
-    m.nkinds = vw_engine_rank() == 1 ? 3 : 2;
     m.cell_build = wire_build;
     m.cell_free = NULL;
     m.step = wire_step;
@@ -427,7 +475,7 @@ static int wire_mismatch(void)
     vw_world *w;
     CHECK_EQ_INT(vw_world_create(&m, &st, d, &cfg, &w), VW_OK);
     CHECK_EQ_INT(vw_world_run(w), VW_OK);
-    fprintf(stderr, "test_mpi_storm: process %d: the run ended without noticing the stray kind\n",
+    fprintf(stderr, "test_mpi_storm: process %d: the run ended without noticing the garbled packet\n",
             vw_engine_rank());
     vw_world_free(w);
     vw_decomp_free(d);
@@ -459,7 +507,7 @@ int main(int argc, char **argv)
     }
     int rank = vw_engine_rank();
     if (wire || fail) {
-        int rc = wire ? wire_mismatch() : local_failure(fail, fail_rank, workers);
+        int rc = wire ? wire_garbled() : local_failure(fail, fail_rank, workers);
         vw_engine_finish();
         return rc;
     }
@@ -467,6 +515,7 @@ int main(int argc, char **argv)
         for (int bad = 0; bad <= vw_engine_size(); bad++) test_agree(bad);
         for (int bad = 0; bad <= vw_engine_size(); bad++) test_config_agree(bad);
         test_mismatch(workers);
+        test_module_mismatch(workers);
         if (rank == 0) printf("agreement: %d checks, %d failed\n", vw_test_checks, vw_test_failures);
         vw_engine_finish();
         return vw_test_failures ? 1 : 0;

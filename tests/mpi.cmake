@@ -84,8 +84,9 @@ vw_mpi_script_test(mpi_rank_input 2 rank_input.sh 240
 vw_mpi_script_test(mpi_rank_alone 2 rank_alone.sh 150
                    $<TARGET_FILE:vwalls_tool> ${PROJECT_SOURCE_DIR}/tests/data/good/mixed.nff)
 
-# Faults: the job ends within 10 s, non-zero, naming the rank.
-foreach(mode kill exit)
+# Faults: the job ends within 10 s, non-zero, naming the rank (a rank that hangs: by the
+# launcher's time limit, MPIEXEC_TIMEOUT).
+foreach(mode kill exit hang)
   vw_mpi_script_test(mpi_fault_${mode} 4 fault.sh 60 ${mode} $<TARGET_FILE:test_mpi_storm>)
 endforeach()
 

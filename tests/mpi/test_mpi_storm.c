@@ -8,6 +8,7 @@
  * a peer whose module differs (--agree) and a peer that sends a garbled packet (--wire).
  *
  * usage: test_mpi_storm [--workers W] [--seeds N] [--agree] [--kill-rank R] [--exit-rank R]
+ *                       [--hang-rank R]
  *                       [--fail STEP --fail-rank R] [--wire]
  * Runs alone (threads engine) or under mpirun; honours VW_STRESS / VW_STRESS_SPLIT.
  */
@@ -39,6 +40,8 @@ typedef struct storm {
     int fail_run;         /* rank + 1 whose handler fails the run (0: none); then every
                              cell's step() sends tokens for ever, so the run can only end
                              if every rank drops its work */
+    int hang_rank1;       /* rank + 1 whose handler hangs (0: none): a rank alive but stuck,
+                             which only the launcher's time limit ends (MPIEXEC_TIMEOUT) */
 } storm;
 
 static void fill(token *t, uint64_t key, uint32_t hops)
@@ -115,6 +118,10 @@ static void on_token(vw_ctx *ctx, void *state, const void *msg)
     storm *st = vw_ctx_user(ctx);
     static _Atomic long handled;
     if (st->kill_rank == vw_ctx_process(ctx) && ++handled == 500) raise(SIGKILL);
+    if (st->hang_rank1 == vw_ctx_process(ctx) + 1 && ++handled == 500) {
+        fprintf(stderr, "test_mpi_storm: rank %d hangs on purpose\n", vw_ctx_process(ctx));
+        for (;;) pause(); /* its communication thread goes on: alive, but never done */
+    }
     if (st->fail_run == vw_ctx_process(ctx) + 1 && ++handled == 2000)
         vw_ctx_fail(ctx, VW_E_NOMEM, "no room for token %ld", (long)handled);
     token check;
@@ -485,6 +492,7 @@ static int wire_garbled(void)
 int main(int argc, char **argv)
 {
     int workers = 2, seeds = 3, agree = 0, kill_rank = -1, exit_rank = -1, fail_rank = 1, wire = 0;
+    int hang_rank = -1;
     const char *fail = NULL;
     for (int i = 1; i < argc; i++) {
         if (!strcmp(argv[i], "--workers") && i + 1 < argc) workers = atoi(argv[++i]);
@@ -492,6 +500,7 @@ int main(int argc, char **argv)
         else if (!strcmp(argv[i], "--agree")) agree = 1;
         else if (!strcmp(argv[i], "--kill-rank") && i + 1 < argc) kill_rank = atoi(argv[++i]);
         else if (!strcmp(argv[i], "--exit-rank") && i + 1 < argc) exit_rank = atoi(argv[++i]);
+        else if (!strcmp(argv[i], "--hang-rank") && i + 1 < argc) hang_rank = atoi(argv[++i]);
         else if (!strcmp(argv[i], "--fail") && i + 1 < argc) fail = argv[++i];
         else if (!strcmp(argv[i], "--wire")) wire = 1;
         else if (!strcmp(argv[i], "--fail-rank") && i + 1 < argc) fail_rank = atoi(argv[++i]);
@@ -530,7 +539,8 @@ int main(int argc, char **argv)
             vw_decomp *d;
             CHECK_EQ_INT(vw_decomp_create_grid(&box, dims, &d), VW_OK);
             int ncells = vw_decomp_cell_count(d);
-            storm st = {(uint64_t)seed * 104729u + li, ncells, 5 + (seed * 7 + (int)li) % 30, 0, kill_rank, -1};
+            storm st = {(uint64_t)seed * 104729u + li, ncells, 5 + (seed * 7 + (int)li) % 30, 0, kill_rank, -1,
+                        0, hang_rank + 1};
             int64_t *per_cell = calloc((size_t)ncells, sizeof *per_cell);
             int64_t sum = 0, outputs = 0, outsum = 0;
             for (int c = 0; c < ncells; c++)

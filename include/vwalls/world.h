@@ -85,7 +85,8 @@ VW_API void vw_config_init(vw_config *c);
 VW_API vw_status vw_world_create(const vw_module *m, void *user, const vw_decomp *d,
                                  const vw_config *c, vw_world **out);
 VW_API void vw_world_free(vw_world *w);
-/* The first error's message, with detail (sqlite3_errmsg style). With w NULL: why this
+/* The message of the last step that failed, with detail (sqlite3_errmsg style: read it
+   before the next step, which clears it). With w NULL: why this
    thread's last vw_world_create failed (which leaves no world to ask), e.g. "processes
    were given different worker counts (1 to 2)". */
 VW_API const char *vw_world_errmsg(const vw_world *w);
@@ -185,7 +186,7 @@ VW_API uint64_t vw_world_migrated(const vw_world *w);
 /* The stats JSON (docs/runtime.md, Statistics), written by the output process only,
    through vw_outfile (vwalls/outfile.h: complete or absent). extra_json: more
    top-level members ("\"rays\": {...}") or NULL. On failure vw_world_errmsg() says
-   "path: reason", unless the world already holds an earlier error (the first is kept). */
+   "path: reason". */
 VW_API vw_status vw_world_write_stats(vw_world *w, const char *path, const char *command,
                                       const char *extra_json);
 

@@ -85,7 +85,6 @@ static double units_lambda(const vw_world *w, const double *load, const double *
 static vw_status balance_duplicate(vw_world *w, const double *load, const vw_balance_params *p,
                                    const vw_balance_apply *a, vw_balance_report *r)
 {
-    vw_status before_err = w->err;
     int max_extra = p->max_extra > 0 ? p->max_extra : 4 * w->gworkers;
     size_t nextra = sizeof(int) * (size_t)max_extra;
     int *pc = vw_test_fault("balance-copies-nomem") ? NULL : malloc(nextra), *pw = malloc(nextra);
@@ -112,7 +111,7 @@ static vw_status balance_duplicate(vw_world *w, const double *load, const vw_bal
     if (pays && !held) st = VW_E_NOMEM;
     /* The plan is each process's own (from the same loads: only memory can differ), and
        the copies are collective: all fail, or none waits for one in them. */
-    st = vw__world_step_agreed(w, st, before_err, "vw_balance_world");
+    st = vw__world_step_agreed(w, st, "vw_balance_world");
     for (int c = 0; pays && st == VW_OK && c < w->ncells; c++) {
         const vw__cell *cl = &w->cells[c];
         for (int u = 0; u <= cl->nreps; u++) {
@@ -146,6 +145,7 @@ vw_status vw_balance_world(vw_world *w, const vw_load_field *f, const vw_balance
                            const vw_balance_apply *a, vw_balance_report *rep)
 {
     if (!w || !f || !p) return VW_E_INVAL;
+    vw__world_begin_step(w);
     double t0 = vw__now();
     vw_balance_report r;
     memset(&r, 0, sizeof r);
@@ -165,7 +165,6 @@ vw_status vw_balance_world(vw_world *w, const vw_load_field *f, const vw_balance
 
     /* Before: the field's loads on the current layout and mapping (the field was made
        from, or calibrated by, the last measurement, so these are the measured loads). */
-    vw_status before_err = w->err;
     double *load =
         vw_test_fault("balance-plan-nomem") ? NULL : malloc(sizeof(double) * VW_MAX_CELLS);
     int *map = malloc(sizeof(int) * VW_MAX_CELLS);
@@ -180,7 +179,7 @@ vw_status vw_balance_world(vw_world *w, const vw_load_field *f, const vw_balance
         /* One agreement on every process: balance_duplicate's, or, without memory for
            the loads, this one. */
         st = st == VW_OK ? balance_duplicate(w, load, &pp, a, &r)
-                         : vw__world_step_agreed(w, st, before_err, "vw_balance_world");
+                         : vw__world_step_agreed(w, st, "vw_balance_world");
         goto done;
     }
     if (st == VW_OK) st = vw_balance_decompose(w->decomp, f, &pp, &nd, map);
@@ -207,7 +206,7 @@ vw_status vw_balance_world(vw_world *w, const vw_load_field *f, const vw_balance
     }
     /* Each process plans alone, from the same field, so only memory can make the plans
        differ: all fail, or none waits for one in the redecomposition. */
-    st = vw__world_step_agreed(w, st, before_err, "vw_balance_world");
+    st = vw__world_step_agreed(w, st, "vw_balance_world");
     if (st == VW_OK && pays) {
         uint64_t before = w->migrated;
         st = vw_world_redecompose(w, nd, map);

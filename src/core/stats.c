@@ -187,6 +187,7 @@ vw_status vw_world_write_stats(vw_world *w, const char *path, const char *comman
                                const char *extra_json)
 {
     if (!w || !path) return VW_E_INVAL;
+    vw__world_begin_step(w);
     if (w->rank != 0) return VW_OK;
     char err[512];
     vw_outfile *of;

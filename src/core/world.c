@@ -56,18 +56,16 @@ const char *vw_world_errmsg(const vw_world *w)
    that process away (to vw_world_free, MPI_Finalize) while the others wait for it in
    their next collective call, for ever. So each step ends in agreement: every process
    returns the status of the lowest failing one, and holds "rank R: its message" as the
-   world's error (that process too, unless it already held an earlier error: the first
-   is kept). One MPI_Allreduce of an int when all is well. `before` is w->err before the
-   step; `step` names it where the failure left no message of its own. */
-vw_status vw__world_step_agreed(vw_world *w, vw_status st, vw_status before, const char *step)
+   world's error (that process too). One MPI_Allreduce of an int when all is well.
+   `step` names the step where the failure left no message of its own. */
+vw_status vw__world_step_agreed(vw_world *w, vw_status st, const char *step)
 {
     char msg[512] = "";
-    if (st != VW_OK && before == VW_OK && w->err == VW_OK)
-        vw__world_error(w, st, "%s: %s", step, vw_status_message(st));
-    if (st != VW_OK) snprintf(msg, sizeof msg, "%s", before == VW_OK ? w->errmsg : vw_status_message(st));
+    if (st != VW_OK && w->err == VW_OK) vw__world_error(w, st, "%s: %s", step, vw_status_message(st));
+    if (st != VW_OK) snprintf(msg, sizeof msg, "%s", w->errmsg);
     if (!w->transport) return st;
     vw_status all = vw_world_agree(w, st, msg, sizeof msg);
-    if (all != VW_OK && before == VW_OK) {
+    if (all != VW_OK) {
         w->err = VW_OK; /* this step's own message gives way to the agreed one */
         vw__world_error(w, all, "%s", msg);
     }
@@ -352,7 +350,7 @@ vw_status vw_world_create(const vw_module *m, void *user, const vw_decomp *d, co
     if (st == VW_OK) st = map_cells(w, c ? c->cell_worker : NULL);
     /* Every process made the transport (vw__mpi_attach agrees on that); what failed
        after it may have failed on some processes only. */
-    if (w->transport) st = vw__world_step_agreed(w, st, VW_OK, "vw_world_create");
+    if (w->transport) st = vw__world_step_agreed(w, st, "vw_world_create");
     if (st != VW_OK) {
         create_failed(st, "%s", w->err != VW_OK ? w->errmsg : vw_status_message(st));
         vw_world_free(w);
@@ -478,8 +476,8 @@ static vw_status add_objects(vw_world *w, const void *objects, size_t n)
 vw_status vw_world_add_objects(vw_world *w, const void *objects, size_t n)
 {
     if (!w) return VW_E_INVAL;
-    vw_status before = w->err;
-    return vw__world_step_agreed(w, add_objects(w, objects, n), before, "vw_world_add_objects");
+    vw__world_begin_step(w);
+    return vw__world_step_agreed(w, add_objects(w, objects, n), "vw_world_add_objects");
 }
 
 static vw_status update_object(vw_world *w, size_t id, const void *object)
@@ -509,8 +507,8 @@ static vw_status update_object(vw_world *w, size_t id, const void *object)
 vw_status vw_world_update_object(vw_world *w, size_t id, const void *object)
 {
     if (!w) return VW_E_INVAL;
-    vw_status before = w->err;
-    return vw__world_step_agreed(w, update_object(w, id, object), before, "vw_world_update_object");
+    vw__world_begin_step(w);
+    return vw__world_step_agreed(w, update_object(w, id, object), "vw_world_update_object");
 }
 
 int vw_world_cells_of_object(const vw_world *w, size_t id, int *out, int max)
@@ -565,6 +563,7 @@ static uint64_t world_fingerprint(const vw_world *w)
 vw_status vw_world_commit(vw_world *w)
 {
     if (!w) return VW_E_INVAL;
+    vw__world_begin_step(w);
     if (w->transport) {
         int r = vw__mpi_first_differing(w, world_fingerprint(w));
         if (r >= 0)
@@ -596,6 +595,7 @@ vw_status vw_world_post(vw_world *w, int cell, int kind, const void *msg)
     if (!w || cell < 0 || cell >= w->ncells || kind < 0 || kind >= w->m->nkinds ||
         (!msg && w->m->kinds[kind].size)) /* a kind of size 0 has nothing to point to */
         return VW_E_INVAL;
+    vw__world_begin_step(w);
     if (!w->m->kinds[kind].handle)
         return vw__world_error(w, VW_E_INVAL, "posted message kind %d to cell %d, but the kind "
                                "has no handle", kind, cell);
@@ -623,6 +623,7 @@ vw_status vw_world_post(vw_world *w, int cell, int kind, const void *msg)
 vw_status vw_world_run(vw_world *w)
 {
     if (!w) return VW_E_INVAL;
+    vw__world_begin_step(w);
     if (!w->committed) {
         vw_status st = vw_world_commit(w);
         if (st != VW_OK) return st;
@@ -686,8 +687,8 @@ static vw_status redecompose(vw_world *w, const vw_decomp *d, const int *cell_wo
 vw_status vw_world_redecompose(vw_world *w, const vw_decomp *d, const int *cell_worker)
 {
     if (!w) return VW_E_INVAL;
-    vw_status before = w->err;
-    return vw__world_step_agreed(w, redecompose(w, d, cell_worker), before, "vw_world_redecompose");
+    vw__world_begin_step(w);
+    return vw__world_step_agreed(w, redecompose(w, d, cell_worker), "vw_world_redecompose");
 }
 
 /* ---- duplicated cells --------------------------------------------------------------- */
@@ -856,8 +857,8 @@ static vw_status set_replicas(vw_world *w, int cell, const int *workers, int n)
 vw_status vw_world_set_replicas(vw_world *w, int cell, const int *workers, int n)
 {
     if (!w) return VW_E_INVAL;
-    vw_status before = w->err;
-    return vw__world_step_agreed(w, set_replicas(w, cell, workers, n), before,
+    vw__world_begin_step(w);
+    return vw__world_step_agreed(w, set_replicas(w, cell, workers, n),
                                  "vw_world_set_replicas");
 }
 

@@ -244,12 +244,19 @@ struct vw_world {
 /* The fraction of a cell's work that its unit u (0 = the master, r = copy r) takes: 1
    without copies. */
 double vw__unit_share(const vw__cell *c, int u);
+/* Records the first error of the current step (a public call: create, add, update, set
+   copies, redecompose or remap, commit, post, run, balance, write stats) as the world's
+   error with its message; later ones within the step (wrappers of the same failure)
+   keep it. */
 vw_status vw__world_error(vw_world *w, vw_status st, const char *fmt, ...)
     __attribute__((format(printf, 3, 4)));
+/* A public step begins: the last step's error is no longer the world's (vw_world_errmsg
+   tells the last failed step's, not the world's first). */
+static inline void vw__world_begin_step(vw_world *w) { w->err = VW_OK; }
 int vw__worker_process(const vw_world *w, int global_worker);
-/* Ends a collective step in agreement (see world.c): st is this process's outcome,
-   before w->err before the step, step its name for a failure without a message. */
-vw_status vw__world_step_agreed(vw_world *w, vw_status st, vw_status before, const char *step);
+/* Ends a collective step in agreement (see world.c): st is this process's outcome, step
+   its name for a failure without a message. */
+vw_status vw__world_step_agreed(vw_world *w, vw_status st, const char *step);
 /* calloc for n items of `size`, aligned to and padded to whole cache lines. */
 void *vw__calloc_lines(size_t n, size_t size);
 vw_status vw__world_build_cell(vw_world *w, int cell, vw__worker *wk);

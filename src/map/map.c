@@ -244,6 +244,7 @@ vw_status vw_map_compute(vw_map_kind kind, const vw_decomp *d, const double *cel
 vw_status vw_world_remap(vw_world *w, const int *cell_worker)
 {
     if (!w || !cell_worker) return VW_E_INVAL;
+    vw__world_begin_step(w);
     int built = 0;
     for (int c = 0; c < w->ncells; c++) built |= w->cells[c].built;
     uint64_t before = w->migrated;

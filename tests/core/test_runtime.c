@@ -523,6 +523,12 @@ static int test_run_fail(void)
             atomic_store(&fail_packets, how == FLOOD_PACKET);
             expect_failed_run(w, workers, statuses[how], texts[how], what);
             atomic_store(&fail_packets, 0);
+            /* A second failed run tells its own failure, not the first run's. */
+            flood = FLOOD_STEP;
+            fail_after = 2000;
+            char again[80];
+            snprintf(again, sizeof again, "%s, then a step fails", what);
+            expect_failed_run(w, workers, VW_E_INPUT, "step 2000 found bad input", again);
             /* The world runs again: a chain of hops arrives whole. */
             flood = FLOOD_NONE;
             int64_t before = vw_world_counter(w, CNT_HOPS);

@@ -190,11 +190,7 @@ vw_status rt_anim_apply(rt_anim *a, const vw_edit *edits, size_t n, int check, i
         /* Failed on every process alike (the dynscene agrees): "rank R: what" becomes
            "rank R: applying edits: what", the form of the agreement below, which would
            name this process instead. */
-        const char *m = vw_dynscene_errmsg(a->ds), *colon = strstr(m, ": ");
-        if (!strncmp(m, "rank ", 5) && colon)
-            snprintf(err, errlen, "%.*s: applying edits: %s", (int)(colon - m), m, colon + 2);
-        else
-            snprintf(err, errlen, "applying edits: %s", m);
+        vw_errmsg_wrap(err, errlen, "applying edits", vw_dynscene_errmsg(a->ds));
         rs->apply_s += now() - t0;
         return st;
     }

@@ -106,9 +106,13 @@ VW_API vw_status vw_collider_redecompose(vw_collider *c, const vw_decomp *d,
                                          const int *cell_worker);
 /* One distributed run for n probes. *out (malloc'ed, free with free()) gets the contacts,
    one per (tag, obstacle), sorted by tag then obstacle, identical on every process.
-   Collective under MPI: every process passes the same probes. */
+   Collective under MPI: every process passes the same probes. A failure (of the posting,
+   the run or the room for *out) fails it on every process, with the same
+   vw_collider_errmsg ("rank R: ..." under MPI). */
 VW_API vw_status vw_collider_query(vw_collider *c, const vw_probe *probes, size_t n,
                                    vw_contact **out, size_t *nout);
+/* Why the last vw_collider_query failed ("no error" when it did not). */
+VW_API const char *vw_collider_errmsg(const vw_collider *c);
 VW_API vw_world *vw_collider_world(vw_collider *c);
 
 /* ---- the edit language (docs/edit-language.md) -------------------------------------- */

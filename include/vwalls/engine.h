@@ -55,6 +55,11 @@ VW_API int vw_engine_size(void);
 VW_API vw_status vw_engine_agree(vw_status local, char *msg, size_t len);
 VW_API vw_status vw_world_agree(vw_world *w, vw_status local, char *msg, size_t len);
 VW_API vw_status vw_config_agree(const vw_config *c, vw_status local, char *msg, size_t len);
+/* "what: msg" into dst (len bytes), keeping an agreed message's leading "rank R: " in
+   front: "rank 1: cell 2: no room" wrapped in "applying edits" is "rank 1: applying
+   edits: cell 2: no room", so the rank that failed leads every message alike. dst must
+   not overlap msg. */
+VW_API void vw_errmsg_wrap(char *dst, size_t len, const char *what, const char *msg);
 
 /* Broadcast (collective on MPI_COMM_WORLD: every rank must call it with the same n): the
    n bytes at buf on rank 0 replace those at buf on every other rank. For input only rank

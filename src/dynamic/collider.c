@@ -25,6 +25,8 @@ struct vw_collider {
     pthread_mutex_t mu;    /* guards the contact list */
     vw_contact *contacts;
     size_t ncontacts, capcontacts;
+    char errmsg[512];      /* why the last query failed (vw_collider_errmsg) */
+    int fault_contacts;    /* VW_FAULT=collider-contacts-nomem: no room for contacts */
 };
 
 /* A cell's shapes sorted by the low x of their bounds, with the bounds kept beside
@@ -169,7 +171,7 @@ static void handle_contact(vw_ctx *ctx, void *state, const void *msg)
     pthread_mutex_lock(&c->mu);
     if (c->ncontacts == c->capcontacts) {
         size_t cap = c->capcontacts ? 2 * c->capcontacts : 64;
-        vw_contact *n = realloc(c->contacts, cap * sizeof *n);
+        vw_contact *n = c->fault_contacts ? NULL : realloc(c->contacts, cap * sizeof *n);
         if (!n) { /* a lost contact would accept a colliding move: the query fails */
             pthread_mutex_unlock(&c->mu);
             vw_ctx_fail(ctx, VW_E_NOMEM, "out of memory for %zu contacts", cap);
@@ -305,6 +307,7 @@ vw_status vw_collider_create(const vw_decomp *d, const vw_config *cfg, double to
         return VW_E_NOMEM;
     }
     c->tol = tol > 0 ? tol : 0;
+    c->fault_contacts = vw_test_fault("collider-contacts-nomem");
     pthread_mutex_init(&c->mu, NULL);
     vw_status st = vw_world_create(&collider_module, c, d, cfg, &c->world);
     if (st == VW_OK && (st = mailboxes(c)) == VW_E_INVAL) st = give_every_process_a_cell(c, d);
@@ -346,6 +349,11 @@ vw_status vw_collider_redecompose(vw_collider *c, const vw_decomp *d, const int 
     return st;
 }
 
+const char *vw_collider_errmsg(const vw_collider *c)
+{
+    return !c ? "no collider" : c->errmsg[0] ? c->errmsg : "no error";
+}
+
 vw_world *vw_collider_world(vw_collider *c) { return c ? c->world : NULL; }
 
 static int contact_cmp(const void *a, const void *b)
@@ -362,6 +370,7 @@ vw_status vw_collider_query(vw_collider *c, const vw_probe *probes, size_t n, vw
     if (!c || !out || !nout || (n && !probes)) return VW_E_INVAL;
     *out = NULL;
     *nout = 0;
+    c->errmsg[0] = 0;
     const vw_decomp *d = vw_world_decomp(c->world);
     int nc = vw_decomp_cell_count(d);
     int *cells = malloc(sizeof(int) * (size_t)nc);
@@ -388,9 +397,15 @@ vw_status vw_collider_query(vw_collider *c, const vw_probe *probes, size_t n, vw
     free(cells);
     c->ncontacts = 0;
     /* The probes were posted on each process alone; the run is collective. */
-    st = vw_world_agree(c->world, st, NULL, 0);
-    if (st == VW_OK) st = vw_world_run(c->world);
+    if (st != VW_OK) snprintf(c->errmsg, sizeof c->errmsg, "posting the probes: %s", vw_status_message(st));
+    st = vw_world_agree(c->world, st, c->errmsg, sizeof c->errmsg);
     if (st != VW_OK) return st;
+    st = vw_world_run(c->world);
+    if (st != VW_OK) {
+        /* "rank R: cell C: ..." from the run, the same on every process */
+        snprintf(c->errmsg, sizeof c->errmsg, "%s", vw_world_errmsg(c->world));
+        return st;
+    }
     if (c->ncontacts) qsort(c->contacts, c->ncontacts, sizeof *c->contacts, contact_cmp);
     /* One contact per (tag, obstacle): the same obstacle is held by every cell it
        overlaps, and a polygon is several shapes. */
@@ -403,7 +418,12 @@ vw_status vw_collider_query(vw_collider *c, const vw_probe *probes, size_t n, vw
             c->contacts[m++] = c->contacts[i];
     }
     vw_contact *r = malloc((m ? m : 1) * sizeof *r);
-    if (!r) return VW_E_NOMEM;
+    if (!r) snprintf(c->errmsg, sizeof c->errmsg, "out of memory for %zu contacts", m);
+    st = vw_world_agree(c->world, r ? VW_OK : VW_E_NOMEM, c->errmsg, sizeof c->errmsg);
+    if (st != VW_OK) {
+        free(r);
+        return st;
+    }
     if (m) memcpy(r, c->contacts, m * sizeof *r);
     *out = r;
     *nout = m;

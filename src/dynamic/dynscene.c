@@ -740,11 +740,12 @@ static vw_status run_batch(vw_dynscene *ds, const vw_edit *edits, size_t n, int 
     size_t nct = 0;
     /* The probes were made alone; the query is collective. */
     st = agree(ds, st, "preparing a batch of edits");
+    const char *why = NULL; /* the query's own message, when it failed */
     if (st == VW_OK && check) {
         if (ds->brute)
             st = brute_contacts(ds, &b, &ct, &nct);
-        else
-            st = vw_collider_query(ds->col, b.probes, b.nprobes, &ct, &nct);
+        else if ((st = vw_collider_query(ds->col, b.probes, b.nprobes, &ct, &nct)) != VW_OK)
+            why = vw_collider_errmsg(ds->col);
         if (st == VW_OK && nct) qsort(ct, nct, sizeof *ct, contact_cmp);
     }
     /* moved[id] != 0: an earlier edit of this batch was accepted for id (its old
@@ -805,7 +806,14 @@ static vw_status run_batch(vw_dynscene *ds, const vw_edit *edits, size_t n, int 
     /* Commit the accepted edits, in order (adds take their ids in order): their room
        first, agreed, since each commit updates the collider (collective). */
     if (st == VW_OK) st = reserve_commits(ds, pd, res, ok, n);
-    st = agree(ds, st, "deciding a batch of edits");
+    if (why) {
+        /* The query failed on every process alike, with one message: no agreement
+           (it would name the lowest rank, not the one that failed). */
+        if (!ds->errmsg[0])
+            vw_errmsg_wrap(ds->errmsg, sizeof ds->errmsg, "checking a batch of edits for collisions", why);
+    } else {
+        st = agree(ds, st, "deciding a batch of edits");
+    }
     for (size_t i = 0; i < n && st == VW_OK; i++) {
         if (!ok[i] || res[i].outcome != VW_OUT_ACCEPTED) continue;
         st = commit_edit(ds, &pd[i], ends ? ends + pd[i].probe0 : NULL);

@@ -38,6 +38,19 @@ for f in batch commit; do
   grep -q "^vwalls animate: applying edits: $what: out of memory\$" err.txt ||
     fail "dynscene-$f-nomem: message: $(cat err.txt)"
 done
+# No room for the contacts of the collider's query (VW_FAULT=collider-contacts-nomem):
+# the query fails, and the message says where (cell C), not only that a batch failed.
+# shellcheck disable=SC2046
+set -- $(grep -m1 '^s ' scene.nff)
+printf 'check on\nadd sphere %s %s %s 0.05\nframe\n' "$2" "$3" "$4" > hit.txt
+VW_FAULT=collider-contacts-nomem "$V" animate scene.nff hit.txt -o 'm%02d.png' --cells 2x2x1 --workers 2 \
+  --quiet 2>err.txt; rc=$?
+[ $rc -eq 1 ] || fail "collider-contacts-nomem: status $rc"
+grep -q "^vwalls animate: applying edits: checking a batch of edits for collisions: cell [0-9]*: out of memory for 64 contacts\$" err.txt ||
+  fail "collider-contacts-nomem: message: $(cat err.txt)"
+"$V" animate scene.nff hit.txt -o 'm%02d.png' --cells 2x2x1 --workers 2 --quiet --log hit.log ||
+  fail "hit.txt without the fault: status $?"
+grep -q "rejected: collides at its destination" hit.log || fail "hit.txt collides with nothing: $(cat hit.log)"
 # --farm: auto is all (every worker holds every cell), idle with --balance; every mode
 # gives the same frames.
 grep -q '"farm": "all"' s.json || fail "default farm is not all: $(grep -o '"farm": "[a-z]*"' s.json)"

@@ -32,7 +32,8 @@
 # (rt_anim_apply: the touched cells' marks anim-apply-nomem, room for an added object's
 # records anim-records-nomem) and its rebalance between frames (rt_anim_balance:
 # anim-balance-nomem); and inside vw_dynscene_apply, a batch's probes and pending edits
-# (dynscene-batch-nomem) and the room for its accepted edits (dynscene-commit-nomem),
+# (dynscene-batch-nomem), the room for its accepted edits (dynscene-commit-nomem) and the
+# collider's contacts (collider-contacts-nomem: the query fails on every rank alike),
 # each agreed before the collider's next collective step.
 # usage: rank_status.sh VWALLS NP "MPIEXEC -n NP [flags]"
 vwalls=$1 np=$2 launch=$3
@@ -42,6 +43,10 @@ fail=0
 "$vwalls" gen cornell -o "$dir/cornell.nff" || { echo "rank_status.sh: FAIL: gen cornell"; exit 1; }
 "$vwalls" gen balls --size 1 -o "$dir/balls.nff" || { echo "rank_status.sh: FAIL: gen balls"; exit 1; }
 printf 'move 0 0.01 0 0\nframe\n' >"$dir/edits"
+# an added sphere at the first sphere's centre: a contact for the collider to record
+# shellcheck disable=SC2046
+set -- $(grep -m1 '^s ' "$dir/balls.nff")
+printf 'check on\nadd sphere %s %s %s 0.05\nframe\n' "$2" "$3" "$4" >"$dir/hit"
 # (expanded by each rank's shell, not here)
 # shellcheck disable=SC2016
 rank='${OMPI_COMM_WORLD_RANK:-$PMI_RANK}'
@@ -203,6 +208,9 @@ for f in batch commit; do
         "^vwalls animate: rank 1: applying edits: $what: out of memory" \
         "$on1=dynscene-$f-nomem; \"$vwalls\" animate \"$dir/balls.nff\" \"$dir/edits\" -o \"$dir/a%d.png\" $small"
 done
+must_agree "animate, no room for the collider's contacts on rank 1" 1 \
+    "^vwalls animate: rank 1: applying edits: checking a batch of edits for collisions: cell [0-9]*: out of memory for 64 contacts" \
+    "$on1=collider-contacts-nomem; \"$vwalls\" animate \"$dir/balls.nff\" \"$dir/hit\" -o \"$dir/a%d.png\" $small"
 must_agree "animate --balance tensor, no memory for the rebalance on rank 1" 1 \
     "^vwalls animate: rank 1: balancing: the loads: out of memory" \
     "$on1=anim-balance-nomem; \"$vwalls\" animate \"$dir/balls.nff\" \"$dir/edits\" -o \"$dir/a%d.png\" --balance tensor --threshold 0 --trigger work $small"

@@ -297,7 +297,13 @@ static int check_writable(const char *opt, const char *path, char *err, size_t e
     else if (access(dir, W_OK | X_OK) != 0) bad = errno;
     if (bad) snprintf(err, errlen, "%s %s: cannot write: %s: %s", opt, path, dir, strerror(bad));
     free(dir);
-    return bad ? -1 : 0;
+    if (bad) return -1;
+    /* The rest as the write itself will meet it: a link followed into a directory that
+       cannot be written, a dangling link, a read-only file system. */
+    char why[768];
+    if (vw_outfile_check(path, why, sizeof why) == VW_OK) return 0;
+    snprintf(err, errlen, "%s %s", opt, why);
+    return -1;
 }
 
 int vw_cli_check_outputs(const char *cmd, const char *const *opts, const char *const *paths, int n)

@@ -53,6 +53,14 @@ VW_API vw_status vw_outfile_commit(vw_outfile *f, char *err, size_t errlen);
    (a device or a FIFO keeps what was already sent to it). Frees f; NULL is a no-op. */
 VW_API void vw_outfile_abort(vw_outfile *f);
 
+/* Could path be written now, as vw_outfile_open would write it? For a new name, a
+   regular file or a link to one, it makes the temporary file next to the target and
+   removes it at once (so a link into a directory that cannot be written, a read-only
+   file system or a dangling link fail here, with the message the open would give); a
+   device, a FIFO or a socket is not opened, only checked for write permission. For a
+   program that writes its outputs after long work: check them all first. */
+VW_API vw_status vw_outfile_check(const char *path, char *err, size_t errlen);
+
 /* The whole of buf[0..len) to path: open, write, commit. buf may be NULL only when len
    is 0 (VW_E_INVAL otherwise, and path is left as it was). */
 VW_API vw_status vw_outfile_write(const char *path, const void *buf, size_t len, char *err,

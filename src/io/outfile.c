@@ -399,6 +399,24 @@ VW_API void vw_outfile_abort(vw_outfile *f)
     outfile_free(f);
 }
 
+VW_API vw_status vw_outfile_check(const char *path, char *err, size_t errlen)
+{
+    struct stat st;
+    /* A device, a FIFO or a socket is written in place: not opened here (a FIFO's open
+       would wait for a reader), only asked whether it may be. */
+    if (path && *path && stat(path, &st) == 0 && !S_ISREG(st.st_mode) && !S_ISDIR(st.st_mode)) {
+        if (access(path, W_OK) == 0)
+            return VW_OK;
+        vw__errf(err, errlen, "%s: cannot open: %s", path, strerror(errno));
+        return VW_E_IO;
+    }
+    vw_outfile *f;
+    vw_status s = vw_outfile_open(path, &f, err, errlen);
+    if (s == VW_OK)
+        vw_outfile_abort(f);
+    return s;
+}
+
 VW_API vw_status vw_outfile_write(const char *path, const void *buf, size_t len, char *err,
                                   size_t errlen)
 {

@@ -2,8 +2,9 @@
  * new or regular file replaced whole; a symbolic link kept, the file it leads to
  * written; a device or a FIFO written in place and left what it was; a dangling link, a
  * directory and an empty name refused), the mode under the umask, that no failure
- * leaves a temporary file, and that vw_outfile_remove_temps() in a SIGTERM handler
- * leaves none behind whatever the writing threads were doing when the signal came.
+ * leaves a temporary file, that vw_outfile_remove_temps() in a SIGTERM handler
+ * leaves none behind whatever the writing threads were doing when the signal came, and
+ * that vw_outfile_check refuses what the open would, writing nothing.
  * Usage: test_io_outfile   (the device checks need CAP_MKNOD and are skipped without it)
  */
 #ifndef _GNU_SOURCE
@@ -339,6 +340,41 @@ static void remove_temps_ends_writing(void)
     CHECK(access(at("later.txt"), F_OK) != 0);
 }
 
+/* vw_outfile_check: what the open would refuse, refused without writing anything. */
+static void checks(void)
+{
+    char err[512];
+    /* a new name: allowed, and nothing made */
+    CHECK_EQ_INT(vw_outfile_check(at("chk-new.txt"), err, sizeof err), VW_OK);
+    CHECK(access(at("chk-new.txt"), F_OK) != 0);
+    /* a regular file: allowed, and left as it was */
+    CHECK_EQ_INT(put(at("chk-old.txt"), "kept", err, sizeof err), VW_OK);
+    CHECK_EQ_INT(vw_outfile_check(at("chk-old.txt"), err, sizeof err), VW_OK);
+    CHECK(strcmp(text_of(at("chk-old.txt")), "kept") == 0);
+    /* a link to a regular file: allowed; a dangling one, or one into a directory nobody
+       can create files in (/proc, even as root): refused with the open's message */
+    CHECK(symlink(at("chk-old.txt"), at("chk-link.txt")) == 0);
+    CHECK_EQ_INT(vw_outfile_check(at("chk-link.txt"), err, sizeof err), VW_OK);
+    CHECK(symlink(at("nodir/x.txt"), at("chk-dangling.txt")) == 0);
+    CHECK_EQ_INT(vw_outfile_check(at("chk-dangling.txt"), err, sizeof err), VW_E_IO);
+    EXPECT(strstr(err, "chk-dangling.txt: is a symbolic link to a file that does not exist"),
+           "dangling link: '%s'", err);
+    CHECK(symlink("/proc/version", at("chk-proc.txt")) == 0);
+    CHECK_EQ_INT(vw_outfile_check(at("chk-proc.txt"), err, sizeof err), VW_E_IO);
+    EXPECT(strstr(err, "chk-proc.txt: cannot create:"), "link into /proc: '%s'", err);
+    CHECK(strstr(text_of("/proc/version"), "Linux") != NULL);
+    /* a missing directory, a directory: refused */
+    CHECK_EQ_INT(vw_outfile_check(at("nodir/x.txt"), err, sizeof err), VW_E_IO);
+    CHECK_EQ_INT(vw_outfile_check(dir, err, sizeof err), VW_E_IO);
+    /* a device: allowed and not written; a FIFO without a reader: allowed at once (the
+       open would wait for a reader) */
+    CHECK_EQ_INT(vw_outfile_check("/dev/null", err, sizeof err), VW_OK);
+    CHECK(mkfifo(at("chk-fifo"), 0600) == 0);
+    CHECK_EQ_INT(vw_outfile_check(at("chk-fifo"), err, sizeof err), VW_OK);
+    CHECK_EQ_INT(temps_in(dir), 0);
+    CHECK(unlink(at("chk-fifo")) == 0);
+}
+
 int main(void)
 {
     snprintf(dir, sizeof dir, "/tmp/vw_outfile_XXXXXX");
@@ -348,7 +384,8 @@ int main(void)
     special_files();
     many_at_once();
     signal_rounds();
-    remove_temps_ends_writing();
+    checks();
+    remove_temps_ends_writing(); /* last: no vw_outfile opens after it */
     char cmd[128];
     snprintf(cmd, sizeof cmd, "rm -rf '%s'", dir);
     CHECK(system(cmd) == 0);

@@ -337,42 +337,23 @@ if(EXISTS /dev/full)
     endif()
   endforeach()
 endif()
-# An output that cannot be made (its directory is missing), whichever of the three: exit
-# 1 before the render, naming it, and no other output written (a --stats into a missing
-# directory used to fail after the image and the overlay were in place).
-foreach(bad "-o;${WORK}/nodir/i.png" "--overlay;${WORK}/nodir/o.png" "--stats;${WORK}/nodir/s.json")
-  file(REMOVE ${WORK}/keep.png ${WORK}/keep-o.png ${WORK}/keep.json)
-  set(args -o ${WORK}/keep.png --overlay ${WORK}/keep-o.png --stats ${WORK}/keep.json)
-  list(GET bad 0 opt)
-  list(GET bad 1 path)
-  list(FIND args ${opt} at)
-  math(EXPR at "${at} + 1")
-  list(REMOVE_AT args ${at})
-  list(INSERT args ${at} ${path})
-  execute_process(COMMAND ${VWALLS} render ${SCENE} ${args} --size 16x12 --quiet
-                  RESULT_VARIABLE rc ERROR_VARIABLE err)
-  if(NOT rc EQUAL 1 OR NOT err MATCHES "${opt} [^ ]*nodir/[^ ]*: cannot write: [^ ]*nodir: No such file")
-    message(FATAL_ERROR "render ${opt} into a missing directory: exit ${rc} (expected 1): ${err}")
-  endif()
-  foreach(f keep.png keep-o.png keep.json)
-    if(EXISTS ${WORK}/${f})
-      message(FATAL_ERROR "render ${opt} into a missing directory: ${f} written")
-    endif()
-  endforeach()
-endforeach()
-# An output that is a link the write could not follow (its target's directory cannot be
-# written into: /proc; or the link dangles): refused before the render like the above,
-# where the check used to look at the link's own directory only and the image was in
-# place when the overlay or the stats failed.
+# An output that cannot be made, whichever of the three: exit 1 before the render,
+# naming it, and no other output written. Its directory is missing (a --stats into a
+# missing directory used to fail after the image and the overlay were in place), or it
+# is a link the write could not follow: into a directory nobody can create files in
+# (/proc) or dangling (the check used to look at the link's own directory only).
 file(REMOVE ${WORK}/to-proc.png ${WORK}/dangling.json)
 file(CREATE_LINK /proc/version ${WORK}/to-proc.png SYMBOLIC)
 file(CREATE_LINK ${WORK}/nodir/s.json ${WORK}/dangling.json SYMBOLIC)
-foreach(bad "--overlay;${WORK}/to-proc.png;cannot create" "--stats;${WORK}/dangling.json;is a symbolic link to a file that does not exist")
+set(missing "cannot write: [^ ]*nodir: No such file")
+foreach(bad "-o;${WORK}/nodir/i.png;${missing}" "--overlay;${WORK}/nodir/o.png;${missing}"
+            "--stats;${WORK}/nodir/s.json;${missing}" "--overlay;${WORK}/to-proc.png;cannot create"
+            "--stats;${WORK}/dangling.json;is a symbolic link to a file that does not exist")
+  file(REMOVE ${WORK}/keep.png ${WORK}/keep-o.png ${WORK}/keep.json)
+  set(args -o ${WORK}/keep.png --overlay ${WORK}/keep-o.png --stats ${WORK}/keep.json)
   list(GET bad 0 opt)
   list(GET bad 1 path)
   list(GET bad 2 why)
-  file(REMOVE ${WORK}/keep.png ${WORK}/keep-o.png ${WORK}/keep.json)
-  set(args -o ${WORK}/keep.png --overlay ${WORK}/keep-o.png --stats ${WORK}/keep.json)
   list(FIND args ${opt} at)
   math(EXPR at "${at} + 1")
   list(REMOVE_AT args ${at})
@@ -380,11 +361,11 @@ foreach(bad "--overlay;${WORK}/to-proc.png;cannot create" "--stats;${WORK}/dangl
   execute_process(COMMAND ${VWALLS} render ${SCENE} ${args} --size 16x12 --quiet
                   RESULT_VARIABLE rc ERROR_VARIABLE err)
   if(NOT rc EQUAL 1 OR NOT err MATCHES "${opt} [^ ]*${path}: ${why}")
-    message(FATAL_ERROR "render ${opt} through a link: exit ${rc} (expected 1): ${err}")
+    message(FATAL_ERROR "render ${opt} ${path}: exit ${rc} (expected 1): ${err}")
   endif()
   foreach(f keep.png keep-o.png keep.json)
     if(EXISTS ${WORK}/${f})
-      message(FATAL_ERROR "render ${opt} through a link: ${f} written")
+      message(FATAL_ERROR "render ${opt} ${path}: ${f} written")
     endif()
   endforeach()
 endforeach()

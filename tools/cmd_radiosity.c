@@ -451,6 +451,9 @@ int vw_cmd_radiosity(int argc, char **argv)
     /* Only the output process checks the ledger and writes the outputs; every process
        exits with its status, agreed when the command has returned (vw_cli_job_status). */
     if (vw_world_is_output(w)) {
+        /* The final outputs (mesh, CSV, image, checkpoint, trace, stats) appear together
+           or not at all: released at done. */
+        vw_outfile_hold();
         rad_ledger L = rad_solver_ledger(s);
         if (vw_cli_fault("ledger")) L.error = INFINITY; /* tests: a run that fails the check */
         /* Checked before any file is written: a run whose energy does not add up is a
@@ -528,6 +531,10 @@ int vw_cmd_radiosity(int argc, char **argv)
                             "finer); give a smaller --sf or a larger --patch-size\n", o.sf);
     }
 done:
+    if (vw_outfile_release(rc == VW_EXIT_OK, err, sizeof err) != VW_OK && rc == VW_EXIT_OK) {
+        vw_cli_error(CMD, "%s", err);
+        rc = VW_EXIT_FAIL;
+    }
     free(r.trace);
     rad_solver_free(s);
     rad_mesh_free(&mesh);

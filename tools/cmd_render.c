@@ -592,6 +592,9 @@ int vw_cmd_render(int argc, char **argv)
     vw_world_add_time(w, "compute", t_run1 - t_run0);
 
     if (rt_job_is_output(job)) {
+        /* The image, the overlay and the stats appear together or not at all (a full
+           disk at the stats leaves no image): released below. */
+        vw_outfile_hold();
         const rt_shared *sh = rt_job_shared(job);
         int W = sh->view.width, H = sh->view.height;
         size_t n = (size_t)W * H * 3;
@@ -646,6 +649,10 @@ int vw_cmd_render(int argc, char **argv)
                 rc = VW_EXIT_FAIL;
             }
             free(extra);
+        }
+        if (vw_outfile_release(rc == VW_EXIT_OK, err, sizeof err) != VW_OK && rc == VW_EXIT_OK) {
+            vw_cli_error(CMD, "%s", err);
+            rc = VW_EXIT_FAIL;
         }
         if (!quiet && rc == VW_EXIT_OK) {
             long long eye = vw_world_counter(w, RT_C_EYE), refl = vw_world_counter(w, RT_C_REFLECT);

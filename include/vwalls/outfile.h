@@ -53,6 +53,20 @@ VW_API vw_status vw_outfile_commit(vw_outfile *f, char *err, size_t errlen);
    (a device or a FIFO keeps what was already sent to it). Frees f; NULL is a no-op. */
 VW_API void vw_outfile_abort(vw_outfile *f);
 
+/* Outputs that appear together or not at all. After vw_outfile_hold(), a commit that
+   wrote everything keeps its temporary file (complete, closed, still removed by
+   vw_outfile_remove_temps) and returns VW_OK; vw_outfile_release(1, ...) then renames
+   every held file into place, in the order committed, and vw_outfile_release(0, ...)
+   removes them all: a program holds before writing its outputs and releases with 1
+   only when all were written (a full disk at the last one leaves none of them). A
+   rename that fails (rare: the temporary file is in the target's directory) removes
+   that file and the ones after it, returns VW_E_IO with "path: cannot rename into
+   place: reason", and leaves the ones before it in place. Files written in place (a
+   device, a FIFO) are not held. Process-wide, for the thread that writes the outputs;
+   release ends the hold. */
+VW_API void vw_outfile_hold(void);
+VW_API vw_status vw_outfile_release(int place, char *err, size_t errlen);
+
 /* Could path be written now, as vw_outfile_open would write it? For a new name, a
    regular file or a link to one, it makes the temporary file next to the target and
    removes it at once (so a link into a directory that cannot be written, a read-only

@@ -38,7 +38,13 @@ struct vw_outfile {
     char *target; /* the regular file the temporary one replaces; NULL: written in place */
     char *tmp;    /* the temporary file, target.tmp.XXXXXX; NULL: written in place */
     int slot;     /* registry slot of tmp, -1 when not registered */
+    struct vw_outfile *held_next; /* the held commits, in order (vw_outfile_hold) */
 };
+
+/* Commits held by vw_outfile_hold() until vw_outfile_release(), oldest first. */
+static pthread_mutex_t held_mu = PTHREAD_MUTEX_INITIALIZER;
+static int holding;
+static struct vw_outfile *held_first, **held_last = &held_first;
 
 /* ---- the registry ---------------------------------------------------------------- */
 
@@ -371,6 +377,18 @@ VW_API vw_status vw_outfile_commit(vw_outfile *f, char *err, size_t errlen)
         vw__errf(err, errlen, "%s: write failed: %s", f->path, strerror(f->werr ? f->werr : EIO));
         st = VW_E_IO;
     }
+    if (f->tmp && !bad) {
+        pthread_mutex_lock(&held_mu);
+        int hold = holding;
+        if (hold) {
+            f->held_next = NULL;
+            *held_last = f;
+            held_last = &f->held_next;
+        }
+        pthread_mutex_unlock(&held_mu);
+        if (hold)
+            return VW_OK; /* complete, and put in place (or not) by vw_outfile_release */
+    }
     if (f->tmp) {
         int r = finish_temp(f, !bad);
         if (r == 1) {
@@ -397,6 +415,42 @@ VW_API void vw_outfile_abort(vw_outfile *f)
     if (f->tmp && finish_temp(f, 0) == 1)
         f->tmp = NULL;
     outfile_free(f);
+}
+
+VW_API void vw_outfile_hold(void)
+{
+    pthread_mutex_lock(&held_mu);
+    holding = 1;
+    pthread_mutex_unlock(&held_mu);
+}
+
+VW_API vw_status vw_outfile_release(int place, char *err, size_t errlen)
+{
+    pthread_mutex_lock(&held_mu);
+    vw_outfile *f = held_first;
+    held_first = NULL;
+    held_last = &held_first;
+    holding = 0;
+    pthread_mutex_unlock(&held_mu);
+    vw_status st = VW_OK;
+    while (f) {
+        vw_outfile *next = f->held_next;
+        int put = place && st == VW_OK;
+        int r = finish_temp(f, put);
+        if (r == 1) { /* the signal handler removed it */
+            f->tmp = NULL;
+            if (put) {
+                vw__errf(err, errlen, "%s: not written: the process is ending", f->path);
+                st = VW_E_STATE;
+            }
+        } else if (r < 0) {
+            vw__errf(err, errlen, "%s: cannot rename into place: %s", f->path, strerror(errno));
+            st = VW_E_IO;
+        }
+        outfile_free(f);
+        f = next;
+    }
+    return st;
 }
 
 VW_API vw_status vw_outfile_check(const char *path, char *err, size_t errlen)

@@ -4,7 +4,8 @@
  * directory and an empty name refused), the mode under the umask, that no failure
  * leaves a temporary file, that vw_outfile_remove_temps() in a SIGTERM handler
  * leaves none behind whatever the writing threads were doing when the signal came, and
- * that vw_outfile_check refuses what the open would, writing nothing.
+ * that vw_outfile_check refuses what the open would, writing nothing, and that held
+ * commits appear together or not at all.
  * Usage: test_io_outfile   (the device checks need CAP_MKNOD and are skipped without it)
  */
 #ifndef _GNU_SOURCE
@@ -375,6 +376,45 @@ static void checks(void)
     CHECK(unlink(at("chk-fifo")) == 0);
 }
 
+/* vw_outfile_hold / vw_outfile_release: held commits appear together, in order, or
+   not at all; a file written in place is not held. */
+static void held(void)
+{
+    char err[512];
+    CHECK_EQ_INT(put(at("held-a.txt"), "old a", err, sizeof err), VW_OK);
+    /* released with 0: none of them, and the old file as it was */
+    vw_outfile_hold();
+    CHECK_EQ_INT(put(at("held-a.txt"), "new a", err, sizeof err), VW_OK);
+    CHECK_EQ_INT(put(at("held-b.txt"), "new b", err, sizeof err), VW_OK);
+    CHECK(strcmp(text_of(at("held-a.txt")), "old a") == 0);
+    CHECK(access(at("held-b.txt"), F_OK) != 0);
+    temps_expected = 1;
+    CHECK_EQ_INT(temps_in(dir), 2); /* complete, waiting */
+    temps_expected = 0;
+    CHECK_EQ_INT(vw_outfile_release(0, err, sizeof err), VW_OK);
+    CHECK(strcmp(text_of(at("held-a.txt")), "old a") == 0);
+    CHECK(access(at("held-b.txt"), F_OK) != 0);
+    CHECK_EQ_INT(temps_in(dir), 0);
+    /* released with 1: all of them; /dev/null, written in place, is not held */
+    vw_outfile_hold();
+    CHECK_EQ_INT(put(at("held-a.txt"), "new a", err, sizeof err), VW_OK);
+    CHECK_EQ_INT(put("/dev/null", "nothing", err, sizeof err), VW_OK);
+    CHECK_EQ_INT(put(at("held-b.txt"), "new b", err, sizeof err), VW_OK);
+    CHECK_EQ_INT(vw_outfile_release(1, err, sizeof err), VW_OK);
+    CHECK(strcmp(text_of(at("held-a.txt")), "new a") == 0);
+    CHECK(strcmp(text_of(at("held-b.txt")), "new b") == 0);
+    CHECK_EQ_INT(temps_in(dir), 0);
+    /* the hold ended with the release: the next commit is in place at once */
+    CHECK_EQ_INT(put(at("held-b.txt"), "newer b", err, sizeof err), VW_OK);
+    CHECK(strcmp(text_of(at("held-b.txt")), "newer b") == 0);
+    /* a failed write is not held, and says why at its commit */
+    if (access("/dev/full", W_OK) != 0) return;
+    vw_outfile_hold();
+    CHECK_EQ_INT(put("/dev/full", "lost", err, sizeof err), VW_E_IO);
+    EXPECT(strstr(err, "No space left on device"), "/dev/full: '%s'", err);
+    CHECK_EQ_INT(vw_outfile_release(1, err, sizeof err), VW_OK);
+}
+
 int main(void)
 {
     snprintf(dir, sizeof dir, "/tmp/vw_outfile_XXXXXX");
@@ -385,6 +425,7 @@ int main(void)
     many_at_once();
     signal_rounds();
     checks();
+    held();
     remove_temps_ends_writing(); /* last: no vw_outfile opens after it */
     char cmd[128];
     snprintf(cmd, sizeof cmd, "rm -rf '%s'", dir);

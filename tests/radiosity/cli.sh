@@ -211,6 +211,17 @@ awk 'NF != 3 || $2 < 0 { bad = 1 } END { exit bad || NR < 1 || $3 > 0.01 }' "$T/
 grep -q -- "--csv .*nodir/w.csv: cannot write: .*nodir: No such file or directory" "$T/err" \
   || fail "--csv in a missing directory: message: $(cat "$T/err")"
 [ ! -e "$T/w.ply" ] || fail "--csv in a missing directory: the PLY was written"
+# The last output cannot be written (the stats to a full disk): the mesh, the CSV and
+# the trace, complete by then, are not put in place either (vw_outfile_hold).
+if [ -e /dev/full ]; then
+  rm -f "$T/f.ply" "$T/f.csv" "$T/f.trace"
+  "$V" radiosity "$T/cornell.nff" -o "$T/f.ply" --csv "$T/f.csv" --trace "$T/f.trace" --stats /dev/full \
+    --max-shots 4 --quiet 2>"$T/err"; rc=$?
+  [ $rc -eq 1 ] && grep -q "/dev/full: write failed: No space left on device" "$T/err" \
+    || fail "--stats /dev/full: exit $rc, $(cat "$T/err")"
+  for f in f.ply f.csv f.trace; do [ ! -e "$T/$f" ] || fail "--stats /dev/full: $f written"; done
+  ls "$T" | grep -q '\.tmp\.' && fail "--stats /dev/full: temporary files left: $(ls "$T")"
+fi
 "$V" radiosity "$T/missing.obj" --stats "$T" 2>"$T/err"; rc=$?
 [ $rc -eq 1 ] && grep -q -- "--stats .*: cannot write: it is a directory" "$T/err" \
   || fail "--stats DIR: exit $rc, $(cat "$T/err")"

@@ -336,6 +336,20 @@ if(EXISTS /dev/full)
       message(FATAL_ERROR "${cmd} > /dev/full: exit ${rc} (expected 1), said it ${nsaid} times: ${err}")
     endif()
   endforeach()
+  # The last output cannot be written (the stats to a full disk): the image and the
+  # overlay, complete by then, are not put in place either (vw_outfile_hold).
+  file(REMOVE ${WORK}/keep.png ${WORK}/keep-o.png)
+  execute_process(COMMAND ${VWALLS} render ${SCENE} -o ${WORK}/keep.png --overlay ${WORK}/keep-o.png
+                          --stats /dev/full --size 16x12 --quiet
+                  RESULT_VARIABLE rc ERROR_VARIABLE err)
+  if(NOT rc EQUAL 1 OR NOT err MATCHES "/dev/full: write failed: No space left on device")
+    message(FATAL_ERROR "render --stats /dev/full: exit ${rc} (expected 1): ${err}")
+  endif()
+  foreach(f keep.png keep-o.png)
+    if(EXISTS ${WORK}/${f})
+      message(FATAL_ERROR "render --stats /dev/full: ${f} written")
+    endif()
+  endforeach()
 endif()
 # An output that cannot be made, whichever of the three: exit 1 before the render,
 # naming it, and no other output written. Its directory is missing (a --stats into a

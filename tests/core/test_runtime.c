@@ -526,7 +526,7 @@ static int test_run_fail(void)
             /* A second failed run tells its own failure, not the first run's. */
             flood = FLOOD_STEP;
             fail_after = 2000;
-            char again[80];
+            char again[96];
             snprintf(again, sizeof again, "%s, then a step fails", what);
             expect_failed_run(w, workers, VW_E_INPUT, "step 2000 found bad input", again);
             /* The world runs again: a chain of hops arrives whole. */

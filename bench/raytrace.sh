@@ -13,7 +13,8 @@
 #      a round runs every configuration back to back, at the machine's speed of the moment;
 #      the whole processes of those rounds likewise, and the phases of the one-cell runs
 #      (what does not shrink with a second worker bounds the whole-process speedup);
-#  (d) 2x2x2 against 1 cell by instruction count (callgrind): free of the noise.
+#  (d) 2x2x2 against 1 cell by instruction count (callgrind): free of the noise;
+#  (e) 2x2x2 against 1 cell on the next sphereflake (size 5), in time and instructions.
 # Whole processes are timed with date +%s.%N: best of REPEAT runs, the configurations
 # interleaved (one run of each per round: the shared machine's speed drifts).
 # usage: bench/raytrace.sh [BUILD_DIR] [SIZE] [REPEAT]     (e.g. bench/raytrace.sh build 512 3)
@@ -191,14 +192,33 @@ EOF
 # (d) The decomposition overhead without the machine's noise: instructions executed by
 # the whole process (valgrind's callgrind, one worker, 256x256: the ratio hardly depends
 # on the size), 2x2x2 cells against 1 cell. Skipped when valgrind is not installed.
+# Instructions of one render: instr SCENE CELLS (1 worker, 256x256, whole process).
+instr() {
+  valgrind --tool=callgrind --callgrind-out-file="$T/cg.out" "$VW" render "$1" \
+    -o "$T/cg.png" --size 256x256 --depth 5 --quiet --workers 1 --cells "$2" 2>&1 |
+    sed -n 's/.*Collected : \([0-9]*\).*/\1/p'
+}
 if command -v valgrind > /dev/null 2>&1; then
-  instr() {
-    valgrind --tool=callgrind --callgrind-out-file="$T/cg.out" "$VW" render "$T/balls.nff" \
-      -o "$T/cg.png" --size 256x256 --depth 5 --quiet --workers 1 --cells "$1" 2>&1 |
-      sed -n 's/.*Collected : \([0-9]*\).*/\1/p'
-  }
-  i1=$(instr 1)
-  i8=$(instr 2x2x2)
+  i1=$(instr "$T/balls.nff" 1)
+  i8=$(instr "$T/balls.nff" 2x2x2)
   echo "(d) instructions (callgrind, 1 worker, 256x256, whole process)"
   printf "    1 cell %s, 2x2x2 %s: 2x2x2/1cell = %s\n" "$i1" "$i8" "$(awk -v a="$i8" -v b="$i1" 'BEGIN { printf "%.3f", a / b }')"
+fi
+
+# (e) The 2x2x2 overhead against the scene's size: a crossing costs the same whatever the
+# scene, a segment's search in Embree grows with it, so the ratio of (c) falls on the
+# next sphereflake (size 5: 66,430 spheres). Whole processes, interleaved, best of
+# REPEAT; and by instruction count when valgrind is there.
+if "$VW" gen balls --size 5 > "$T/balls5.nff" 2>/dev/null; then
+  render5() { "$VW" render "$T/balls5.nff" -o "$T/vw5.png" --size "${SIZE}x${SIZE}" --depth 5 --quiet "$@"; }
+  timeall b5c1 'render5 --cells 1 --workers 1' b5c8 'render5 --cells 2x2x2 --workers 1'
+  echo "(e) the same on the size-5 sphereflake (66,430 spheres), 1 worker"
+  printf "    whole process: 1 cell %6.3f s, 2x2x2 %6.3f s   2x2x2/1cell time = %s\n" \
+    "${BEST[b5c1]}" "${BEST[b5c8]}" "$(ratio "${BEST[b5c8]}" "${BEST[b5c1]}")"
+  if command -v valgrind > /dev/null 2>&1; then
+    i1=$(instr "$T/balls5.nff" 1)
+    i8=$(instr "$T/balls5.nff" 2x2x2)
+    printf "    instructions (256x256): 1 cell %s, 2x2x2 %s: 2x2x2/1cell = %s\n" "$i1" "$i8" \
+      "$(awk -v a="$i8" -v b="$i1" 'BEGIN { printf "%.3f", a / b }')"
+  fi
 fi

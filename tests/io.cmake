@@ -1,7 +1,7 @@
-# tests/io.cmake - tests of src/io: NFF and OBJ readers, the NFF writer, images, output
+# tests/io.cmake - tests of src/io: NFF, OBJ and PLY readers, the NFF writer, images, output
 # files, the scene generators and the gen/info subcommands. Every test is named io_*.
 
-foreach(t bad nff obj image gen)
+foreach(t bad nff obj ply image gen)
   add_executable(test_io_${t} ${PROJECT_SOURCE_DIR}/tests/io/test_io_${t}.c)
   target_include_directories(test_io_${t} PRIVATE ${PROJECT_SOURCE_DIR}/tests)
   target_link_libraries(test_io_${t} PRIVATE vwalls_static m)

@@ -36,6 +36,9 @@ add_test(NAME raytrace_identical_wall_hit COMMAND vw_test_raytrace identical
 # The same under the stress switch (random delays and reordering of deliveries).
 add_test(NAME raytrace_stress_balls COMMAND vw_test_raytrace identical gen:balls:2 64x64)
 add_test(NAME raytrace_stress_mixed COMMAND vw_test_raytrace identical ${VW_RT_MIXED} 64x64)
+# A PLY mesh (binary, coloured faces): the same image on every layout and worker count.
+add_test(NAME raytrace_identical_ply COMMAND vw_test_raytrace identical
+         ${PROJECT_SOURCE_DIR}/tests/data/good/pyramid.ply 48x48)
 # The two scenes above a billion units from the origin (raytrace_cli: the same PNG too).
 add_test(NAME raytrace_identical_far_mixed COMMAND vw_test_raytrace identical
          ${PROJECT_SOURCE_DIR}/tests/raytrace/far_mixed.nff 96x96)
@@ -44,12 +47,13 @@ add_test(NAME raytrace_identical_far_wall_hit COMMAND vw_test_raytrace identical
 set(VW_RT_TSAN "TSAN_OPTIONS=suppressions=${PROJECT_SOURCE_DIR}/tests/raytrace/tsan.supp")
 set_tests_properties(raytrace_cone raytrace_analytic raytrace_analytic_far raytrace_identical_balls
   raytrace_identical_mixed raytrace_identical_wall_hit raytrace_identical_far_mixed
-  raytrace_identical_far_wall_hit PROPERTIES ENVIRONMENT "${VW_RT_TSAN}")
+  raytrace_identical_far_wall_hit raytrace_identical_ply PROPERTIES ENVIRONMENT "${VW_RT_TSAN}")
 # Threads-engine tests: ./run test-sanitizers runs them under TSan (rays handed from
 # cell to cell inline and by message, under the stress switch too).
 set_tests_properties(raytrace_cone raytrace_analytic raytrace_analytic_far raytrace_identical_balls
   raytrace_identical_mixed raytrace_identical_wall_hit raytrace_stress_balls raytrace_stress_mixed
-  raytrace_identical_far_mixed raytrace_identical_far_wall_hit PROPERTIES LABELS "threads")
+  raytrace_identical_far_mixed raytrace_identical_far_wall_hit raytrace_identical_ply
+  PROPERTIES LABELS "threads")
 set_tests_properties(raytrace_stress_balls PROPERTIES ENVIRONMENT "VW_STRESS=7;${VW_RT_TSAN}")
 set_tests_properties(raytrace_stress_mixed PROPERTIES
   ENVIRONMENT "VW_STRESS=1994;VW_STRESS_SPLIT=1;${VW_RT_TSAN}")

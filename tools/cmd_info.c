@@ -9,7 +9,7 @@
 
 static void info_usage(FILE *f)
 {
-    fprintf(f, "usage: vwalls info SCENE.(nff|obj) [--objects]\n"
+    fprintf(f, "usage: vwalls info SCENE.(nff|obj|ply) [--objects]\n"
                "\n"
                "Prints what the scene holds: object counts, bounds, camera and lights.\n"
                "  --objects   also one line per object: id, kind, bounds and material\n"

@@ -19,7 +19,7 @@ static const char *const CMD = "radiosity";
 
 static void help(void)
 {
-    printf("usage: vwalls radiosity SCENE.(obj|nff) -o OUT.ply [options]\n"
+    printf("usage: vwalls radiosity SCENE.(obj|nff|ply) -o OUT.ply [options]\n"
            "\n"
            "Progressive refinement radiosity, distributed over cells: every cell shoots its\n"
            "patch of largest unshot power; a shot travels from cell to cell as a hemicube\n"

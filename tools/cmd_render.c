@@ -1,4 +1,4 @@
-/* cmd_render.c - vwalls render: the distributed ray tracer on an NFF or OBJ scene,
+/* cmd_render.c - vwalls render: the distributed ray tracer on an NFF, OBJ or PLY scene,
  * writing a PNG or PFM (atomically, by the output process only), and optionally the
  * stats JSON and a picture of the walls tinted by each cell's measured load.
  */
@@ -23,7 +23,7 @@ static const char *const CMD = "render";
 
 static void help(void)
 {
-    printf("usage: vwalls render SCENE.(nff|obj) -o OUT.(png|pfm) [options]\n"
+    printf("usage: vwalls render SCENE.(nff|obj|ply) -o OUT.(png|pfm) [options]\n"
            "\n"
            "Ray traces the scene (Whitted: Phong lights with shadow rays, mirror reflection,\n"
            "refraction) with rays travelling as messages between the cells of a grid of\n"

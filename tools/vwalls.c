@@ -21,8 +21,8 @@ static const vw_command commands[] = {
     {"example-pairs", vw_cmd_example_pairs, "count touching sphere pairs (the example module)"},
     {"example-components", vw_cmd_example_components,
      "connected components of touching spheres (the second example module)"},
-    {"render", vw_cmd_render, "ray trace an NFF or OBJ scene, distributed over cells"},
-    {"radiosity", vw_cmd_radiosity, "progressive radiosity of an OBJ or NFF scene, distributed over cells"},
+    {"render", vw_cmd_render, "ray trace an NFF, OBJ or PLY scene, distributed over cells"},
+    {"radiosity", vw_cmd_radiosity, "progressive radiosity of an OBJ, NFF or PLY scene, distributed over cells"},
     {"animate", vw_cmd_animate, "run an edit script on a scene: collision-checked moves, a frame per 'frame'"},
     {"edit", vw_cmd_edit, "the edit language interactively from stdin"},
 };

@@ -95,6 +95,15 @@ VW_API vw_status vw_scene_read_nff(const char *name, const char *text, size_t le
 VW_API vw_status vw_scene_read_obj(const char *name, const char *text, size_t len,
                                    const char *dir, vw_scene **out, char *err, size_t errlen);
 
+/* PLY (the Stanford format: ASCII, binary_little_endian or binary_big_endian): the
+   element vertex (x, y, z; nx, ny, nz; red, green, blue) and the element face (the
+   list vertex_indices or vertex_index; red, green, blue), every other element and
+   property read past. A face's colour is its own, else the mean of its vertices',
+   else 0.8 grey; no camera and no lights (the commands' defaults, as for OBJ). Binary
+   data's errors name the line after end_header, and the element and record. */
+VW_API vw_status vw_scene_read_ply(const char *name, const void *data, size_t len,
+                                   vw_scene **out, char *err, size_t errlen);
+
 /* Warnings: input the readers take with a fallback. Each is one line, "file:line:
    warning: message" (no newline), handed to fn(msg, user); the default (and fn NULL)
    prints it on stderr. The handler is process-wide: set it before reading, not while

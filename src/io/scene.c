@@ -447,8 +447,9 @@ VW_API vw_status vw_scene_read_file(const char *path, vw_scene **out, char *err,
         return VW_E_INVAL;
     }
     int is_nff = has_suffix(path, ".nff"), is_obj = has_suffix(path, ".obj");
-    if (!is_nff && !is_obj) {
-        vw__errf(err, errlen, "%s: unknown scene format (expected .nff or .obj)", path);
+    int is_ply = has_suffix(path, ".ply");
+    if (!is_nff && !is_obj && !is_ply) {
+        vw__errf(err, errlen, "%s: unknown scene format (expected .nff, .obj or .ply)", path);
         return VW_E_INPUT;
     }
     char *text;
@@ -458,6 +459,8 @@ VW_API vw_status vw_scene_read_file(const char *path, vw_scene **out, char *err,
         return st;
     if (is_nff) {
         st = vw_scene_read_nff(path, text, len, out, err, errlen);
+    } else if (is_ply) {
+        st = vw_scene_read_ply(path, text, len, out, err, errlen);
     } else {
         /* mtllib names are relative to the directory of the OBJ file. */
         const char *slash = strrchr(path, '/');

@@ -96,6 +96,33 @@ static inline char *nff_string(const vw_scene *s, size_t *len)
     return buf;
 }
 
+/* The mesh readers' fuzz targets (OBJ, PLY) end here with the reader's outcome: a
+   refusal is one of the readers' statuses and leaves no scene; an accepted mesh indexes
+   only its own vertices and its NFF reads back. Frees s; aborts on a violation. */
+static inline void fuzz_check_mesh(vw_status st, vw_scene *s)
+{
+    if (st != VW_OK) {
+        if (s || (st != VW_E_INPUT && st != VW_E_NOMEM && st != VW_E_LIMIT))
+            abort();
+        return;
+    }
+    double lo[3], hi[3];
+    vw_scene_bounds(s, lo, hi);
+    for (size_t i = 0; i < s->nindices; i++)
+        if (s->indices[i] < 0 || (size_t)s->indices[i] >= s->nvertices)
+            abort();
+    size_t n = 0;
+    char *text = nff_string(s, &n), err[256];
+    vw_scene *back = NULL;
+    if (!text || vw_scene_read_nff("mesh.nff", text, n, &back, err, sizeof err) != VW_OK) {
+        fprintf(stderr, "converted mesh does not read back: %s\n", text ? err : "no NFF");
+        abort();
+    }
+    free(text);
+    vw_scene_free(back);
+    vw_scene_free(s);
+}
+
 static inline char *slurp(const char *path, size_t *len)
 {
     FILE *f = fopen(path, "rb");

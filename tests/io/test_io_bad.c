@@ -1,6 +1,8 @@
 /* test_io_bad.c - every file in tests/data/bad must be rejected with VW_E_INPUT, a
  * "name:LINE: " prefix and the message its first line promises ("# expect: ..."); and
  * with its line ends made CR alone or CRLF, with the same message (the same line).
+ * A PLY file, whose first line must be "ply", says what it expects in a header line
+ * "comment expect: ...".
  * Usage: test_io_bad DATA_DIR
  */
 #define _GNU_SOURCE
@@ -52,9 +54,9 @@ static void same_with_line_ends(const char *path, const char *dir, const char *e
         size_t m;
         char *t = vw_test_line_ends(text, n, crlf, &m), err2[1024] = "";
         vw_scene *s = (vw_scene *)1;
-        vw_status st = has_ext(path, ".obj")
-                     ? vw_scene_read_obj(path, t, m, dir, &s, err2, sizeof err2)
-                     : vw_scene_read_nff(path, t, m, &s, err2, sizeof err2);
+        vw_status st = has_ext(path, ".obj")   ? vw_scene_read_obj(path, t, m, dir, &s, err2, sizeof err2)
+                       : has_ext(path, ".ply") ? vw_scene_read_ply(path, t, m, &s, err2, sizeof err2)
+                                               : vw_scene_read_nff(path, t, m, &s, err2, sizeof err2);
         EXPECT(st == VW_E_INPUT && s == NULL && !strcmp(err, err2),
                "%s with %s line ends: status %d\n  message:  '%s'\n  with LF:  '%s'", path,
                crlf ? "CRLF" : "CR", (int)st, err2, err);
@@ -73,18 +75,24 @@ int main(int argc, char **argv)
     int files = 0;
     struct dirent *e;
     while ((e = readdir(d))) {
-        if (!has_ext(e->d_name, ".nff") && !has_ext(e->d_name, ".obj"))
+        int ply = has_ext(e->d_name, ".ply");
+        if (!has_ext(e->d_name, ".nff") && !has_ext(e->d_name, ".obj") && !ply)
             continue;
         char path[8192], line[512], err[1024] = "";
         snprintf(path, sizeof path, "%s/%s", dirpath, e->d_name);
         FILE *f = fopen(path, "r");
         CHECK(f != NULL);
-        CHECK(fgets(line, sizeof line, f) != NULL);
+        /* The first line; a PLY's must be "ply", so it says it in a header comment. */
+        const char *tag = ply ? "comment expect: " : "# expect: ";
+        int found = 0;
+        while (!found && fgets(line, sizeof line, f)) {
+            line[strcspn(line, "\r\n")] = '\0';
+            found = !strncmp(line, tag, strlen(tag));
+            if (!ply) break;
+        }
         fclose(f);
-        line[strcspn(line, "\r\n")] = '\0';
-        const char *tag = "# expect: ";
-        if (strncmp(line, tag, strlen(tag)) != 0) {
-            fprintf(stderr, "%s: first line lacks '%s'\n", path, tag);
+        if (!found) {
+            fprintf(stderr, "%s: %s lacks '%s'\n", path, ply ? "header" : "first line", tag);
             return 1;
         }
         const char *expect = line + strlen(tag);

@@ -1,0 +1,178 @@
+/* test_io_ply.c - the PLY reader: the same mesh as ASCII, binary little- and big-endian,
+ * with CRLF line ends, and as an OBJ gives the same scene (fingerprint); normals and
+ * colours (a face's own, its vertices' mean) are read, other elements and properties
+ * read past; bad input fails with "name:line: message" and no scene.
+ * Usage: test_io_ply
+ */
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "vw_test.h"
+#include "vwalls/scene.h"
+
+static const float pyr_v[5][3] = {{-1, -1, 0}, {1, -1, 0}, {1, 1, 0}, {-1, 1, 0}, {0, 0, 1.5f}};
+static const int pyr_f[5][4] = {{0, 1, 2, 3}, {0, 1, 4, -1}, {1, 2, 4, -1}, {2, 3, 4, -1}, {3, 0, 4, -1}};
+
+static const char *header(const char *format)
+{
+    static char h[512];
+    snprintf(h, sizeof h,
+             "ply\nformat %s 1.0\ncomment a pyramid\nelement vertex 5\nproperty float x\n"
+             "property float y\nproperty float z\nelement face 5\n"
+             "property list uchar int vertex_indices\nend_header\n", format);
+    return h;
+}
+
+/* The pyramid in a binary byte order (big: 1). */
+static unsigned char *binary(int big, size_t *len)
+{
+    const char *h = header(big ? "binary_big_endian" : "binary_little_endian");
+    size_t n = strlen(h);
+    unsigned char *b = malloc(n + 5 * 12 + 5 * 17), *p = b + n;
+    memcpy(b, h, n);
+    for (int v = 0; v < 5; v++)
+        for (int k = 0; k < 3; k++) {
+            uint32_t u;
+            memcpy(&u, &pyr_v[v][k], 4);
+            for (int i = 0; i < 4; i++) *p++ = (unsigned char)(u >> (8 * (big ? 3 - i : i)));
+        }
+    for (int f = 0; f < 5; f++) {
+        int c = pyr_f[f][3] < 0 ? 3 : 4;
+        *p++ = (unsigned char)c;
+        for (int k = 0; k < c; k++)
+            for (int i = 0; i < 4; i++)
+                *p++ = (unsigned char)((uint32_t)pyr_f[f][k] >> (8 * (big ? 3 - i : i)));
+    }
+    *len = (size_t)(p - b);
+    return b;
+}
+
+static char *ascii(void)
+{
+    static char t[2048];
+    int n = snprintf(t, sizeof t, "%s", header("ascii"));
+    for (int v = 0; v < 5; v++) n += snprintf(t + n, sizeof t - (size_t)n, "%g %g %g\n", pyr_v[v][0], pyr_v[v][1], pyr_v[v][2]);
+    for (int f = 0; f < 5; f++) {
+        int c = pyr_f[f][3] < 0 ? 3 : 4;
+        n += snprintf(t + n, sizeof t - (size_t)n, "%d", c);
+        for (int k = 0; k < c; k++) n += snprintf(t + n, sizeof t - (size_t)n, " %d", pyr_f[f][k]);
+        n += snprintf(t + n, sizeof t - (size_t)n, "\n");
+    }
+    return t;
+}
+
+static vw_scene *good(const void *data, size_t len, const char *what)
+{
+    char err[512] = "";
+    vw_scene *s = NULL;
+    vw_status st = vw_scene_read_ply("t.ply", data, len, &s, err, sizeof err);
+    EXPECT(st == VW_OK && s, "%s: status %d: %s", what, (int)st, err);
+    return st == VW_OK ? s : NULL;
+}
+
+static void bad(const char *text, size_t len, const char *want)
+{
+    char err[512] = "";
+    vw_scene *s = (vw_scene *)1;
+    vw_status st = vw_scene_read_ply("t.ply", text, len ? len : strlen(text), &s, err, sizeof err);
+    EXPECT(st == VW_E_INPUT && s == NULL && !strncmp(err, want, strlen(want)),
+           "want '%s...': status %d, '%s'", want, (int)st, err);
+}
+
+int main(void)
+{
+    /* One mesh, four encodings, one scene. */
+    char *a = ascii();
+    size_t nle, nbe, ncr;
+    unsigned char *le = binary(0, &nle), *be = binary(1, &nbe);
+    char *crlf = vw_test_line_ends(a, strlen(a), 1, &ncr);
+    vw_scene *sa = good(a, strlen(a), "ascii"), *sle = good(le, nle, "little-endian");
+    vw_scene *sbe = good(be, nbe, "big-endian"), *scr = good(crlf, ncr, "CRLF");
+    CHECK(sa && sle && sbe && scr);
+    CHECK_EQ_INT(vw_scene_count_objects(sa), 5);
+    CHECK_EQ_INT(sa->nvertices, 5);
+    CHECK(!sa->camera.valid && sa->nlights == 0);
+    CHECK(vw_scene_fingerprint(sa) == vw_scene_fingerprint(sle));
+    CHECK(vw_scene_fingerprint(sa) == vw_scene_fingerprint(sbe));
+    CHECK(vw_scene_fingerprint(sa) == vw_scene_fingerprint(scr));
+    /* ... and the same as an OBJ of it (0.8 grey, as an OBJ face without a material) */
+    const char *objt = "v -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\nv 0 0 1.5\n"
+                       "f 1 2 3 4\nf 1 2 5\nf 2 3 5\nf 3 4 5\nf 4 1 5\n";
+    char err[512];
+    vw_scene *so = NULL;
+    CHECK_EQ_INT(vw_scene_read_obj("t.obj", objt, strlen(objt), NULL, &so, err, sizeof err), VW_OK);
+    EXPECT(vw_scene_fingerprint(sa) == vw_scene_fingerprint(so), "the PLY and the OBJ differ");
+    vw_scene_free(sa), vw_scene_free(sle), vw_scene_free(sbe), vw_scene_free(scr), vw_scene_free(so);
+    free(le), free(be), free(crlf);
+
+    /* Normals, colours (a face's own; else its vertices' mean), and what is read past:
+       an element edge, a face property flags, a vertex property confidence. */
+    const char *rich = "ply\nformat ascii 1.0\nobj_info made by hand\nelement vertex 3\n"
+                       "property double x\nproperty double y\nproperty double z\n"
+                       "property float nx\nproperty float ny\nproperty float nz\n"
+                       "property uchar red\nproperty uchar green\nproperty uchar blue\n"
+                       "property float confidence\n"
+                       "element face 2\nproperty list uint8 int32 vertex_index\nproperty uchar flags\n"
+                       "element edge 1\nproperty int vertex1\nproperty int vertex2\nend_header\n"
+                       "0 0 0  0 0 1  255 0 0  0.5\n1 0 0  0 0 1  0 255 0  0.5\n0 1 0  0 0 1  0 0 255  1\n"
+                       "3 0 1 2 7\n3 2 1 0 9\n0 1\n";
+    vw_scene *sr = good(rich, strlen(rich), "normals and colours");
+    CHECK(sr && sr->normals != NULL && sr->npolygons == 2);
+    CHECK(sr->nmaterials == 1);
+    for (int k = 0; k < 3; k++) EXPECT(sr->materials[0].diffuse[k] > 0.33f && sr->materials[0].diffuse[k] < 0.34f,
+                                       "vertices' mean colour %d: %g", k, sr->materials[0].diffuse[k]);
+    vw_scene_free(sr);
+    const char *facecol = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+                          "property float z\nelement face 2\nproperty list uchar int vertex_indices\n"
+                          "property float red\nproperty float green\nproperty float blue\nend_header\n"
+                          "0 0 0\n1 0 0\n0 1 0\n3 0 1 2 0.25 0.5 1\n3 2 1 0 0.25 0.5 1\n";
+    vw_scene *sf = good(facecol, strlen(facecol), "face colours");
+    CHECK(sf && sf->nmaterials == 1 && sf->materials[0].diffuse[0] == 0.25f &&
+          sf->materials[0].diffuse[1] == 0.5f && sf->materials[0].diffuse[2] == 1.0f);
+    vw_scene_free(sf);
+
+    /* Bad input: the message, on the line it names. */
+    bad("plx\n", 0, "t.ply:1: not a PLY file");
+    bad("ply\nformat ascii 1.0\nelement vertex 0\n", 0, "t.ply:4: the file ends inside the header");
+    bad("ply\nformat ebcdic 1.0\nend_header\n", 0, "t.ply:2: unknown format 'ebcdic'");
+    bad("ply\nformat ascii 2.0\nend_header\n", 0, "t.ply:2: unknown format version '2.0'");
+    bad("ply\nformat ascii 1.0\nelement vertex 1\nproperty quad x\nend_header\n", 0, "t.ply:4: unknown type 'quad'");
+    bad("ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nend_header\n0 0\n", 0,
+        "t.ply:3: element vertex has no scalar properties x, y and z");
+    bad("ply\nformat ascii 1.0\nend_header\n", 0, "t.ply:4: no element vertex");
+    bad("ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\n"
+        "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n3 0 0 1\n", 0,
+        "t.ply:11: face 0: vertex index 1 out of range (1 vertices)");
+    bad("ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\nproperty float z\n"
+        "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n2 0 1\n", 0,
+        "t.ply:12: face 0: a polygon needs at least 3 vertices, it has 2");
+    bad("ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\n"
+        "end_header\n0 nan 0\n", 0, "t.ply:8: vertex 0: NaN or infinite number 'nan'");
+    bad("ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\n"
+        "end_header\n0 0\n", 0, "t.ply:8: the file ends inside element vertex (1 records cannot fit");
+    bad("ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\nproperty float z\n"
+        "end_header\n0 0 0\n1   \n\n\n\n", 0, "t.ply:9: the file ends inside vertex 1");
+    bad("ply\nformat ascii 1.0\nelement vertex 1\nproperty uchar x\nproperty float y\nproperty float z\n"
+        "end_header\n300 0 0\n", 0, "t.ply:8: vertex 0: 300 does not fit its type");
+    bad("ply\nformat ascii 1.0\nelement vertex 1\nproperty int x\nproperty float y\nproperty float z\n"
+        "end_header\n1.5 0 0\n", 0, "t.ply:8: vertex 0: bad integer '1.5'");
+    bad("ply\nformat ascii 1.0\nelement face 1\nproperty list uchar int vertex_indices\n"
+        "element vertex 0\nproperty float x\nproperty float y\nproperty float z\nend_header\n3 0 1 2\n", 0,
+        "t.ply:3: element face comes before element vertex");
+    bad("ply\nformat ascii 1.0\nelement vertex 3000000000\nend_header\n", 0, "t.ply:3: bad element count");
+    bad("ply\nformat binary_little_endian 1.0\nelement vertex 100000000\nproperty float x\n"
+        "property float y\nproperty float z\nend_header\n", 0,
+        "t.ply:8: the file ends inside element vertex (100000000 records cannot fit in the 0 bytes left)");
+    bad("ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\n"
+        "property float red\nproperty float green\nproperty float blue\nend_header\n0 0 0 0.5 1.5 0\n", 0,
+        "t.ply:11: vertex 0: colour component 1.5 outside 0..1");
+    bad("ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\n"
+        "end_header\n0 1e39 0\n", 0, "t.ply:8: vertex 0: number '1e39' out of range");
+    /* binary data cut short: the element and record are named */
+    unsigned char *cut = binary(0, &nle);
+    bad((const char *)cut, nle - 3, "t.ply:11: the binary data ends inside face 4");
+    free(cut);
+    TEST_DONE();
+}

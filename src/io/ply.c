@@ -331,6 +331,15 @@ static vw_status value(ply *P, enum ptype t, const char *what, double *out)
     return VW_OK;
 }
 
+/* A list's length (its count type may be signed: a negative one is refused). */
+static vw_status list_length(ply *P, const prop *pr, const char *what, double *n)
+{
+    vw_status st = value(P, pr->count, what, n);
+    if (st == VW_OK && *n < 0)
+        return fail(P, "%s: list %s has a negative length %.0f", what, pr->name, *n);
+    return st;
+}
+
 /* ---- the elements ---------------------------------------------------------------- */
 
 static int find_prop(const elem *e, const char *name)
@@ -407,7 +416,7 @@ static vw_status read_vertices(ply *P, const elem *e)
                 continue;
             }
             double cnt, skip;
-            st = value(P, pr->count, what, &cnt);
+            st = list_length(P, pr, what, &cnt);
             for (double k = 0; st == VW_OK && k < cnt; k++)
                 st = value(P, pr->type, what, &skip);
         }
@@ -478,7 +487,7 @@ static vw_status read_faces(ply *P, const elem *e, int seen_vertices)
                 continue;
             }
             double cnt, x;
-            st = value(P, pr->count, what, &cnt);
+            st = list_length(P, pr, what, &cnt);
             for (double k = 0; st == VW_OK && k < cnt; k++) {
                 if ((st = value(P, pr->type, what, &x)) != VW_OK || i != list)
                     continue;
@@ -537,7 +546,7 @@ static vw_status skip_element(ply *P, const elem *e)
                 continue;
             }
             double cnt;
-            st = value(P, pr->count, what, &cnt);
+            st = list_length(P, pr, what, &cnt);
             for (double k = 0; st == VW_OK && k < cnt; k++)
                 st = value(P, pr->type, what, &x);
         }

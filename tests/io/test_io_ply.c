@@ -170,6 +170,9 @@ int main(void)
         "t.ply:11: vertex 0: colour component 1.5 outside 0..1");
     bad("ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\n"
         "end_header\n0 1e39 0\n", 0, "t.ply:8: vertex 0: number '1e39' out of range");
+    bad("ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+        "element face 1\nproperty list char int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n-3 0 1 2\n", 0,
+        "t.ply:13: face 0: list vertex_indices has a negative length -3");
     /* binary data cut short: the element and record are named */
     unsigned char *cut = binary(0, &nle);
     bad((const char *)cut, nle - 3, "t.ply:11: the binary data ends inside face 4");

@@ -340,6 +340,31 @@ static vw_status list_length(ply *P, const prop *pr, const char *what, double *n
     return st;
 }
 
+/* A list item handed over by read_record. */
+typedef vw_status (*item_fn)(ply *P, void *arg, double x, const char *what);
+
+/* One record of element e: its scalars into vals (NULL: read past), the items of list
+   `keep` to fn, every other list read past. */
+static vw_status read_record(ply *P, const elem *e, const char *what, double *vals, int keep,
+                             item_fn fn, void *arg)
+{
+    vw_status st = VW_OK;
+    double x;
+    for (int i = 0; i < e->nprops && st == VW_OK; i++) {
+        const prop *pr = &e->props[i];
+        if (pr->count == T_NONE) {
+            st = value(P, pr->type, what, vals ? &vals[i] : &x);
+            continue;
+        }
+        double cnt;
+        st = list_length(P, pr, what, &cnt);
+        for (double k = 0; st == VW_OK && k < cnt; k++)
+            if ((st = value(P, pr->type, what, &x)) == VW_OK && i == keep)
+                st = fn(P, arg, x, what);
+    }
+    return st;
+}
+
 /* ---- the elements ---------------------------------------------------------------- */
 
 static int find_prop(const elem *e, const char *name)
@@ -408,19 +433,8 @@ static vw_status read_vertices(ply *P, const elem *e)
         return fail_status(P, VW_E_NOMEM);
     char what[64];
     for (size_t r = 0; r < n && st == VW_OK; r++) {
-        for (int i = 0; i < e->nprops && st == VW_OK; i++) {
-            const prop *pr = &e->props[i];
-            snprintf(what, sizeof what, "vertex %zu", r);
-            if (pr->count == T_NONE) {
-                st = value(P, pr->type, what, &vals[i]);
-                continue;
-            }
-            double cnt, skip;
-            st = list_length(P, pr, what, &cnt);
-            for (double k = 0; st == VW_OK && k < cnt; k++)
-                st = value(P, pr->type, what, &skip);
-        }
-        if (st != VW_OK)
+        snprintf(what, sizeof what, "vertex %zu", r);
+        if ((st = read_record(P, e, what, vals, -1, NULL, NULL)) != VW_OK)
             break;
         double v[3] = {vals[xyz[0]], vals[xyz[1]], vals[xyz[2]]};
         int vi;
@@ -454,6 +468,27 @@ static vw_status material_of(ply *P, const float rgb[3], int *mat)
     return st;
 }
 
+/* A face's corners so far, and the sum of their colours. */
+typedef struct face_acc {
+    int corners;
+    float sum[3];
+} face_acc;
+
+static vw_status face_corner(ply *P, void *arg, double x, const char *what)
+{
+    face_acc *a = arg;
+    if (x < 0 || x >= (double)P->nverts)
+        return fail(P, "%s: vertex index %.0f out of range (%zu vertices)", what, x, P->nverts);
+    size_t vi = (size_t)x;
+    vw_status st = vw__sb_polygon_corner(&P->b, (int)vi, P->normals ? P->normals[vi] : NULL);
+    if (st != VW_OK)
+        return fail_status(P, st);
+    for (int c = 0; P->colors && c < 3; c++)
+        a->sum[c] += P->colors[vi][c];
+    a->corners++;
+    return VW_OK;
+}
+
 static vw_status read_faces(ply *P, const elem *e, int seen_vertices)
 {
     int list = find_prop(e, "vertex_indices");
@@ -477,36 +512,11 @@ static vw_status read_faces(ply *P, const elem *e, int seen_vertices)
     char what[64];
     for (uint64_t r = 0; r < e->count && st == VW_OK; r++) {
         snprintf(what, sizeof what, "face %llu", (unsigned long long)r);
-        int corners = 0, all_normals = P->normals != NULL;
-        float sum[3] = {0, 0, 0};
+        face_acc acc = {0, {0, 0, 0}};
         vw__sb_polygon_begin(&P->b);
-        for (int i = 0; i < e->nprops && st == VW_OK; i++) {
-            const prop *pr = &e->props[i];
-            if (pr->count == T_NONE) {
-                st = value(P, pr->type, what, &vals[i]);
-                continue;
-            }
-            double cnt, x;
-            st = list_length(P, pr, what, &cnt);
-            for (double k = 0; st == VW_OK && k < cnt; k++) {
-                if ((st = value(P, pr->type, what, &x)) != VW_OK || i != list)
-                    continue;
-                if (x < 0 || x >= (double)P->nverts) {
-                    st = fail(P, "%s: vertex index %.0f out of range (%zu vertices)", what, x, P->nverts);
-                    break;
-                }
-                size_t vi = (size_t)x;
-                if ((st = vw__sb_polygon_corner(&P->b, (int)vi, P->normals ? P->normals[vi] : NULL)) != VW_OK) {
-                    st = fail_status(P, st);
-                    break;
-                }
-                for (int c = 0; P->colors && c < 3; c++)
-                    sum[c] += P->colors[vi][c];
-                corners++;
-            }
-            if (st == VW_OK && i == list && corners < 3)
-                st = fail(P, "%s: a polygon needs at least 3 vertices, it has %d", what, corners);
-        }
+        st = read_record(P, e, what, vals, list, face_corner, &acc);
+        if (st == VW_OK && acc.corners < 3)
+            st = fail(P, "%s: a polygon needs at least 3 vertices, it has %d", what, acc.corners);
         if (st != VW_OK)
             break;
         float c[3];
@@ -519,12 +529,12 @@ static vw_status read_faces(ply *P, const elem *e, int seen_vertices)
             col = c;
         } else if (P->colors) {
             for (int k = 0; k < 3; k++)
-                c[k] = sum[k] / (float)corners;
+                c[k] = acc.sum[k] / (float)acc.corners;
             col = c;
         }
         int mat;
         if ((st = material_of(P, col, &mat)) != VW_OK ||
-            (st = vw__sb_polygon_end(&P->b, mat, all_normals)) != VW_OK)
+            (st = vw__sb_polygon_end(&P->b, mat, P->normals != NULL)) != VW_OK)
             st = fail_status(P, st);
     }
     free(vals);
@@ -536,20 +546,9 @@ static vw_status skip_element(ply *P, const elem *e)
 {
     vw_status st = check_count(P, e);
     char what[64];
-    double x;
     for (uint64_t r = 0; r < e->count && st == VW_OK; r++) {
         snprintf(what, sizeof what, "%s %llu", e->name, (unsigned long long)r);
-        for (int i = 0; i < e->nprops && st == VW_OK; i++) {
-            const prop *pr = &e->props[i];
-            if (pr->count == T_NONE) {
-                st = value(P, pr->type, what, &x);
-                continue;
-            }
-            double cnt;
-            st = list_length(P, pr, what, &cnt);
-            for (double k = 0; st == VW_OK && k < cnt; k++)
-                st = value(P, pr->type, what, &x);
-        }
+        st = read_record(P, e, what, NULL, -1, NULL, NULL);
     }
     return st;
 }

@@ -71,6 +71,10 @@ static void help(void)
            "                   the cores of the host with fewest)\n"
            "  --slow W:K[,..]  worker W does its work K times slower, K from 1 to 1000\n"
            "                   (emulates a slow machine)\n"
+           "  --steal S        auto (default) | on | off: a copy that is done takes the\n"
+           "                   turns other copies of its cell (on any process) have not\n"
+           "                   taken; off: every copy makes exactly its share; auto: on\n"
+           "                   when a process has no more workers than cores\n"
            "  --overlay-by B   load (default): each cell by its measured load; worker: each\n"
            "                   pixel by the worker that made its eye ray (farmed cells show\n"
            "                   their copies' turns)\n"
@@ -214,6 +218,7 @@ int vw_cmd_render(int argc, char **argv)
     const char *speeds_s = NULL, *slow_s = NULL;
     vw_balance_strategy strategy = VW_BALANCE_NONE;
     int farm = -1, farm_copies = 0; /* -1: auto, resolved once the options are read */
+    int steal = -1;                 /* vw_config.steal: -1 auto, 1 on, 0 off */
     vw_map_kind map = VW_MAP_BLOCK;
     int map_given = 0, balance_given = 0, by_worker = 0;
     const char *tuning = NULL; /* a pre-pass option given: it needs --balance or --map */
@@ -288,6 +293,14 @@ int vw_cmd_render(int argc, char **argv)
         } else if (!strcmp(a, "--farm")) {
             if (!(v = vw_cli_value(CMD, argc, argv, &i)) || vw_cli_farm(CMD, v, &farm))
                 return VW_EXIT_USAGE;
+        } else if (!strcmp(a, "--steal")) {
+            if (!(v = vw_cli_value(CMD, argc, argv, &i))) return VW_EXIT_USAGE;
+            if (!strcmp(v, "auto") || !strcmp(v, "on") || !strcmp(v, "off")) {
+                steal = !strcmp(v, "auto") ? -1 : !strcmp(v, "on");
+            } else {
+                vw_cli_error(CMD, "--steal: bad value '%s' (expected auto, on or off)", v);
+                return VW_EXIT_USAGE;
+            }
         } else if (!strcmp(a, "--speeds")) {
             if (!(speeds_s = vw_cli_value(CMD, argc, argv, &i))) return VW_EXIT_USAGE;
         } else if (!strcmp(a, "--slow")) {
@@ -486,6 +499,7 @@ int vw_cmd_render(int argc, char **argv)
     vw_config_init(&cfg);
     cfg.worker_slowdown = slowdown;
     cfg.worker_speeds = speeds; /* the shares of farmed and duplicated cells' copies */
+    cfg.steal = steal;
     p.config = &cfg;
     rt_job *job = NULL;
     vw_status st = rt_job_create(scene, &p, &job, err, sizeof err);

@@ -62,6 +62,12 @@ if(TARGET test_runtime)
   vw_mpi_test(mpi_runtime_step_send_np2 2 COMMAND $<TARGET_FILE:test_runtime> step-send)
   vw_mpi_test(mpi_runtime_step_send_np3 3 ENV "VW_STRESS=7" COMMAND $<TARGET_FILE:test_runtime> step-send)
 endif()
+# Farmed work across processes: a copy that is done takes the turns of copies in other
+# processes (every batch once; the slowed processes' turns go to the fast one).
+if(TARGET test_farm)
+  vw_mpi_test(mpi_farm_np2 2 COMMAND $<TARGET_FILE:test_farm> --mpi)
+  vw_mpi_test(mpi_farm_stress_np3 3 ENV "VW_STRESS=3" COMMAND $<TARGET_FILE:test_farm> --mpi --stress)
+endif()
 vw_mpi_test(mpi_agree_np1 1 COMMAND $<TARGET_FILE:test_mpi_storm> --agree)
 vw_mpi_test(mpi_agree_np3 3 COMMAND $<TARGET_FILE:test_mpi_storm> --agree)
 

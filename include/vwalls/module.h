@@ -110,8 +110,10 @@ VW_API int vw_ctx_replicas(const vw_ctx *ctx);
    vw_config.worker_speeds: a share in proportion to its worker's speed, its slots spread
    evenly over the batch numbers),
    with no message; a copy whose turns are used up then takes the turns not yet taken
-   by the other copies in its process, so a copy slowed down (a busy core) leaves its
-   rest to the others. Counting restarts at every run; a cell without copies gets
+   by the other copies (vw_config.steal), so a copy slowed down (a busy core, a slower
+   machine) leaves its rest to the others: in its process one at a time, on another
+   process by asking it, which the call then waits for. Counting restarts at every
+   run; a cell without copies gets
    0, 1, 2, ... Call it from step() until it returns nbatches, with the same nbatches
    in every copy; small batches spread the work evenly when its cost varies along the
    batch numbers. */

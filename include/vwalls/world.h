@@ -62,7 +62,9 @@ typedef struct vw_config {
        entries, copied at create (NULL = none). */
     const double *worker_slowdown;
     /* Farmed work (vw_ctx_next_batch): a copy of a cell whose turns are used up takes
-       the turns the cell's other copies in its process have not taken. 1 = on, 0 = off
+       the turns the cell's other copies have not taken: those in its process one at a
+       time, those on other processes by asking their process, its part of what the
+       copy has left (half with equal speeds) in one round trip. 1 = on, 0 = off
        (every copy makes exactly its equal share), -1 (the default) = on when the
        process has no more workers than cores. Then taking turns only evens out a
        machine's speed differences; with more workers than cores (emulating a larger
@@ -74,8 +76,8 @@ typedef struct vw_config {
        copied at create), or NULL: all equal. The master and copies of a duplicated cell
        take shares of its turns (vw_ctx_next_batch) and of the messages sent to it
        (vw_send_cell) in proportion to their workers' speeds, so a copy on a machine
-       three times as fast makes three times the batches, also across processes, where
-       no turns are taken from a slower copy. */
+       three times as fast makes three times the batches, also across processes (until
+       its turns are used up: see steal). */
     const double *worker_speeds;
 } vw_config;
 

@@ -20,6 +20,7 @@
 #include "core/world_internal.h"
 #include "vwalls/engine.h"
 
+#include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -390,12 +391,10 @@ int vw_ctx_replicas(const vw_ctx *ctx)
     return ctx->cell >= 0 ? ctx->w->cells[ctx->cell].nreps : 0;
 }
 
-/* The next of unit u's turns: the batch of its i-th slot in the cell's share pattern
-   (i = 0, 1, ...: its counter; u + k i with equal speeds), or nbatches when they are
-   used up. One atomic add per batch: every value of the counter goes to one taker. */
-static uint64_t take_turn(const vw__cell *c, _Atomic uint64_t *counter, int u, uint64_t nbatches)
+/* The batch of unit u's i-th turn: of its i-th slot in the cell's share pattern (u + k i
+   with equal speeds), or nbatches when that is past the end. */
+static uint64_t turn_batch(const vw__cell *c, int u, uint64_t i, uint64_t nbatches)
 {
-    uint64_t i = atomic_fetch_add_explicit(counter, 1, memory_order_relaxed);
     if (i >= nbatches) return nbatches; /* a unit's i-th slot is never before slot i */
     if (!c->share_len) return i;        /* no copies: 0, 1, 2, ... */
     uint64_t L = (uint64_t)c->share_len, n = (uint64_t)(c->share_first[u + 1] - c->share_first[u]);
@@ -405,25 +404,115 @@ static uint64_t take_turn(const vw__cell *c, _Atomic uint64_t *counter, int u, u
     return b < nbatches ? b : nbatches;
 }
 
+/* The next of unit u's turns (i = 0, 1, ...: its counter), or nbatches when they are
+   used up. One atomic add per batch: every value of the counter goes to one taker. */
+static uint64_t take_turn(const vw__cell *c, _Atomic uint64_t *counter, int u, uint64_t nbatches)
+{
+    return turn_batch(c, u, atomic_fetch_add_explicit(counter, 1, memory_order_relaxed), nbatches);
+}
+
+/* How many turns unit u has in all: its slots before nbatches. */
+static uint64_t turns_of(const vw__cell *c, int u, uint64_t nbatches)
+{
+    if (!c->share_len) return nbatches;
+    uint64_t L = (uint64_t)c->share_len;
+    int first = c->share_first[u], n = c->share_first[u + 1] - first;
+    uint64_t t = nbatches / L * (uint64_t)n;
+    for (int j = 0; j < n; j++) t += (uint64_t)c->share_pos[first + j] < nbatches % L;
+    return t;
+}
+
+static _Atomic uint64_t *turn_counter(vw__cell *c, int u)
+{
+    return u ? &c->reps[u - 1].batches : &c->batches;
+}
+
+uint64_t vw__take_turns(vw_world *w, int cell, int unit, int thief, uint64_t nbatches,
+                        uint64_t *first)
+{
+    if ((unsigned)cell >= (unsigned)w->ncells || (unsigned)thief >= (unsigned)w->gworkers)
+        return UINT64_MAX;
+    vw__cell *c = &w->cells[cell];
+    if (unit < 0 || unit > c->nreps) return UINT64_MAX;
+    int worker = unit ? c->reps[unit - 1].worker : c->worker;
+    if (vw__worker_process(w, worker) != w->rank) return UINT64_MAX;
+    _Atomic uint64_t *counter = turn_counter(c, unit);
+    uint64_t all = turns_of(c, unit, nbatches), at = atomic_load_explicit(counter, memory_order_relaxed);
+    *first = at;
+    if (at >= all) return 0;
+    /* The thief's part of what is left, by the two workers' speeds: half when they are
+       equal (or unknown), so that both would end together. */
+    double part = w->speeds ? w->speeds[thief] / (w->speeds[thief] + w->speeds[worker]) : 0.5;
+    double want = ceil((double)(all - at) * part);
+    uint64_t k = want < 1 ? 1 : want >= (double)(all - at) ? all - at : (uint64_t)want;
+    /* One add for all k: the unit's own worker goes on after them. Those past its
+       last turn (its worker took some meanwhile) are none: the thief stops there. */
+    *first = atomic_fetch_add_explicit(counter, k, memory_order_relaxed);
+    return k;
+}
+
+/* The next turn of the unit's stash, or nbatches when it is empty. */
+static uint64_t stash_next(const vw__cell *c, vw__stash *s, uint64_t nbatches)
+{
+    while (s->at < s->end) {
+        uint64_t b = turn_batch(c, s->unit, s->at++, nbatches);
+        if (b < nbatches) return b;
+        s->at = s->end; /* a unit's turns only grow: none after one past the end */
+    }
+    return nbatches;
+}
+
+/* Turns of unit u from its process, which holds the counter: a round trip through the
+   communication threads for the thief's part of what u has left, kept in the asking
+   unit's stash. The worker's wait is nobody's busy time. */
+static uint64_t take_remote_turns(vw_ctx *ctx, int u, uint64_t nbatches, vw__stash *stash)
+{
+    vw__worker *wk = ctx->wk;
+    meter_charge(wk, vw__now());
+    uint64_t first = 0, n = ctx->w->transport->take_turns(ctx->w, ctx->cell, u, wk->global,
+                                                             nbatches, &first);
+    wk->mark = vw__now();
+    meter_note(wk, unit_busy(wk, ctx->cell, ctx->rep));
+    *stash = (vw__stash){u, first, first + n};
+    return stash_next(&ctx->w->cells[ctx->cell], stash, nbatches);
+}
+
 uint64_t vw_ctx_next_batch(vw_ctx *ctx, uint64_t nbatches)
 {
     if (ctx->cell < 0) return nbatches;
     vw_world *w = ctx->w;
     vw__cell *c = &w->cells[ctx->cell];
     int k = c->nreps + 1;
-    uint64_t b = take_turn(c, ctx->rep ? &c->reps[ctx->rep - 1].batches : &c->batches, ctx->rep,
-                           nbatches);
+    vw__stash *stash = ctx->rep ? &c->reps[ctx->rep - 1].stash : &c->stash;
+    uint64_t b = stash_next(c, stash, nbatches);
+    if (b < nbatches) return b;
+    b = take_turn(c, turn_counter(c, ctx->rep), ctx->rep, nbatches);
     if (b < nbatches || k == 1 || !w->steal) return b;
-    /* Its own turns used up, a copy takes the turns the other copies in this process have
-       not taken yet (the counters of copies in other processes live there): a copy
-       whose worker the machine slowed down leaves its rest to the copies that are done,
-       instead of everyone waiting for it (vw_config.steal says when). */
+    /* Its own turns used up, a copy takes the turns the other copies have not taken yet:
+       a copy whose worker the machine slowed down leaves its rest to the copies that are
+       done, instead of everyone waiting for it (vw_config.steal says when). First those
+       of this process, one at a time by an add on their counters; then those of the
+       other processes, whose counters live there, by asking: a round trip for the
+       thief's part of what the copy has left (vw__take_turns), and only once every copy
+       here is done; a copy that answered "none left" is not asked again this run. */
     for (int i = 1; i < k; i++) {
         int u = (ctx->rep + i) % k;
         int worker = u ? c->reps[u - 1].worker : c->worker;
         if (vw__worker_process(w, worker) != w->rank) continue;
-        b = take_turn(c, u ? &c->reps[u - 1].batches : &c->batches, u, nbatches);
+        b = take_turn(c, turn_counter(c, u), u, nbatches);
         if (b < nbatches) return b;
+    }
+    if (!w->transport) return nbatches;
+    for (int i = 1; i < k; i++) {
+        int u = (ctx->rep + i) % k;
+        int worker = u ? c->reps[u - 1].worker : c->worker;
+        atomic_int *spent = u ? &c->reps[u - 1].spent : &c->spent;
+        if (vw__worker_process(w, worker) == w->rank ||
+            atomic_load_explicit(spent, memory_order_relaxed))
+            continue;
+        b = take_remote_turns(ctx, u, nbatches, stash);
+        if (b < nbatches) return b;
+        atomic_store_explicit(spent, 1, memory_order_relaxed);
     }
     return nbatches;
 }
@@ -820,9 +909,13 @@ vw_status vw__runtime_run(vw_world *w)
     for (int cl = 0; cl < w->ncells; cl++) {
         vw__cell *c = &w->cells[cl];
         atomic_store_explicit(&c->batches, 0, memory_order_relaxed);
+        atomic_store_explicit(&c->spent, 0, memory_order_relaxed);
+        c->stash.at = c->stash.end = 0;
         int local = vw__worker_process(w, c->worker) == w->rank;
         for (int r = 0; r < c->nreps; r++) {
             atomic_store_explicit(&c->reps[r].batches, 0, memory_order_relaxed);
+            atomic_store_explicit(&c->reps[r].spent, 0, memory_order_relaxed);
+            c->reps[r].stash.at = c->reps[r].stash.end = 0;
             local += vw__worker_process(w, c->reps[r].worker) == w->rank;
         }
         c->farmed = c->nreps > 0 && local == w->nworkers;

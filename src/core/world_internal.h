@@ -69,6 +69,14 @@ typedef struct vw__busy {
     unsigned notes;
 } vw__busy;
 
+/* Turns a unit took from a copy in another process (vw_ctx_next_batch): slots [at, end)
+   of copy `unit`'s counter, its part of what that copy had left in one round trip. Only
+   the unit's own worker touches it. */
+typedef struct vw__stash {
+    int unit;
+    uint64_t at, end;
+} vw__stash;
+
 typedef struct vw__replica {
     _Alignas(VW__LINE) int worker; /* global worker id, never the master's */
     void *state;
@@ -82,6 +90,9 @@ typedef struct vw__replica {
     vw__busy busy;
     _Atomic uint64_t batches; /* turns taken in this run (vw_ctx_next_batch; other
                                  workers of the process take them too at the end) */
+    atomic_int spent;         /* a copy in another process: its process answered that
+                                 its turns are used up (this run) */
+    vw__stash stash;          /* turns taken from a copy in another process, to make */
 } vw__replica;
 
 typedef struct vw__cell {
@@ -115,6 +126,8 @@ typedef struct vw__cell {
     _Alignas(VW__LINE) uint64_t messages_in;
     vw__busy busy;
     _Atomic uint64_t batches; /* the master's turns taken in this run (as above) */
+    atomic_int spent;         /* (as above) */
+    vw__stash stash;
 } vw__cell;
 
 /* Stride of vw__cell.rr: one cache line per sending worker. */
@@ -178,6 +191,11 @@ typedef struct vw__transport {
     vw_status (*run)(struct vw_world *w);
     /* After a run, collectively: makes every process's cell and worker figures global. */
     vw_status (*sync)(struct vw_world *w);
+    /* Called by worker `thief` when its own turns are used up: takes some of unit
+       `unit`'s turns of `cell` (vw__take_turns on the unit's process): returns how many
+       (0: none left), the first at *first; waits for the answer. */
+    uint64_t (*take_turns)(struct vw_world *w, int cell, int unit, int thief,
+                           uint64_t nbatches, uint64_t *first);
     void (*free)(struct vw_world *w);
     void *impl;
 } vw__transport;
@@ -301,6 +319,14 @@ void vw__run_output(vw_world *w, const vw__packet *p);
    a message instead of making them read and write out of bounds. */
 const char *vw__packet_problem(const vw_world *w, const vw__packet *p, char *buf, size_t len);
 void vw__uncount(vw_world *w);
+/* Worker `thief` of another process asks for turns of unit `unit` of `cell` (a unit
+   this process hosts): takes the thief's part of those it has left (half with equal
+   speeds, by the two workers' speeds otherwise) with one add on the unit's counter.
+   Returns how many (0: none left), the first counter value at *first, or UINT64_MAX
+   when no such unit or worker exists here (a malformed request). The communication
+   thread, during a run. */
+uint64_t vw__take_turns(vw_world *w, int cell, int unit, int thief, uint64_t nbatches,
+                        uint64_t *first);
 uint64_t vw__rng_next(uint64_t *s);
 double vw__cell_load(vw_world *w, int cell);
 /* load() of copy rep (>= 1) of cell, hosted by this process. */

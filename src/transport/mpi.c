@@ -26,6 +26,7 @@
 #include "transport/mpi_internal.h"
 #include "vwalls/engine.h"
 
+#include <limits.h>
 #include <sched.h>
 #include <stddef.h>
 #include <stdio.h>
@@ -33,7 +34,25 @@
 #include <string.h>
 #include <time.h>
 
-enum { TAG_DATA = 7301 };
+/* TAG_DATA: packets. TAG_TURN / TAG_TURN_BACK: a worker's request for a turn of a
+   copy hosted by the receiver (vw_ctx_next_batch), and the answer. */
+enum { TAG_DATA = 7301, TAG_TURN = 7302, TAG_TURN_BACK = 7303 };
+
+/* A turn request: the waiting worker's, on its stack until `answered`. */
+typedef struct turn_req {
+    int cell, unit, thief, peer;
+    uint64_t nbatches;
+    uint64_t first, n; /* the answer: n turns from counter value first */
+    int answered;      /* guarded by mu */
+    struct turn_req *next;
+} turn_req;
+
+/* A control message's words on the wire: {id, cell, unit, thief, nbatches} for
+   TAG_TURN, {id, first, n} for TAG_TURN_BACK. */
+enum { TURN_WORDS = 5, BACK_WORDS = 3, CTL_MAX = 5 };
+typedef struct ctl_msg {
+    uint64_t v[CTL_MAX];
+} ctl_msg;
 
 /* Wire format: the packet record from `dest` to the end of its used data (dest, src,
    nmsgs, used, cap, data). Every process runs the same binary, so the layout matches;
@@ -56,6 +75,13 @@ typedef struct mpi_tp {
     pthread_cond_t cv;
     vw__packet *qhead, *qtail; /* handed over by workers, not yet posted; guarded by mu */
     int sleeping;              /* the communication thread waits on cv; guarded by mu */
+    turn_req *turn_q;          /* turn requests not yet sent; guarded by mu */
+    pthread_cond_t turn_cv;    /* a turn request was answered; with mu */
+    turn_req **asked;          /* sent turn requests by id (NULL: free), comm. thread */
+    int nasked, capasked, waiting;
+    MPI_Request *ctl_reqs;     /* control messages being sent, and their words */
+    ctl_msg **ctl_bufs;
+    int nctl, capctl;
     atomic_long sent;          /* S: packets handed to the transport this run */
     long received;             /* R: packets received this run (communication thread) */
     MPI_Request *reqs;         /* posted sends and their packets */
@@ -137,7 +163,132 @@ static void tp_send(vw_world *w, vw__worker *from, vw__packet *p)
     pthread_mutex_unlock(&t->mu);
 }
 
+/* Another process's copy's turn (vw__transport.take_turns): the request goes out through
+   the communication thread, and the worker waits for the answer. The worker counts as
+   busy meanwhile, so no termination wave can end the run before the answer is here, and
+   control messages need no place in the packet counts S and R. */
+static uint64_t tp_take_turns(vw_world *w, int cell, int unit, int thief, uint64_t nbatches,
+                              uint64_t *first)
+{
+    mpi_tp *t = tp_of(w);
+    const vw__cell *c = &w->cells[cell];
+    turn_req r = {.cell = cell, .unit = unit, .thief = thief, .nbatches = nbatches};
+    r.peer = vw__worker_process(w, unit ? c->reps[unit - 1].worker : c->worker);
+    pthread_mutex_lock(&t->mu);
+    r.next = t->turn_q;
+    t->turn_q = &r;
+    if (t->sleeping) pthread_cond_signal(&t->cv);
+    while (!r.answered) pthread_cond_wait(&t->turn_cv, &t->mu);
+    pthread_mutex_unlock(&t->mu);
+    *first = r.first;
+    return r.n;
+}
+
 /* ---- the communication thread ---------------------------------------------------------- */
+
+/* Sends a control message of n words (a copy, freed when the send completes). */
+static void ctl_send(vw_world *w, mpi_tp *t, int to, int tag, const uint64_t *v, int n)
+{
+    if (t->nctl == t->capctl) {
+        int cap = t->capctl;
+        t->ctl_reqs = grow(t->ctl_reqs, &cap, t->nctl + 1, sizeof *t->ctl_reqs);
+        t->ctl_bufs = grow(t->ctl_bufs, &t->capctl, t->nctl + 1, sizeof *t->ctl_bufs);
+    }
+    ctl_msg *m = malloc(sizeof *m);
+    if (!m) fatal(w, "out of memory sending a turn request");
+    memcpy(m->v, v, (size_t)n * sizeof *v);
+    t->ctl_bufs[t->nctl] = m;
+    MPI_Isend(m->v, n, MPI_UINT64_T, to, tag, t->comm, &t->ctl_reqs[t->nctl]);
+    t->nctl++;
+}
+
+static void ctl_complete(mpi_tp *t)
+{
+    int k = 0;
+    for (int i = 0; i < t->nctl; i++) {
+        int done = 0;
+        MPI_Test(&t->ctl_reqs[i], &done, MPI_STATUS_IGNORE);
+        if (done) {
+            free(t->ctl_bufs[i]);
+            continue;
+        }
+        t->ctl_reqs[k] = t->ctl_reqs[i];
+        t->ctl_bufs[k++] = t->ctl_bufs[i];
+    }
+    t->nctl = k;
+}
+
+/* Sends the workers' turn requests, each under a free id of `asked`. */
+static int post_turns(vw_world *w, mpi_tp *t)
+{
+    pthread_mutex_lock(&t->mu);
+    turn_req *r = t->turn_q;
+    t->turn_q = NULL;
+    pthread_mutex_unlock(&t->mu);
+    int any = r != NULL;
+    for (; r; r = r->next) {
+        int id = 0;
+        while (id < t->nasked && t->asked[id]) id++;
+        if (id == t->nasked) {
+            t->asked = grow(t->asked, &t->capasked, t->nasked + 1, sizeof *t->asked);
+            t->nasked++;
+        }
+        t->asked[id] = r;
+        t->waiting++;
+        uint64_t v[TURN_WORDS] = {(uint64_t)id, (uint64_t)r->cell, (uint64_t)r->unit,
+                                  (uint64_t)r->thief, r->nbatches};
+        ctl_send(w, t, r->peer, TAG_TURN, v, TURN_WORDS);
+    }
+    return any;
+}
+
+/* A turn message that MPI_Iprobe found (s): another process's request, answered at
+   once, or the answer to one of ours, handed to its waiting worker. */
+static void receive_turn(vw_world *w, mpi_tp *t, const MPI_Status *s)
+{
+    int n = 0;
+    MPI_Get_count(s, MPI_UINT64_T, &n);
+    char what[300];
+    int is_turn = s->MPI_TAG == TAG_TURN;
+    if (n != (is_turn ? TURN_WORDS : BACK_WORDS)) {
+        snprintf(what, sizeof what, "a turn %s from rank %d has %d words "
+                 "(do all processes run the same binary?)", is_turn ? "request" : "answer",
+                 s->MPI_SOURCE, n);
+        fatal(w, what);
+    }
+    uint64_t v[CTL_MAX];
+    MPI_Recv(v, n, MPI_UINT64_T, s->MPI_SOURCE, s->MPI_TAG, t->comm, MPI_STATUS_IGNORE);
+    if (is_turn) {
+        uint64_t first = 0;
+        uint64_t got = v[1] < (uint64_t)INT_MAX && v[2] < (uint64_t)INT_MAX &&
+                               v[3] < (uint64_t)INT_MAX
+                           ? vw__take_turns(w, (int)v[1], (int)v[2], (int)v[3], v[4], &first)
+                           : UINT64_MAX;
+        if (got == UINT64_MAX) {
+            snprintf(what, sizeof what, "rank %d asked for turns of cell %llu, copy %llu, "
+                     "which this process does not host", s->MPI_SOURCE,
+                     (unsigned long long)v[1], (unsigned long long)v[2]);
+            fatal(w, what);
+        }
+        uint64_t back[BACK_WORDS] = {v[0], first, got};
+        ctl_send(w, t, s->MPI_SOURCE, TAG_TURN_BACK, back, BACK_WORDS);
+        return;
+    }
+    turn_req *r = v[0] < (uint64_t)t->nasked ? t->asked[v[0]] : NULL;
+    if (!r || r->peer != s->MPI_SOURCE || v[2] > UINT64_MAX - v[1]) {
+        snprintf(what, sizeof what, "rank %d answered turn request %llu, which was not "
+                 "asked of it, or with a wrong range", s->MPI_SOURCE, (unsigned long long)v[0]);
+        fatal(w, what);
+    }
+    t->asked[v[0]] = NULL;
+    t->waiting--;
+    pthread_mutex_lock(&t->mu);
+    r->first = v[1];
+    r->n = v[2];
+    r->answered = 1;
+    pthread_cond_broadcast(&t->turn_cv);
+    pthread_mutex_unlock(&t->mu);
+}
 
 static void post_send(vw_world *w, mpi_tp *t, vw__packet *p)
 {
@@ -228,15 +379,27 @@ static void deliver_received(vw_world *w, mpi_tp *t, vw__packet *p)
     vw__deliver_local(w, p, w->cfg.stress_seed ? &t->rng : NULL);
 }
 
-/* Receives what has arrived (at most a batch, so sends and waves keep moving). */
+/* Receives what has arrived (at most a batch, so sends and waves keep moving): packets,
+   and turn requests and answers. */
 static int receive(vw_world *w, mpi_tp *t)
 {
     int any = 0;
     for (int k = 0; k < 64; k++) {
         int flag = 0, n = 0;
         MPI_Status s;
-        MPI_Iprobe(MPI_ANY_SOURCE, TAG_DATA, t->comm, &flag, &s);
+        MPI_Iprobe(MPI_ANY_SOURCE, MPI_ANY_TAG, t->comm, &flag, &s);
         if (!flag) break;
+        any = 1;
+        if (s.MPI_TAG == TAG_TURN || s.MPI_TAG == TAG_TURN_BACK) {
+            receive_turn(w, t, &s);
+            continue;
+        }
+        if (s.MPI_TAG != TAG_DATA) {
+            char what[120];
+            snprintf(what, sizeof what, "received a message with tag %d from rank %d",
+                     s.MPI_TAG, s.MPI_SOURCE);
+            fatal(w, what);
+        }
         MPI_Get_count(&s, MPI_BYTE, &n);
         if (n < (int)WIRE_HDR) fatal(w, "received a truncated packet");
         size_t cap = (size_t)n - WIRE_HDR;
@@ -260,7 +423,6 @@ static int receive(vw_world *w, mpi_tp *t)
             fatal(w, what);
         }
         t->received++;
-        any = 1;
         if (stress_roll(w, t))
             hold_packet(w, t, p, 0);
         else
@@ -310,7 +472,7 @@ static void pause_idle(mpi_tp *t, int rounds)
         ts.tv_nsec -= 1000000000L;
     }
     pthread_mutex_lock(&t->mu);
-    if (!t->qhead) {
+    if (!t->qhead && !t->turn_q) {
         t->sleeping = 1;
         pthread_cond_timedwait(&t->cv, &t->mu, &ts);
         t->sleeping = 0;
@@ -337,6 +499,8 @@ static vw_status tp_run(vw_world *w)
         progress |= complete_sends(w, t);
         progress |= receive(w, t);
         progress |= release_held(w, t);
+        progress |= post_turns(w, t);
+        ctl_complete(t);
         if (w->cfg.stress_seed && (vw__rng_next(&t->rng) & 15) == 0) {
             struct timespec ts = {0, (long)(vw__rng_next(&t->rng) % 300000)};
             nanosleep(&ts, NULL);
@@ -383,6 +547,12 @@ static vw_status tp_run(vw_world *w)
         free(p);
     }
     t->nsend = 0;
+    /* Every request was answered before its worker went idle, so every control message
+       was received. */
+    if (t->waiting) fatal(w, "a run ended with a turn request unanswered");
+    if (t->nctl) MPI_Waitall(t->nctl, t->ctl_reqs, statuses_ignore());
+    for (int i = 0; i < t->nctl; i++) free(t->ctl_bufs[i]);
+    t->nctl = 0;
     atomic_store(&t->sent, 0);
     t->received = 0;
     vw__uncount(w); /* our count: this brings active to 0 and ends the workers' loops */
@@ -493,8 +663,12 @@ static void tp_free(vw_world *w)
     free(t->reqs);
     free(t->sending);
     free(t->done_idx);
+    free(t->asked);
+    free(t->ctl_reqs);
+    free(t->ctl_bufs);
     pthread_mutex_destroy(&t->mu);
     pthread_cond_destroy(&t->cv);
+    pthread_cond_destroy(&t->turn_cv);
     free(t);
     w->transport = NULL;
 }
@@ -553,6 +727,7 @@ vw_status vw__mpi_attach(vw_world *w)
     t->level = level;
     pthread_mutex_init(&t->mu, NULL);
     pthread_cond_init(&t->cv, NULL);
+    pthread_cond_init(&t->turn_cv, NULL);
     atomic_init(&t->sent, 0);
     t->rng = w->cfg.stress_seed * 0x9e3779b97f4a7c15ull + (uint64_t)rank * 7919u + 3;
     t->garble = vw_test_fault("wire-garble");
@@ -560,6 +735,7 @@ vw_status vw__mpi_attach(vw_world *w)
     t->base.send = tp_send;
     t->base.run = tp_run;
     t->base.sync = tp_sync;
+    t->base.take_turns = tp_take_turns;
     t->base.free = tp_free;
     t->base.impl = t;
     w->transport = &t->base;

@@ -6,7 +6,14 @@
  * vw_config.worker_slowdown) leaves most of its share to the fast one. With worker
  * speeds (vw_config.worker_speeds) the shares follow them.
  *
+ * Under mpirun (--mpi) the copies are on every worker of every process, and a copy
+ * takes the turns of copies in other processes too (a request to the process that
+ * holds their counter). Each process sees only the batches its own copies made, so
+ * "every batch once" is checked on the gathered counters: how many were made, and the
+ * sum of a 40-bit hash of each batch's number.
+ *
  * usage: test_farm [--stress]   (also honours VW_STRESS)
+ *        mpirun -np N test_farm --mpi [--stress]
  */
 #include <stdatomic.h>
 #include <string.h>
@@ -14,11 +21,12 @@
 #include "vw_test.h"
 #include "vwalls/vwalls.h"
 
-enum { CNT_MADE, NCOUNTERS };
+enum { CNT_MADE, CNT_HASH, NCOUNTERS };
 
 typedef struct farm {
     uint64_t nbatches;
     atomic_int *made; /* per batch: times made in this run */
+    int work;         /* iterations of busy work a batch */
 } farm;
 
 /* The cells keep nothing of their own: their state is the shared farm. */
@@ -31,6 +39,15 @@ static vw_status build(vw_ctx *ctx, const void *objs, size_t n, void **state)
 
 static void cell_free(void *state, void *user) { (void)state, (void)user; }
 
+/* A batch number's hash (splitmix64's finaliser), 40 bits: sums of a million fit. */
+static int64_t batch_hash(uint64_t b)
+{
+    b += 0x9e3779b97f4a7c15ull;
+    b = (b ^ (b >> 30)) * 0xbf58476d1ce4e5b9ull;
+    b = (b ^ (b >> 27)) * 0x94d049bb133111ebull;
+    return (int64_t)((b ^ (b >> 31)) >> 24);
+}
+
 /* One batch per call, with a little work in it, so the slowdown's meter has time to
    stretch. */
 static int step(vw_ctx *ctx, void *state)
@@ -41,15 +58,16 @@ static int step(vw_ctx *ctx, void *state)
     if (b >= f->nbatches) return 0;
     atomic_fetch_add(&f->made[b], 1);
     vw_count(ctx, CNT_MADE, 1);
+    vw_count(ctx, CNT_HASH, batch_hash(b));
     volatile double x = 1;
-    for (int i = 0; i < 2000; i++) x = x * 1.0000001 + 1e-9;
+    for (int i = 0; i < f->work; i++) x = x * 1.0000001 + 1e-9;
     return 1;
 }
 
 static void ignore(vw_ctx *ctx, void *state, const void *msg) { (void)ctx, (void)state, (void)msg; }
 
 static const vw_msg_kind kinds[] = {{"unused", 8, ignore, NULL, VW_MSG_INDEPENDENT}};
-static const char *const counters[] = {"made"};
+static const char *const counters[] = {"made", "hash"};
 
 static const vw_module farm_module = {
     .abi = VW_MODULE_ABI,
@@ -63,16 +81,18 @@ static const vw_module farm_module = {
     .step = step,
 };
 
-/* Runs `runs` times a world of one cell with a copy on every other worker; returns the
-   batches worker 0 made per run on average. Every batch is made once in every run. */
-static int64_t farm_runs(int workers, int steal, const double *slowdown, const double *speeds,
-                         uint64_t nbatches, int runs, uint64_t stress)
+/* Runs `runs` times a world of one cell with a copy on every other worker (of every
+   process); returns the batches worker 0 made per run on average. Every batch is made
+   once in every run. `workers` is per process. */
+static int64_t farm_runs_work(int workers, int steal, const double *slowdown,
+                              const double *speeds, uint64_t nbatches, int runs, uint64_t stress,
+                              int work)
 {
     vw_box box = {{0, 0, 0}, {1, 1, 1}};
     int dims[3] = {1, 1, 1};
     vw_decomp *d;
     CHECK_EQ_INT(vw_decomp_create_grid(&box, dims, &d), VW_OK);
-    farm f = {nbatches, calloc(nbatches, sizeof(atomic_int))};
+    farm f = {nbatches, calloc(nbatches, sizeof(atomic_int)), work};
     CHECK(f.made != NULL);
     vw_config cfg;
     vw_config_init(&cfg);
@@ -83,21 +103,31 @@ static int64_t farm_runs(int workers, int steal, const double *slowdown, const d
     if (stress && !cfg.stress_seed) cfg.stress_seed = stress;
     vw_world *w;
     CHECK_EQ_INT(vw_world_create(&farm_module, &f, d, &cfg, &w), VW_OK);
+    int procs = vw_world_processes(w), gworkers = workers * procs;
     int on[64], n = 0;
-    for (int g = 1; g < workers && n < 64; g++) on[n++] = g;
+    for (int g = 1; g < gworkers && n < 64; g++) on[n++] = g;
     CHECK_EQ_INT(vw_world_set_replicas(w, 0, on, n), VW_OK);
+    int64_t hashes = 0;
+    for (uint64_t b = 0; b < nbatches; b++) hashes += batch_hash(b);
     for (int r = 0; r < runs; r++) {
         for (uint64_t b = 0; b < nbatches; b++) atomic_store(&f.made[b], 0);
         CHECK_EQ_INT(vw_world_run(w), VW_OK);
-        uint64_t wrong = 0;
-        for (uint64_t b = 0; b < nbatches; b++) wrong += atomic_load(&f.made[b]) != 1;
-        EXPECT(wrong == 0, "%d workers, steal %d, run %d: %llu of %llu batches not made once",
-               workers, steal, r, (unsigned long long)wrong, (unsigned long long)nbatches);
-        /* The workers' counters add up over the runs. */
-        int64_t sum = 0;
-        for (int g = 0; g < workers; g++) sum += vw_world_worker_counter(w, g, CNT_MADE);
-        EXPECT(sum == (int64_t)nbatches * (r + 1), "run %d: the workers made %lld batches", r,
-               (long long)sum);
+        if (procs == 1) {
+            uint64_t wrong = 0;
+            for (uint64_t b = 0; b < nbatches; b++) wrong += atomic_load(&f.made[b]) != 1;
+            EXPECT(wrong == 0, "%d workers, steal %d, run %d: %llu of %llu batches not made once",
+                   workers, steal, r, (unsigned long long)wrong, (unsigned long long)nbatches);
+        }
+        /* The workers' counters (every process's) add up over the runs. */
+        int64_t sum = 0, hash = 0;
+        for (int g = 0; g < gworkers; g++) {
+            sum += vw_world_worker_counter(w, g, CNT_MADE);
+            hash += vw_world_worker_counter(w, g, CNT_HASH);
+        }
+        EXPECT(sum == (int64_t)nbatches * (r + 1) && hash == hashes * (r + 1),
+               "%d processes x %d workers, steal %d, run %d: the workers made %lld batches of "
+               "%llu a run, hash sum %s", procs, workers, steal, r, (long long)sum,
+               (unsigned long long)nbatches, hash == hashes * (r + 1) ? "right" : "wrong");
     }
     int64_t mine = vw_world_worker_counter(w, 0, CNT_MADE);
     vw_world_free(w);
@@ -106,9 +136,63 @@ static int64_t farm_runs(int workers, int steal, const double *slowdown, const d
     return runs > 0 ? mine / runs : 0;
 }
 
+static int64_t farm_runs(int workers, int steal, const double *slowdown, const double *speeds,
+                         uint64_t nbatches, int runs, uint64_t stress)
+{
+    return farm_runs_work(workers, steal, slowdown, speeds, nbatches, runs, stress, 2000);
+}
+
+/* Under mpirun: one worker per process, the copies spread over the processes. */
+static void mpi_main(uint64_t stress)
+{
+    int procs = vw_engine_size();
+    /* Off: exactly the turns, equal shares (402 batches: the master's share is 402 / N
+       rounded up for N processes of one worker). */
+    int64_t mine = farm_runs(1, 0, NULL, NULL, 402, 2, stress);
+    int64_t share = (402 + procs - 1) / procs;
+    EXPECT(mine == share, "steal off, %d processes: worker 0 made %lld of 402 batches, not "
+           "its %lld turns", procs, (long long)mine, (long long)share);
+    /* On, every other process's worker 8 times slower: worker 0 takes most of their
+       turns, asking their processes for them. A batch takes about 0.1 ms (8 times that
+       slowed), so a turn's round trip between processes costs less than making it. */
+    double slow[16];
+    for (int g = 0; g < 16; g++) slow[g] = g ? 8.0 : 1.0;
+    if (procs <= 16) {
+        mine = farm_runs_work(1, 1, slow, NULL, 400, 2, stress, 50000);
+        EXPECT(mine > 400 / procs + 400 / (2 * procs), "steal on, the other processes slowed "
+               "8x: worker 0 made only %lld of 400 batches", (long long)mine);
+    }
+    /* Every batch once with two workers a process, with equal and unequal speeds. */
+    static const double mixed[16] = {1.0, 2.5, 0.001, 7.0, 1.0, 3.0, 1.0, 2.0,
+                                     1.0, 2.5, 0.001, 7.0, 1.0, 3.0, 1.0, 2.0};
+    for (int steal = 0; steal <= 1; steal++) {
+        farm_runs(2, steal, NULL, NULL, 997, 3, stress);
+        if (procs <= 8) farm_runs(2, steal, NULL, mixed, 997, 2, stress);
+    }
+    farm_runs(1, 1, NULL, NULL, 1, 2, stress); /* fewer batches than copies */
+}
+
 int main(int argc, char **argv)
 {
-    uint64_t stress = argc > 1 && !strcmp(argv[1], "--stress") ? 7 : 0;
+    int mpi = 0;
+    uint64_t stress = 0;
+    for (int i = 1; i < argc; i++) {
+        if (!strcmp(argv[i], "--stress"))
+            stress = 7;
+        else if (!strcmp(argv[i], "--mpi"))
+            mpi = 1;
+    }
+    if (mpi) {
+        char msg[300];
+        if (vw_engine_init(&argc, &argv, msg, sizeof msg) != VW_OK) {
+            fprintf(stderr, "test_farm: %s\n", msg);
+            return 1;
+        }
+        mpi_main(stress);
+        printf("farm (%d processes): %d failures\n", vw_engine_size(), vw_test_failures);
+        vw_engine_finish();
+        return vw_test_failures ? 1 : 0;
+    }
     /* Off: exactly the turns, equal shares (101 batches: the master gets one more). */
     int64_t mine = farm_runs(2, 0, NULL, NULL, 101, 3, stress);
     EXPECT(mine == 51, "steal off: worker 0 made %lld of 101 batches a run, not its 51 turns",

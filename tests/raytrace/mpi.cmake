@@ -10,30 +10,44 @@ execute_process(COMMAND ${VWALLS} render ${SCENE} -o ${WORK}/ref.png --size 80x6
 if(NOT rc EQUAL 0)
   message(FATAL_ERROR "threads engine: exit ${rc}: ${err}")
 endif()
+execute_process(COMMAND ${VWALLS} render ${SCENE} -o ${WORK}/ref_large.png --size 160x120 --quiet
+                RESULT_VARIABLE rc ERROR_VARIABLE err)
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "threads engine: exit ${rc}: ${err}")
+endif()
 # np; cells; workers; farm (copies of cells: none, on idle workers and processes
-# (1 cell on 2 processes), on every worker); worker speeds (the copies' shares follow
-# them across processes: checked below)
+# (1 cell on 2 processes), on every worker); a check below: "quarter" (speeds 1,3, no
+# turns taken: the shares follow the speeds across processes) or "stolen" (process 1
+# slowed 8x, equal shares: process 0 takes process 1's turns); more flags, '|' between.
 foreach(case "2;2x2x2;1;none" "2;4x1x2;2;none" "3;2x2;1;none" "2;1;1;idle" "3;1;2;idle"
-             "2;2x2x2;2;all" "2;1;1;idle;1,3")
+             "2;2x2x2;2;all" "2;1;1;idle;quarter;--speeds|1,3|--steal|off"
+             "2;1;1;idle;stolen;--slow|1:8|--speeds|1,1|--steal|on|--size|160x120")
   list(GET case 0 np)
   list(GET case 1 cells)
   list(GET case 2 workers)
   list(GET case 3 farm)
-  set(speeds "")
+  set(check "")
+  set(flags --size 80x60)
+  set(ref ${WORK}/ref.png)
   list(LENGTH case ncase)
   if(ncase GREATER 4)
-    list(GET case 4 sp)
-    set(speeds --speeds ${sp})
+    list(GET case 4 check)
+    list(GET case 5 more)
+    string(REPLACE "|" ";" more "${more}")
+    list(APPEND flags ${more})
+    if(check STREQUAL "stolen")
+      set(ref ${WORK}/ref_large.png)
+    endif()
   endif()
-  set(out ${WORK}/np${np}_${cells}_${workers}_${farm}.png)
+  set(out ${WORK}/np${np}_${cells}_${workers}_${farm}${check}.png)
   execute_process(COMMAND ${MPIRUN} ${NPFLAG} ${np} ${pre} ${VWALLS} render ${SCENE} -o ${out}
-                          --size 80x60 --cells ${cells} --workers ${workers} --farm ${farm}
-                          ${speeds} --quiet --stats ${WORK}/np${np}.json
+                          ${flags} --cells ${cells} --workers ${workers} --farm ${farm}
+                          --quiet --stats ${WORK}/np${np}.json
                   RESULT_VARIABLE rc ERROR_VARIABLE err TIMEOUT 60)
   if(NOT rc EQUAL 0)
     message(FATAL_ERROR "mpirun -np ${np} --cells ${cells}: exit ${rc}: ${err}")
   endif()
-  execute_process(COMMAND ${CMAKE_COMMAND} -E compare_files ${WORK}/ref.png ${out}
+  execute_process(COMMAND ${CMAKE_COMMAND} -E compare_files ${ref} ${out}
                   RESULT_VARIABLE same)
   if(NOT same EQUAL 0)
     message(FATAL_ERROR "mpirun -np ${np} --cells ${cells} --workers ${workers} --farm ${farm}: "
@@ -44,16 +58,27 @@ foreach(case "2;2x2x2;1;none" "2;4x1x2;2;none" "3;2x2;1;none" "2;1;1;idle" "3;1;
   if(at LESS 0)
     message(FATAL_ERROR "stats JSON does not say ${np} processes")
   endif()
-  if(speeds)
-    # Speeds 1,3: the master on process 0 makes a quarter of the cell's eye rays (8 of
-    # every 32 batches), the copy on process 1 the rest; no turns cross processes.
+  if(check)
     string(JSON p0 GET "${json}" workers 0 counters pixels)
     string(JSON p1 GET "${json}" workers 1 counters pixels)
     math(EXPR all "${p0} + ${p1}")
+  endif()
+  if(check STREQUAL "quarter")
+    # Speeds 1,3, no stealing: the master on process 0 makes a quarter of the cell's eye
+    # rays (8 of every 32 batches), the copy on process 1 the rest.
     math(EXPR lo "${all} / 5")
     math(EXPR hi "${all} * 3 / 10")
     if(p0 LESS lo OR p0 GREATER hi)
-      message(FATAL_ERROR "--speeds ${sp}: process 0 made ${p0} of ${all} eye rays, not about a quarter")
+      message(FATAL_ERROR "${flags}: process 0 made ${p0} of ${all} eye rays, not about a quarter")
+    endif()
+  elseif(check STREQUAL "stolen")
+    # Equal shares, process 1 eight times slower: process 0, done with its half, takes
+    # process 1's turns by asking (0.73-0.76 of the eye rays measured; exactly half
+    # without: the share).
+    math(EXPR lo "${all} * 63 / 100")
+    if(p0 LESS lo)
+      message(FATAL_ERROR "${flags}: process 0 made only ${p0} of ${all} eye rays: no turns "
+                          "taken from the slowed process")
     endif()
   endif()
 endforeach()

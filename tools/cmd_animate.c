@@ -227,32 +227,42 @@ static int do_frame(vw_anim_session *s)
     return 0;
 }
 
-/* One line of the language (len bytes, its newline included). Returns nonzero when the
-   session must stop. */
-static int session_line(vw_anim_session *s, const char *line, size_t len, int lineno)
+/* Parses one line of the language (len bytes); a line that does not parse is reported
+   (stderr and the log), counted as invalid, and VW_E_INPUT comes back. */
+static vw_status parse_line(vw_anim_session *s, const char *line, size_t len, int lineno,
+                            vw_edit *e)
 {
-    vw_edit e;
     char err[512];
     vw_status pst;
     if (memchr(line, '\0', len)) { /* the parser would stop at it and not see the rest */
         snprintf(err, sizeof err, "%s:%d: a NUL byte in the line", s->name, lineno);
         pst = VW_E_INPUT;
     } else {
-        pst = vw_edit_parse(line, s->name, lineno, &e, err, sizeof err);
+        pst = vw_edit_parse(line, s->name, lineno, e, err, sizeof err);
     }
-    if (pst != VW_OK) {
-        int out = vw_cli_is_output();
-        if (out) fprintf(stderr, "%s\n", err);
-        if (s->log && out) {
-            /* The message after its "name:line: ", in the log's own format. */
-            char prefix[64];
-            int k = snprintf(prefix, sizeof prefix, ":%d: ", lineno);
-            const char *why = strstr(err, prefix);
-            fprintf(s->log, "%s:%d: invalid: %s\n", s->name, lineno, why ? why + k : err);
-        }
-        s->acc.invalid++;
-        s->total_invalid++;
-        s->bad_lines++;
+    if (pst == VW_OK) return VW_OK;
+    int out = vw_cli_is_output();
+    if (out) fprintf(stderr, "%s\n", err);
+    if (s->log && out) {
+        /* The message after its "name:line: ", in the log's own format. */
+        char prefix[64];
+        int k = snprintf(prefix, sizeof prefix, ":%d: ", lineno);
+        const char *why = strstr(err, prefix);
+        fprintf(s->log, "%s:%d: invalid: %s\n", s->name, lineno, why ? why + k : err);
+    }
+    s->acc.invalid++;
+    s->total_invalid++;
+    s->bad_lines++;
+    return VW_E_INPUT;
+}
+
+/* One line of the language (len bytes, its newline included). Returns nonzero when the
+   session must stop. */
+static int session_line(vw_anim_session *s, const char *line, size_t len, int lineno)
+{
+    vw_edit e;
+    char err[512];
+    if (parse_line(s, line, len, lineno, &e) != VW_OK) {
         if (!s->interactive && !s->keep_going) {
             flush(s);
             return s->failed = 2;
@@ -465,6 +475,36 @@ static ssize_t next_line(edits_src *e, const char **line, int *read_error)
     return len;
 }
 
+/* Where the line piece starting at p ends: at a lone CR (a line end of classic Mac OS
+   files, as in the NFF and OBJ readers; CRLF is one line end) or at end. */
+static const char *piece_end(const char *p, const char *end)
+{
+    while (p < end && !(*p == '\r' && (p + 1 == end || p[1] != '\n'))) p++;
+    return p;
+}
+
+/* animate without --keep-going: every line of the script is parsed before the first
+   edit, so a line that does not parse (a typo at the end of a long script) stops the
+   run before any frame is written, and every such line is reported at once. Lines that
+   parse but cannot be applied (an id already removed, a move out of the world box)
+   are found only when they are reached. Returns the number of bad lines. */
+static int precheck(vw_anim_session *s, const edits_src *ed)
+{
+    int lineno = 0, bad = 0;
+    for (size_t pos = 0; pos < ed->len;) {
+        const char *p = ed->text + pos, *nl = memchr(p, '\n', ed->len - pos);
+        const char *end = nl ? nl + 1 : ed->text + ed->len;
+        pos = (size_t)(end - ed->text);
+        while (p < end) {
+            const char *q = piece_end(p, end);
+            vw_edit e;
+            bad += parse_line(s, p, (size_t)(q - p), ++lineno, &e) != VW_OK;
+            p = q + 1;
+        }
+    }
+    return bad;
+}
+
 /* The whole command, for both animate (edits from a file) and edit (from stdin). */
 int vw_anim_main(const char *cmd, int argc, char **argv)
 {
@@ -617,14 +657,13 @@ int vw_anim_main(const char *cmd, int argc, char **argv)
     }
     int read_error = 0;
     int stop = 0;
+    if (ed.text && !s->keep_going && precheck(s, &ed)) stop = s->failed = 2;
     while (!stop && (len = next_line(&ed, &line, &read_error)) > 0) {
-        /* A lone CR ends a line too (classic Mac OS files), as in the NFF and OBJ
-           readers; CRLF is one line end. The parser stops at the CR, so each piece is
+        /* A lone CR ends a line too; the parser stops at the CR, so each piece is
            handed over in place. */
         const char *p = line, *end = line + len;
         while (!stop && p < end) {
-            const char *q = p;
-            while (q < end && !(*q == '\r' && (q + 1 == end || q[1] != '\n'))) q++;
+            const char *q = piece_end(p, end);
             lineno++;
             stop = session_line(s, p, (size_t)(q - p), lineno);
             p = q + 1;

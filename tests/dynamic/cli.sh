@@ -135,11 +135,26 @@ PY
 cmp -s f00.png g00.png && cmp -s f01.png g01.png || fail "frames differ with one cell farmed"
 
 printf 'frame\nmove 999999 1 0 0\nfrobnicate 3\nmove 1 nan 0 0\nmoveto 2 1e9 0 0\nframe\n' > bad.txt
-"$V" animate scene.nff bad.txt -o 'b%02d.png' --workers 2 > bout.txt 2> berr.txt
+# Lines that do not parse are found before the first edit: all of them reported, and no
+# frame, not even the one before them.
+"$V" animate scene.nff bad.txt -o 'bad%02d.png' --workers 2 --log blog.txt > bout.txt 2> berr.txt
 rc=$?
 [ $rc -eq 2 ] || fail "bad script: status $rc, expected 2"
-grep -q '^bad.txt:2: no object 999999' berr.txt || fail "unknown id message: $(cat berr.txt)"
-[ -e b01.png ] && fail "a frame after the bad line was rendered"
+grep -q '^bad.txt:3: unknown command' berr.txt && grep -q '^bad.txt:4: bad number' berr.txt ||
+  fail "unparsable lines not all reported: $(cat berr.txt)"
+grep -q 'no object 999999' berr.txt && fail "an edit was applied before the script was checked"
+[ -e bad00.png ] && fail "a frame was rendered from a script with a line that does not parse"
+grep -q '2 invalid; 0 frames' bout.txt || fail "bad script summary: $(tail -1 bout.txt)"
+[ "$(grep -c invalid blog.txt)" -eq 2 ] || fail "bad script log: $(cat blog.txt)"
+# A line that parses but cannot be applied stops the run when it is reached: the frames
+# before it stay, none after.
+printf 'frame\nmove 999999 1 0 0\nframe\n' > badid.txt
+"$V" animate scene.nff badid.txt -o 'i%02d.png' --workers 2 > /dev/null 2> ierr.txt
+rc=$?
+[ $rc -eq 2 ] || fail "unknown id script: status $rc, expected 2"
+grep -q '^badid.txt:2: no object 999999' ierr.txt || fail "unknown id message: $(cat ierr.txt)"
+[ -s i00.png ] || fail "the frame before the unknown id is missing"
+[ -e i01.png ] && fail "a frame after the bad line was rendered"
 
 # --keep-going renders every frame, and the bad lines still make the status 2; all four
 # count as invalid and are in the log, the unparsable ones too.

@@ -205,6 +205,70 @@ double vw_cli_now(void)
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
+/* A number from a one-line file (cgroup v2 limits), or 0 for "max", absent or bad. */
+static uint64_t file_u64(const char *path)
+{
+    FILE *f = fopen(path, "r");
+    if (!f) return 0;
+    unsigned long long v = 0;
+    int ok = fscanf(f, "%llu", &v) == 1;
+    fclose(f);
+    return ok ? (uint64_t)v : 0;
+}
+
+uint64_t vw_cli_mem_available(void)
+{
+    const char *env = getenv("VW_MEM_AVAILABLE");
+    if (env && *env) {
+        char *end;
+        errno = 0;
+        unsigned long long v = strtoull(env, &end, 10);
+        if (!errno && *end == 0 && v > 0) return (uint64_t)v;
+    }
+    uint64_t avail = 0;
+    FILE *f = fopen("/proc/meminfo", "r");
+    if (f) {
+        char line[256];
+        unsigned long long kb;
+        while (fgets(line, sizeof line, f))
+            if (sscanf(line, "MemAvailable: %llu kB", &kb) == 1) {
+                avail = (uint64_t)kb * 1024;
+                break;
+            }
+        fclose(f);
+    }
+    /* A container's limit (cgroup v2, the process's own group as mounted), if lower. */
+    uint64_t max = file_u64("/sys/fs/cgroup/memory.max"), cur = file_u64("/sys/fs/cgroup/memory.current");
+    if (max > 0) {
+        uint64_t left = max > cur ? max - cur : 0;
+        if (!avail || left < avail) avail = left ? left : 1;
+    }
+    return avail;
+}
+
+const char *vw_cli_bytes(double n, char *buf, size_t len)
+{
+    if (n >= 1e9)
+        snprintf(buf, len, "%.2f GB", n / 1e9);
+    else if (n >= 1e6)
+        snprintf(buf, len, "%.0f MB", n / 1e6);
+    else
+        snprintf(buf, len, "%.0f kB", n / 1e3);
+    return buf;
+}
+
+int vw_cli_local_processes(void)
+{
+    /* Open MPI and MPICH's launcher (Hydra) say how many processes share this host. */
+    const char *names[] = {"OMPI_COMM_WORLD_LOCAL_SIZE", "MPI_LOCALNRANKS"};
+    for (int i = 0; i < 2; i++) {
+        const char *v = getenv(names[i]);
+        long n = v ? strtol(v, NULL, 10) : 0;
+        if (n >= 1 && n <= 1 << 20) return (int)n;
+    }
+    return 1;
+}
+
 static void ignore_warning(const char *msg, void *user) { (void)msg, (void)user; }
 
 /* MPI only when a launcher started us (the library decides: vw_engine_init does nothing

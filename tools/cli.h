@@ -140,6 +140,15 @@ void vw_progress_update(vw_progress *p, double fraction, const char *note);
 void vw_progress_end(vw_progress *p);
 
 double vw_cli_now(void);
+/* Memory this process may still take, in bytes: /proc/meminfo's MemAvailable, or less
+   when a cgroup v2 limit (memory.max) leaves less; 0 when unknown. VW_MEM_AVAILABLE=N
+   (bytes) says it instead (tests play a small machine). */
+uint64_t vw_cli_mem_available(void);
+/* How many processes of the job run on this host (the launcher's environment; 1 when
+   it does not say). */
+int vw_cli_local_processes(void);
+/* n bytes for a message: "1.23 GB", "45 MB" or "678 kB" (in buf). */
+const char *vw_cli_bytes(double n, char *buf, size_t len);
 
 /* Appends printf output to the string *buf (length *len, capacity *cap; *buf may start
    NULL with both 0), growing it as needed. Returns 0 when out of memory, and then leaves

@@ -34,7 +34,9 @@ static void help(void)
            "  --sf X               stop when max unshot power / emitted < X (default 1e-3)\n"
            "  --hemicube RES       hemicube resolution, even, <= %d (default 64)\n"
            "  --patch-size S       largest patch side (default: scene extent / 10)\n"
-           "  --elements K         receiver elements per patch side (default 2)\n"
+           "  --elements K         receiver elements per patch side (default 2), about 300\n"
+           "                       bytes each: a solve that needs more memory than the\n"
+           "                       host has left is refused before it starts\n"
            "  --per-round K        shots per cell between convergence checks (default 16)\n"
            "  --neighbourhood D    a shot reaches only cells within D of the shooter\n"
            "  --subdivide T        split elements whose radiosity varies inside them (or differs\n"
@@ -177,6 +179,28 @@ static int parse_view(const char *v, vw_camera *cam)
         return -1;
     }
     return 0;
+}
+
+/* The elements' memory, known once the scene is meshed, against what this host has
+   left: a solve that cannot fit is refused now, not part-way (or by the kernel's
+   out-of-memory killer, under overcommit). The processes share the elements (the
+   cells are mapped by element count), and the host's memory is shared by the job's
+   processes on it. */
+static int check_memory(const rad_mesh *m, const rad_options *o, char *err, size_t len)
+{
+    double elements = 0, need = rad_mesh_solve_bytes(m, o, &elements) / vw_engine_size();
+    double avail = (double)vw_cli_mem_available() / vw_cli_local_processes();
+    if (!(avail > 0) || need <= avail) return VW_EXIT_OK;
+    int fine = o->subdivide > 0 && o->max_level > 0;
+    char a[32], b[32];
+    return vw_cli_fail(CMD, VW_EXIT_USAGE, err, len,
+                       "the solve needs about %s a process (%.0f elements of about %.0f "
+                       "bytes%s), more than the %s this host has left for it: give a "
+                       "smaller --elements%s, a larger --patch-size, or more processes",
+                       vw_cli_bytes(need, a, sizeof a), elements, RAD_ELEM_BYTES,
+                       fine ? ", each with the 4^--max-level fine cells of --subdivide, about "
+                              "60 bytes each" : "",
+                       vw_cli_bytes(avail, b, sizeof b), fine ? " or --max-level" : "");
 }
 
 int vw_cmd_radiosity(int argc, char **argv)
@@ -386,6 +410,7 @@ int vw_cmd_radiosity(int argc, char **argv)
     mo.quiet = !vw_cli_is_output();
     if (rc == VW_EXIT_OK && (st = rad_mesh_build(sc, scene_path, d, &mo, &mesh, err, sizeof err)) != VW_OK)
         rc = st == VW_E_INPUT || st == VW_E_LIMIT ? VW_EXIT_USAGE : VW_EXIT_FAIL;
+    if (rc == VW_EXIT_OK) rc = check_memory(&mesh, &o, err, sizeof err);
     r.scene = sc;
     r.mesh = &mesh;
     r.sf = o.sf;

@@ -136,6 +136,34 @@ void rad_piece_grid(const rad_piece *pc, int lo[2], int hi[2])
     lo[1] = (int)floor(vmin / pc->elem), hi[1] = (int)floor(vmax / pc->elem);
 }
 
+double rad_mesh_solve_bytes(const rad_mesh *m, const rad_options *o, double *elements)
+{
+    /* The level-0 squares each piece's extent covers, its edges pulled in by a millionth
+       of a square: a patch edge lies on a grid line, and the square beyond it (a sliver
+       the solver drops) is not counted. Still an upper bound for pieces that are not
+       rectangles. */
+    double n = 0;
+    for (size_t p = 0; p < m->npieces; p++) {
+        const rad_piece *pc = &m->pieces[p];
+        double umin = INFINITY, umax = -INFINITY, vmin = INFINITY, vmax = -INFINITY;
+        for (int i = 0; i < pc->nv; i++) {
+            double d[3];
+            rad_sub(pc->v[i], pc->origin, d);
+            double u = rad_dot(d, pc->uax), v = rad_dot(d, pc->vax);
+            umin = fmin(umin, u), umax = fmax(umax, u), vmin = fmin(vmin, v), vmax = fmax(vmax, v);
+        }
+        double tol = 1e-6 * pc->elem;
+        double nu = floor((umax - tol) / pc->elem) - floor((umin + tol) / pc->elem) + 1;
+        double nv = floor((vmax - tol) / pc->elem) - floor((vmin + tol) / pc->elem) + 1;
+        n += fmax(nu, 1) * fmax(nv, 1);
+    }
+    if (elements) *elements = n;
+    double fine = o->subdivide > 0 && o->max_level > 0
+                      ? (double)(1 << 2 * (o->max_level < RAD_MAX_LEVEL ? o->max_level : RAD_MAX_LEVEL))
+                      : 0;
+    return n * (RAD_ELEM_BYTES + fine * RAD_FINE_BYTES);
+}
+
 int rad_elem_polygon(const rad_piece *pc, int level, int gi, int gj, rad_poly *out)
 {
     rad_poly p;

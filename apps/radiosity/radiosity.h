@@ -112,6 +112,17 @@ double rad_poly_area(const rad_poly *p, double normal[3], double centroid[3]);
    level-0 element from the first shot on (module.c), so it bounds that memory. */
 #define RAD_MAX_LEVEL 4
 
+/* Memory of the solve, measured (peak RSS of the Cornell box at --elements 2 to 32 and
+   --max-level 3 and 4, nineteenth session): a level-0 element with its vertices and
+   hash entry about 300 bytes, a fine cell of --subdivide about 60. */
+#define RAD_ELEM_BYTES 300.0
+#define RAD_FINE_BYTES 60.0
+/* Bytes the solver takes for the mesh's elements from its start, at least: every
+   level-0 element and, with --subdivide, its 4^max_level fine cells; elements split
+   during the solve come on top. *elements (may be NULL) gets the level-0 count (an
+   upper bound for pieces that are not rectangles). */
+double rad_mesh_solve_bytes(const rad_mesh *m, const rad_options *o, double *elements);
+
 /* ---- hemicube (hemicube.c) ---- */
 
 typedef struct rad_hemicube {

@@ -60,6 +60,24 @@ rm -f "$T/v.png"
 [ $rc -eq 2 ] || fail "--patch-size 1e-9: exit $rc"
 grep -q "patch size 1e-09 is too small" "$T/err" || fail "--patch-size 1e-9: message: $(cat "$T/err")"
 [ ! -e "$T/p.ply" ] || fail "--patch-size 1e-9: output written"
+# A solve larger than the memory left: refused before it starts (it used to fail part-way,
+# or be killed), with the estimate; the estimate follows --elements and --max-level
+# (--elements 8: about 43,000 elements of 300 bytes, 13 MB; with --subdivide and
+# --max-level 3, 64 fine cells of 60 bytes each more, about 180 MB).
+VW_MEM_AVAILABLE=5000000 "$V" radiosity "$T/cornell.nff" -o "$T/m.ply" --elements 8 --quiet \
+  2>"$T/err"; rc=$?
+[ $rc -eq 2 ] || fail "memory: exit $rc"
+grep -q "the solve needs about 1[0-9] MB a process (4[0-9]* elements of about 300 bytes), more than the 5 MB" \
+  "$T/err" || fail "memory: message: $(cat "$T/err")"
+[ ! -e "$T/m.ply" ] || fail "memory: output written"
+VW_MEM_AVAILABLE=50000000 "$V" radiosity "$T/cornell.nff" -o "$T/m.ply" --elements 8 --max-shots 4 \
+  --quiet 2>"$T/err" && [ -s "$T/m.ply" ] || fail "memory: 50 MB: $(cat "$T/err")"
+rm -f "$T/m.ply"
+VW_MEM_AVAILABLE=50000000 "$V" radiosity "$T/cornell.nff" -o "$T/m.ply" --elements 8 --subdivide 0.1 \
+  --max-level 3 --quiet 2>"$T/err"; rc=$?
+[ $rc -eq 2 ] || fail "memory, --max-level 3: exit $rc"
+grep -q "needs about 1[5-9][0-9] MB a process" "$T/err" || fail "memory, --max-level 3: $(cat "$T/err")"
+[ ! -e "$T/m.ply" ] || fail "memory, --max-level 3: output written"
 # sf above every patch's share of the emitted power: converged at once, and said so.
 "$V" radiosity "$T/cornell.nff" -o "$T/p.ply" --sf 0.5 >/dev/null 2>"$T/err" || fail "--sf 0.5"
 grep -q "warning: converged before the first shot" "$T/err" || fail "--sf 0.5: no warning"

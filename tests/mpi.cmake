@@ -67,6 +67,10 @@ endif()
 if(TARGET test_farm)
   vw_mpi_test(mpi_farm_np2 2 COMMAND $<TARGET_FILE:test_farm> --mpi)
   vw_mpi_test(mpi_farm_stress_np3 3 ENV "VW_STRESS=3" COMMAND $<TARGET_FILE:test_farm> --mpi --stress)
+  # A turn request naming a copy the receiver does not host ends the job, saying so.
+  vw_mpi_script_test(mpi_turn_check 2 must_say.sh 60 turn
+                     "asked for turns of cell 0, copy [0-9]+, which this process does not host"
+                     $<TARGET_FILE:test_farm> --mpi --garble-turn)
 endif()
 vw_mpi_test(mpi_agree_np1 1 COMMAND $<TARGET_FILE:test_mpi_storm> --agree)
 vw_mpi_test(mpi_agree_np3 3 COMMAND $<TARGET_FILE:test_mpi_storm> --agree)
@@ -126,4 +130,6 @@ endforeach()
 
 # A peer whose module has a message kind more (another build): the receiver checks every
 # packet from another process and stops the job, naming the sender.
-vw_mpi_script_test(mpi_wire_check 2 wire.sh 60 $<TARGET_FILE:test_mpi_storm>)
+vw_mpi_script_test(mpi_wire_check 2 must_say.sh 60 wire
+                   "rank 0: packet from rank 1 .*malformed: message 0 is of kind 2"
+                   $<TARGET_FILE:test_mpi_storm> --wire)

@@ -93,6 +93,7 @@ typedef struct mpi_tp {
     uint64_t rng;
     uint64_t waves; /* all runs: how many termination waves it took */
     int garble;     /* VW_FAULT=wire-garble: the next packet to a cell goes out garbled */
+    int turn_garble; /* VW_FAULT=turn-garble: the next turn request names no copy */
 } mpi_tp;
 
 /* MPICH defines MPI_STATUSES_IGNORE as (MPI_Status *)1, which GCC 12's
@@ -237,6 +238,10 @@ static int post_turns(vw_world *w, mpi_tp *t)
         t->waiting++;
         uint64_t v[TURN_WORDS] = {(uint64_t)id, (uint64_t)r->cell, (uint64_t)r->unit,
                                   (uint64_t)r->thief, r->nbatches};
+        if (t->turn_garble) { /* the check's test: a copy one past the cell's last */
+            v[2] = (uint64_t)w->cells[r->cell].nreps + 1;
+            t->turn_garble = 0;
+        }
         ctl_send(w, t, r->peer, TAG_TURN, v, TURN_WORDS);
     }
     return any;
@@ -731,6 +736,7 @@ vw_status vw__mpi_attach(vw_world *w)
     atomic_init(&t->sent, 0);
     t->rng = w->cfg.stress_seed * 0x9e3779b97f4a7c15ull + (uint64_t)rank * 7919u + 3;
     t->garble = vw_test_fault("wire-garble");
+    t->turn_garble = vw_test_fault("turn-garble");
     t->base.name = "mpi";
     t->base.send = tp_send;
     t->base.run = tp_run;

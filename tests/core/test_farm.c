@@ -12,8 +12,12 @@
  * "every batch once" is checked on the gathered counters: how many were made, and the
  * sum of a 40-bit hash of each batch's number.
  *
+ * --garble-turn (under mpirun): every process's first turn request names a copy that
+ * does not exist (VW_FAULT=turn-garble); the receiver must end the job saying so
+ * (mpi_turn_check).
+ *
  * usage: test_farm [--stress]   (also honours VW_STRESS)
- *        mpirun -np N test_farm --mpi [--stress]
+ *        mpirun -np N test_farm --mpi [--stress] [--garble-turn]
  */
 #include <stdatomic.h>
 #include <string.h>
@@ -181,6 +185,8 @@ int main(int argc, char **argv)
             stress = 7;
         else if (!strcmp(argv[i], "--mpi"))
             mpi = 1;
+        else if (!strcmp(argv[i], "--garble-turn"))
+            setenv("VW_FAULT", "turn-garble", 1); /* read by the transport */
     }
     if (mpi) {
         char msg[300];

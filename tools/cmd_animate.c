@@ -323,7 +323,7 @@ static void help(const char *cmd)
     printf("  -o PATTERN       frame file names: a .png name with one %%d (like %%04d) for the\n"
            "                   frame number (from 0), %%%% for a percent sign\n"
            "  --cells L        layout of cells, like 4, 2x4, 2x2x2 (default 1)\n"
-           "  --workers W      worker threads per process (default: number of cores)\n"
+           "  --workers W      worker threads per process (default: the cores it may run on)\n"
            "  --size WxH       image size (default: the scene's, else 512x512)\n"
            "  --depth D        maximum ray depth (default 5)\n"
            "  --balance S      none|tensor|rotate|staggered|divide: rebalance between frames\n"

@@ -25,7 +25,7 @@ static void help(void)
            "  --radius R     largest radius (default 0.035, near percolation for 10000 spheres)\n"
            "  --seed S       random seed (default 1)\n"
            "  --cells L      layout of cells, like 4, 2x4, 2x2x2 (default 2x2x2)\n"
-           "  --workers W    worker threads per process (default: number of cores)\n"
+           "  --workers W    worker threads per process (default: the cores it may run on)\n"
            "  --stats FILE   write the stats JSON (counters under \"components\")\n"
            "  --check        also label sequentially (O(N^2)) and fail if any label differs\n"
            "  --quiet        print only the number of components\n"

@@ -23,7 +23,7 @@ static void help(void)
            "  --radius R     largest radius (default 0.01)\n"
            "  --seed S       random seed (default 1)\n"
            "  --cells L      layout of cells, like 4, 2x4, 2x2x2 (default 2x2x2)\n"
-           "  --workers W    worker threads per process (default: number of cores)\n"
+           "  --workers W    worker threads per process (default: the cores it may run on)\n"
            "  --stats FILE   write the stats JSON\n"
            "  --check        also count by brute force and fail if the counts differ\n"
            "  --quiet        print only the count\n"

@@ -10,6 +10,7 @@
 #include "vwalls/engine.h"
 
 #include <math.h>
+#include <sched.h>
 #include <stdarg.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -92,12 +93,17 @@ void vw_config_init(vw_config *c)
 
 int vw__worker_process(const vw_world *w, int global_worker) { return global_worker / w->nworkers; }
 
-/* VW_CORES=N counts N cores instead of the machine's (1 to 1024): so tests can play
-   hosts of different sizes on one machine, and a container can say its share. */
+/* The cores this process may run on: its CPU affinity (taskset, a container's cpuset,
+   an MPI launcher's binding: Open MPI binds each of two processes to one core), as
+   nproc counts them, else the machine's. VW_CORES=N counts N cores instead (1 to
+   1024): so tests can play hosts of different sizes on one machine, and a container
+   can say its share of a CPU quota (cgroup cpu.max), which is not read. */
 int vw__default_workers(void)
 {
     uint64_t c = env_u64("VW_CORES");
     if (c >= 1 && c <= 1024) return (int)c;
+    cpu_set_t set;
+    if (sched_getaffinity(0, sizeof set, &set) == 0 && CPU_COUNT(&set) >= 1) return CPU_COUNT(&set);
     long n = sysconf(_SC_NPROCESSORS_ONLN);
     return n < 1 ? 1 : (int)n;
 }

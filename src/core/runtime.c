@@ -21,6 +21,7 @@
 #include "vwalls/engine.h"
 
 #include <math.h>
+#include <sched.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -752,11 +753,27 @@ static void stress_pause(vw__worker *wk)
 }
 
 /* One run of a worker: until global quiescence. */
+/* Under MPI, when the workers take every core the process may run on (a launcher that
+   binds a process to one core, and one worker on it), the communication thread has no
+   core of its own: a busy worker gives its core away for a moment every 200 us, so the
+   communication thread runs then instead of waiting for the kernel to preempt the
+   worker (about 3.7 ms here), and a turn request or a packet from another process is
+   answered in time (w->share_core). Not with a core to spare: on an oversubscribed
+   machine a yield hands the core to other processes' busy threads too. */
+static void share_core(vw__worker *wk)
+{
+    double now = vw__now();
+    if (now - wk->yielded < 200e-6) return;
+    wk->yielded = now;
+    sched_yield();
+}
+
 static void worker_run(vw__worker *wk)
 {
     vw_world *w = wk->w;
     vw_ctx ctx = {w, wk, -1, 0, -1, 0, 1};
     for (;;) {
+        if (w->share_core) share_core(wk);
         pthread_mutex_lock(&wk->mu);
         vw__packet *p = take(wk);
         pthread_mutex_unlock(&wk->mu);

@@ -328,6 +328,7 @@ vw_status vw_world_create(const vw_module *m, void *user, const vw_decomp *d, co
                                  "differ): every process must run the same build", r, w->m->name);
     }
     w->gworkers = w->nworkers * w->nprocs;
+    w->share_core = w->transport && w->nworkers >= vw__default_workers();
     if (st == VW_OK) {
         w->wstats = calloc((size_t)w->gworkers, sizeof *w->wstats);
         if (!w->wstats) st = VW_E_NOMEM;

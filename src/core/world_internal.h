@@ -152,6 +152,7 @@ typedef struct vw__worker {
     int step_cursor;
     uint64_t rng;              /* stress switch */
     double busy_s;
+    double yielded;            /* when the worker last gave its core away (share_core) */
     /* The meter (runtime.c): the units (cell, copy) that ran since the clock was last
        read at `mark`, each once, with how often it was noted (its notes); that time is
        shared among the nnotes notes when it is next read. `idle` stands for no unit. */
@@ -209,6 +210,7 @@ struct vw_world {
     int nworkers;              /* per process */
     int gworkers;              /* all processes */
     int steal;                 /* cfg.steal decided (vw_ctx_next_batch) */
+    int share_core;            /* busy workers yield now and then (runtime.c share_core) */
     double *speeds;            /* cfg.worker_speeds copied (gworkers), or NULL */
     double *slowdown;          /* cfg.worker_slowdown copied (gworkers), or NULL */
     int ncells;

@@ -237,11 +237,17 @@ uint64_t vw_cli_mem_available(void)
             }
         fclose(f);
     }
-    /* A container's limit (cgroup v2, the process's own group as mounted), if lower. */
-    uint64_t max = file_u64("/sys/fs/cgroup/memory.max"), cur = file_u64("/sys/fs/cgroup/memory.current");
-    if (max > 0) {
+    /* A container's limit, if lower: its memory cgroup as mounted in the container
+       (cgroup v2, else v1; v1 says "no limit" with a number near 2^63). */
+    static const char *const limits[2][2] = {
+        {"/sys/fs/cgroup/memory.max", "/sys/fs/cgroup/memory.current"},
+        {"/sys/fs/cgroup/memory/memory.limit_in_bytes", "/sys/fs/cgroup/memory/memory.usage_in_bytes"}};
+    for (int i = 0; i < 2; i++) {
+        uint64_t max = file_u64(limits[i][0]), cur = file_u64(limits[i][1]);
+        if (max == 0 || max >= (uint64_t)1 << 60) continue;
         uint64_t left = max > cur ? max - cur : 0;
         if (!avail || left < avail) avail = left ? left : 1;
+        break;
     }
     return avail;
 }

@@ -123,17 +123,25 @@ double rad_poly_area(const rad_poly *p, double normal[3], double centroid[3])
     return area;
 }
 
-void rad_piece_grid(const rad_piece *pc, int lo[2], int hi[2])
+/* The piece's extent in its polygon's (u, v) frame: {umin, umax, vmin, vmax}. */
+static void piece_extent(const rad_piece *pc, double ext[4])
 {
-    double umin = INFINITY, umax = -INFINITY, vmin = INFINITY, vmax = -INFINITY;
+    ext[0] = ext[2] = INFINITY, ext[1] = ext[3] = -INFINITY;
     for (int i = 0; i < pc->nv; i++) {
         double d[3];
         rad_sub(pc->v[i], pc->origin, d);
         double u = rad_dot(d, pc->uax), v = rad_dot(d, pc->vax);
-        umin = fmin(umin, u), umax = fmax(umax, u), vmin = fmin(vmin, v), vmax = fmax(vmax, v);
+        ext[0] = fmin(ext[0], u), ext[1] = fmax(ext[1], u);
+        ext[2] = fmin(ext[2], v), ext[3] = fmax(ext[3], v);
     }
-    lo[0] = (int)floor(umin / pc->elem), hi[0] = (int)floor(umax / pc->elem);
-    lo[1] = (int)floor(vmin / pc->elem), hi[1] = (int)floor(vmax / pc->elem);
+}
+
+void rad_piece_grid(const rad_piece *pc, int lo[2], int hi[2])
+{
+    double e[4];
+    piece_extent(pc, e);
+    lo[0] = (int)floor(e[0] / pc->elem), hi[0] = (int)floor(e[1] / pc->elem);
+    lo[1] = (int)floor(e[2] / pc->elem), hi[1] = (int)floor(e[3] / pc->elem);
 }
 
 double rad_mesh_solve_bytes(const rad_mesh *m, const rad_options *o, double *elements)
@@ -145,16 +153,10 @@ double rad_mesh_solve_bytes(const rad_mesh *m, const rad_options *o, double *ele
     double n = 0;
     for (size_t p = 0; p < m->npieces; p++) {
         const rad_piece *pc = &m->pieces[p];
-        double umin = INFINITY, umax = -INFINITY, vmin = INFINITY, vmax = -INFINITY;
-        for (int i = 0; i < pc->nv; i++) {
-            double d[3];
-            rad_sub(pc->v[i], pc->origin, d);
-            double u = rad_dot(d, pc->uax), v = rad_dot(d, pc->vax);
-            umin = fmin(umin, u), umax = fmax(umax, u), vmin = fmin(vmin, v), vmax = fmax(vmax, v);
-        }
-        double tol = 1e-6 * pc->elem;
-        double nu = floor((umax - tol) / pc->elem) - floor((umin + tol) / pc->elem) + 1;
-        double nv = floor((vmax - tol) / pc->elem) - floor((vmin + tol) / pc->elem) + 1;
+        double e[4], tol = 1e-6 * pc->elem;
+        piece_extent(pc, e);
+        double nu = floor((e[1] - tol) / pc->elem) - floor((e[0] + tol) / pc->elem) + 1;
+        double nv = floor((e[3] - tol) / pc->elem) - floor((e[2] + tol) / pc->elem) + 1;
         n += fmax(nu, 1) * fmax(nv, 1);
     }
     if (elements) *elements = n;

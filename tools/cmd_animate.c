@@ -346,7 +346,8 @@ static void help(const char *cmd)
            "                   either; edit always answers every edit)\n"
            "  --help           this text\n"
            "Exit status: 0 success, 2 bad input (any bad line; it stops animate unless\n"
-           "--keep-going), 1 other.\n");
+           "--keep-going: lines that do not parse before the first frame, others where\n"
+           "they are reached), 1 other.\n");
 }
 
 static char *frames_json(const vw_anim_session *s)

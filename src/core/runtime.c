@@ -452,12 +452,16 @@ uint64_t vw__take_turns(vw_world *w, int cell, int unit, int thief, uint64_t nba
     return k;
 }
 
-/* The next turn of the unit's stash, or nbatches when it is empty. */
-static uint64_t stash_next(const vw__cell *c, vw__stash *s, uint64_t nbatches)
+/* The next turn of the unit's stash, or nbatches when it is empty; counted as the
+   worker's turns of other processes' copies. */
+static uint64_t stash_next(vw__worker *wk, const vw__cell *c, vw__stash *s, uint64_t nbatches)
 {
     while (s->at < s->end) {
         uint64_t b = turn_batch(c, s->unit, s->at++, nbatches);
-        if (b < nbatches) return b;
+        if (b < nbatches) {
+            wk->turns_remote++;
+            return b;
+        }
         s->at = s->end; /* a unit's turns only grow: none after one past the end */
     }
     return nbatches;
@@ -475,7 +479,7 @@ static uint64_t take_remote_turns(vw_ctx *ctx, int u, uint64_t nbatches, vw__sta
     wk->mark = vw__now();
     meter_note(wk, unit_busy(wk, ctx->cell, ctx->rep));
     *stash = (vw__stash){u, first, first + n};
-    return stash_next(&ctx->w->cells[ctx->cell], stash, nbatches);
+    return stash_next(wk, &ctx->w->cells[ctx->cell], stash, nbatches);
 }
 
 uint64_t vw_ctx_next_batch(vw_ctx *ctx, uint64_t nbatches)
@@ -485,7 +489,7 @@ uint64_t vw_ctx_next_batch(vw_ctx *ctx, uint64_t nbatches)
     vw__cell *c = &w->cells[ctx->cell];
     int k = c->nreps + 1;
     vw__stash *stash = ctx->rep ? &c->reps[ctx->rep - 1].stash : &c->stash;
-    uint64_t b = stash_next(c, stash, nbatches);
+    uint64_t b = stash_next(ctx->wk, c, stash, nbatches);
     if (b < nbatches) return b;
     b = take_turn(c, turn_counter(c, ctx->rep), ctx->rep, nbatches);
     if (b < nbatches || k == 1 || !w->steal) return b;

@@ -50,6 +50,7 @@ void vw__stats_local(vw_world *w)
         ws->packets_sent = wk->packets_sent;
         ws->msgs_remote = wk->msgs_remote;
         ws->bytes_remote = wk->bytes_remote;
+        ws->turns_remote = wk->turns_remote;
         ws->peak_rss = rss;
     }
 }
@@ -144,11 +145,12 @@ static void write_body(vw_world *w, FILE *f, const char *command, const char *ex
         /* The worker's speed (vw_config.worker_speeds, 1 when none were given): with
            speeds lambda is the longest time against a split by speed, which a reader
            can recompute from busy_s only when the speeds are here. */
-        fprintf(f, "    {\"id\": %d, \"process\": %d, \"speed\": %.9g, \"busy_s\": %.6f, \"peak_rss_bytes\": %llu, \"messages\": %llu, \"bytes\": %llu, \"remote_count\": %llu, \"remote_bytes\": %llu",
+        fprintf(f, "    {\"id\": %d, \"process\": %d, \"speed\": %.9g, \"busy_s\": %.6f, \"peak_rss_bytes\": %llu, \"messages\": %llu, \"bytes\": %llu, \"remote_count\": %llu, \"remote_bytes\": %llu, \"remote_turns\": %llu",
                 g, vw__worker_process(w, g), num(w->speeds ? w->speeds[g] : 1.0),
                 num(vw_world_worker_busy(w, g)), (unsigned long long)rss,
                 (unsigned long long)ws->msgs_sent, (unsigned long long)ws->bytes_sent,
-                (unsigned long long)ws->msgs_remote, (unsigned long long)ws->bytes_remote);
+                (unsigned long long)ws->msgs_remote, (unsigned long long)ws->bytes_remote,
+                (unsigned long long)ws->turns_remote);
         /* The module's counters of the units (cells, copies) on this worker: what each
            worker made, e.g. a farmed cell's eye rays by copy. */
         if (w->m->ncounters > 0) {

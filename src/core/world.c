@@ -1011,7 +1011,7 @@ void vw_world_reset_stats(vw_world *w)
         vw__worker *wk = &w->workers[i];
         wk->busy_s = 0;
         wk->msgs_sent = wk->bytes_sent = wk->packets_sent = 0;
-        wk->msgs_remote = wk->bytes_remote = 0;
+        wk->msgs_remote = wk->bytes_remote = wk->turns_remote = 0;
         wk->tr_self_msgs = wk->tr_self_bytes = 0;
         if (wk->tr_proc) memset(wk->tr_proc, 0, 2 * sizeof *wk->tr_proc * (size_t)w->nprocs);
     }

@@ -162,6 +162,7 @@ typedef struct vw__worker {
     double mark;
     uint64_t msgs_sent, bytes_sent, packets_sent;
     uint64_t msgs_remote, bytes_remote; /* to other processes */
+    uint64_t turns_remote;     /* turns made of copies on other processes (stash) */
     /* Cell-to-cell traffic by destination, for the mapping's locality figures
        (vw_world_traffic, src/map): messages and bytes to this same worker, and per
        destination process [2p] messages, [2p+1] bytes (nprocs pairs). */
@@ -177,6 +178,7 @@ typedef struct vw__worker_stats {
     double busy_s;
     uint64_t msgs_sent, bytes_sent, packets_sent;
     uint64_t msgs_remote, bytes_remote; /* that crossed a process boundary */
+    uint64_t turns_remote;              /* turns made of copies on other processes */
     uint64_t peak_rss;                  /* of the worker's process */
 } vw__worker_stats;
 

@@ -577,7 +577,7 @@ static vw_status tp_sync(vw_world *w)
     size_t nu = (size_t)w->ncells + (size_t)vw__replica_total(w); /* cells, then copies */
     size_t ni = nu * (size_t)(1 + nc), nd = nu * 2;
     size_t nw = (size_t)w->gworkers;
-    int64_t *iv = calloc(ni + 6 * nw, sizeof *iv);
+    int64_t *iv = calloc(ni + 7 * nw, sizeof *iv);
     double *dv = calloc(nd + nw, sizeof *dv);
     if (!iv || !dv) {
         free(iv);
@@ -607,16 +607,17 @@ static vw_status tp_sync(vw_world *w)
     int64_t *wv = iv + ni;
     for (int i = 0; i < w->nworkers; i++) {
         const vw__worker_stats *s = &w->wstats[w->workers[i].global];
-        int64_t *row = wv + 6 * (size_t)w->workers[i].global;
+        int64_t *row = wv + 7 * (size_t)w->workers[i].global;
         row[0] = (int64_t)s->msgs_sent;
         row[1] = (int64_t)s->bytes_sent;
         row[2] = (int64_t)s->packets_sent;
         row[3] = (int64_t)s->msgs_remote;
         row[4] = (int64_t)s->bytes_remote;
         row[5] = (int64_t)s->peak_rss;
+        row[6] = (int64_t)s->turns_remote;
         dv[nd + (size_t)w->workers[i].global] = s->busy_s;
     }
-    MPI_Allreduce(MPI_IN_PLACE, iv, (int)(ni + 6 * nw), MPI_INT64_T, MPI_SUM, t->comm);
+    MPI_Allreduce(MPI_IN_PLACE, iv, (int)(ni + 7 * nw), MPI_INT64_T, MPI_SUM, t->comm);
     MPI_Allreduce(MPI_IN_PLACE, dv, (int)(nd + nw), MPI_DOUBLE, MPI_SUM, t->comm);
     for (int c = 0; c < w->ncells; c++) {
         vw__cell *cl = &w->cells[c];
@@ -638,13 +639,14 @@ static vw_status tp_sync(vw_world *w)
         }
     for (size_t g = 0; g < nw; g++) {
         vw__worker_stats *s = &w->wstats[g];
-        const int64_t *row = wv + 6 * g;
+        const int64_t *row = wv + 7 * g;
         s->msgs_sent = (uint64_t)row[0];
         s->bytes_sent = (uint64_t)row[1];
         s->packets_sent = (uint64_t)row[2];
         s->msgs_remote = (uint64_t)row[3];
         s->bytes_remote = (uint64_t)row[4];
         s->peak_rss = (uint64_t)row[5];
+        s->turns_remote = (uint64_t)row[6];
         s->busy_s = dv[nd + g];
     }
     free(iv);

@@ -62,6 +62,9 @@ foreach(case "2;2x2x2;1;none" "2;4x1x2;2;none" "3;2x2;1;none" "2;1;1;idle" "3;1;
     string(JSON p0 GET "${json}" workers 0 counters pixels)
     string(JSON p1 GET "${json}" workers 1 counters pixels)
     math(EXPR all "${p0} + ${p1}")
+    # The turns each worker took of the other process's copy, as the stats tell them.
+    string(JSON t0 GET "${json}" workers 0 remote_turns)
+    string(JSON t1 GET "${json}" workers 1 remote_turns)
   endif()
   if(check STREQUAL "quarter")
     # Speeds 1,3, no stealing: the master on process 0 makes a quarter of the cell's eye
@@ -71,6 +74,9 @@ foreach(case "2;2x2x2;1;none" "2;4x1x2;2;none" "3;2x2;1;none" "2;1;1;idle" "3;1;
     if(p0 LESS lo OR p0 GREATER hi)
       message(FATAL_ERROR "${flags}: process 0 made ${p0} of ${all} eye rays, not about a quarter")
     endif()
+    if(NOT t0 EQUAL 0 OR NOT t1 EQUAL 0)
+      message(FATAL_ERROR "${flags}: turns taken across processes (${t0}, ${t1}) with --steal off")
+    endif()
   elseif(check STREQUAL "stolen")
     # Equal shares, process 1 eight times slower: process 0, done with its half, takes
     # process 1's turns by asking (0.73-0.76 of the eye rays measured; exactly half
@@ -79,6 +85,14 @@ foreach(case "2;2x2x2;1;none" "2;4x1x2;2;none" "3;2x2;1;none" "2;1;1;idle" "3;1;
     if(p0 LESS lo)
       message(FATAL_ERROR "${flags}: process 0 made only ${p0} of ${all} eye rays: no turns "
                           "taken from the slowed process")
+    endif()
+    # Each turn is a batch of 16 pixels (RT_SHARE): process 0's pixels beyond its half
+    # came from its turns of process 1's copy (less one batch: its own share may be one
+    # more than half, and the last batch shorter).
+    math(EXPR extra "(${p0} - ${all} / 2) / 16 - 1")
+    if(t0 LESS extra)
+      message(FATAL_ERROR "${flags}: the stats say worker 0 took ${t0} turns of the other "
+                          "process's copy, fewer than the ${extra} batches it made beyond its share")
     endif()
   endif()
 endforeach()

@@ -205,7 +205,7 @@ double vw_cli_now(void)
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
-/* A number from a one-line file (cgroup v2 limits), or 0 for "max", absent or bad. */
+/* A number from a one-line file (a cgroup limit or usage), or 0 for "max", absent or bad. */
 static uint64_t file_u64(const char *path)
 {
     FILE *f = fopen(path, "r");

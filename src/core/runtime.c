@@ -307,6 +307,21 @@ static void enqueue(vw_ctx *ctx, int slot, int dest, int cell, int kind, const v
     }
 }
 
+/* Under MPI, when the workers take every core the process may run on (a launcher that
+   binds a process to one core, and one worker on it), the communication thread has no
+   core of its own: a busy worker gives its core away for a moment every 200 us, so the
+   communication thread runs then instead of waiting for the kernel to preempt the
+   worker (about 3.7 ms here), and a turn request or a packet from another process is
+   answered in time (w->share_core). Not with a core to spare: on an oversubscribed
+   machine a yield hands the core to other processes' busy threads too. */
+static void share_core(vw__worker *wk)
+{
+    double now = vw__now();
+    if (now - wk->yielded < 200e-6) return;
+    wk->yielded = now;
+    sched_yield();
+}
+
 /* ---- the meter: busy time per cell ---------------------------------------------------- */
 
 /* Every unit (cell, or copy of a duplicated cell) is charged the time the worker spent
@@ -324,10 +339,12 @@ static void meter_charge(vw__worker *wk, double now)
     double dt = now - wk->mark;
     const double *s = w->cfg.worker_slowdown;
     if (s && s[wk->global] > 1.0) {
-        /* An emulated slower machine: spin for (k-1) times the time spent, charged too. */
+        /* An emulated slower machine: spin for (k-1) times the time spent, charged too;
+           giving the core away as a busy worker does (share_core), or the emulated
+           machine's communication thread would answer later than a real one's. */
         double until = now + dt * (s[wk->global] - 1.0);
-        while ((now = vw__now()) < until) {
-        }
+        while ((now = vw__now()) < until)
+            if (w->share_core) share_core(wk);
         dt = now - wk->mark;
     }
     wk->busy_s += dt;
@@ -757,21 +774,6 @@ static void stress_pause(vw__worker *wk)
 }
 
 /* One run of a worker: until global quiescence. */
-/* Under MPI, when the workers take every core the process may run on (a launcher that
-   binds a process to one core, and one worker on it), the communication thread has no
-   core of its own: a busy worker gives its core away for a moment every 200 us, so the
-   communication thread runs then instead of waiting for the kernel to preempt the
-   worker (about 3.7 ms here), and a turn request or a packet from another process is
-   answered in time (w->share_core). Not with a core to spare: on an oversubscribed
-   machine a yield hands the core to other processes' busy threads too. */
-static void share_core(vw__worker *wk)
-{
-    double now = vw__now();
-    if (now - wk->yielded < 200e-6) return;
-    wk->yielded = now;
-    sched_yield();
-}
-
 static void worker_run(vw__worker *wk)
 {
     vw_world *w = wk->w;

@@ -56,6 +56,8 @@ vw_status vw__sb_init(vw__sb *b);
 /* Hands the scene over (the builder is empty afterwards). */
 vw_scene *vw__sb_finish(vw__sb *b);
 void vw__sb_abort(vw__sb *b);
+/* A reader's end: with st == VW_OK the scene goes to *out, else it is freed. Returns st. */
+vw_status vw__sb_close(vw__sb *b, vw_status st, vw_scene **out);
 
 void vw__default_material(vw_material *m);
 vw_status vw__sb_add_light(vw__sb *b, const double pos[3], const float color[3]);

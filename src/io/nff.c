@@ -571,10 +571,5 @@ VW_API vw_status vw_scene_read_nff(const char *name, const char *text, size_t le
     }
     st = parse_all(&P);
     free(P.nocolor);
-    if (st != VW_OK) {
-        vw__sb_abort(&P.b);
-        return st;
-    }
-    *out = vw__sb_finish(&P.b);
-    return VW_OK;
+    return vw__sb_close(&P.b, st, out);
 }

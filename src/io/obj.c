@@ -734,11 +734,6 @@ VW_API vw_status vw_scene_read_obj(const char *name, const char *text, size_t le
     free(O.mat_ids);
     free(O.mat_wait);
     free(O.vn);
-    if (st != VW_OK) {
-        vw__sb_abort(&O.b);
-        return st;
-    }
-    *out = vw__sb_finish(&O.b);
-    (*out)->camera.valid = 0;
-    return VW_OK;
+    if ((st = vw__sb_close(&O.b, st, out)) == VW_OK) (*out)->camera.valid = 0;
+    return st;
 }

@@ -608,11 +608,6 @@ VW_API vw_status vw_scene_read_ply(const char *name, const void *data, size_t le
     free(P.elems);
     free(P.normals);
     free(P.colors);
-    if (st != VW_OK) {
-        vw__sb_abort(&P.b);
-        return st;
-    }
-    *out = vw__sb_finish(&P.b);
-    (*out)->camera.valid = 0;
-    return VW_OK;
+    if ((st = vw__sb_close(&P.b, st, out)) == VW_OK) (*out)->camera.valid = 0;
+    return st;
 }

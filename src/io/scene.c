@@ -197,6 +197,15 @@ void vw__sb_abort(vw__sb *b)
     vw_scene_free(vw__sb_finish(b));
 }
 
+vw_status vw__sb_close(vw__sb *b, vw_status st, vw_scene **out)
+{
+    if (st == VW_OK)
+        *out = vw__sb_finish(b);
+    else
+        vw__sb_abort(b);
+    return st;
+}
+
 void vw__default_material(vw_material *m)
 {
     memset(m, 0, sizeof *m);

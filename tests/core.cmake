@@ -9,6 +9,10 @@ function(vw_core_test name)
 endfunction()
 
 vw_core_test(test_decomp)
+# What the host gives the process (host.c): hosts laid out in a directory.
+vw_core_test(test_host)
+target_include_directories(test_host PRIVATE ${PROJECT_SOURCE_DIR}/src)
+add_test(NAME core_host COMMAND test_host)
 add_test(NAME core_decomp COMMAND test_decomp)
 set_tests_properties(core_decomp PROPERTIES LABELS "core")
 

@@ -205,53 +205,6 @@ double vw_cli_now(void)
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
-/* A number from a one-line file (a cgroup limit or usage), or 0 for "max", absent or bad. */
-static uint64_t file_u64(const char *path)
-{
-    FILE *f = fopen(path, "r");
-    if (!f) return 0;
-    unsigned long long v = 0;
-    int ok = fscanf(f, "%llu", &v) == 1;
-    fclose(f);
-    return ok ? (uint64_t)v : 0;
-}
-
-uint64_t vw_cli_mem_available(void)
-{
-    const char *env = getenv("VW_MEM_AVAILABLE");
-    if (env && *env) {
-        char *end;
-        errno = 0;
-        unsigned long long v = strtoull(env, &end, 10);
-        if (!errno && *end == 0 && v > 0) return (uint64_t)v;
-    }
-    uint64_t avail = 0;
-    FILE *f = fopen("/proc/meminfo", "r");
-    if (f) {
-        char line[256];
-        unsigned long long kb;
-        while (fgets(line, sizeof line, f))
-            if (sscanf(line, "MemAvailable: %llu kB", &kb) == 1) {
-                avail = (uint64_t)kb * 1024;
-                break;
-            }
-        fclose(f);
-    }
-    /* A container's limit, if lower: its memory cgroup as mounted in the container
-       (cgroup v2, else v1; v1 says "no limit" with a number near 2^63). */
-    static const char *const limits[2][2] = {
-        {"/sys/fs/cgroup/memory.max", "/sys/fs/cgroup/memory.current"},
-        {"/sys/fs/cgroup/memory/memory.limit_in_bytes", "/sys/fs/cgroup/memory/memory.usage_in_bytes"}};
-    for (int i = 0; i < 2; i++) {
-        uint64_t max = file_u64(limits[i][0]), cur = file_u64(limits[i][1]);
-        if (max == 0 || max >= (uint64_t)1 << 60) continue;
-        uint64_t left = max > cur ? max - cur : 0;
-        if (!avail || left < avail) avail = left ? left : 1;
-        break;
-    }
-    return avail;
-}
-
 const char *vw_cli_bytes(double n, char *buf, size_t len)
 {
     if (n >= 1e9)

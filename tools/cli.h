@@ -140,11 +140,6 @@ void vw_progress_update(vw_progress *p, double fraction, const char *note);
 void vw_progress_end(vw_progress *p);
 
 double vw_cli_now(void);
-/* Memory this process may still take, in bytes: /proc/meminfo's MemAvailable, or less
-   when a container's memory cgroup limit (v2 memory.max, v1 memory.limit_in_bytes)
-   leaves less; 0 when unknown. VW_MEM_AVAILABLE=N (bytes) says it instead (tests play
-   a small machine). */
-uint64_t vw_cli_mem_available(void);
 /* How many processes of the job run on this host (the launcher's environment; 1 when
    it does not say). */
 int vw_cli_local_processes(void);

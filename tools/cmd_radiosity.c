@@ -190,7 +190,7 @@ static int parse_view(const char *v, vw_camera *cam)
 static int check_memory(const rad_mesh *m, const rad_options *o, char *err, size_t len)
 {
     double elements = 0, need = rad_mesh_solve_bytes(m, o, &elements) / vw_engine_size();
-    double avail = (double)vw_cli_mem_available() / vw_cli_local_processes();
+    double avail = (double)vw_host_memory() / vw_cli_local_processes();
     if (!(avail > 0) || need <= avail) return VW_EXIT_OK;
     int fine = o->subdivide > 0 && o->max_level > 0;
     char a[32], b[32];

@@ -9,6 +9,7 @@
 #define VWALLS_ENGINE_H
 
 #include <stddef.h>
+#include <stdint.h>
 #include "vwalls/common.h"
 
 #ifdef __cplusplus
@@ -73,6 +74,17 @@ VW_API void vw_engine_broadcast(void *buf, size_t n);
    local). So a tool can size per-worker options (speeds) before the world exists, the
    same on every host. Collective under MPI: every rank must call it. */
 VW_API int vw_engine_workers(int workers);
+/* What this host gives the process (not collective). vw_host_cores: the cores it may
+   run on, the default worker count: its CPU affinity (taskset, a container's cpuset, an
+   MPI launcher's binding), or fewer when a control group it belongs to, or one above,
+   has a CPU quota (cgroup v2 cpu.max, v1 cpu.cfs_quota_us), rounded up to whole cores.
+   vw_host_memory: the bytes it may still allocate, /proc/meminfo's MemAvailable or the
+   least room left under a memory limit of those groups (v2 memory.max, v1
+   memory.limit_in_bytes), if lower; 0 when nothing says. VW_CORES=N (1 to 1024) and
+   VW_MEM_AVAILABLE=BYTES replace the readings, so one machine can play hosts of other
+   sizes. */
+VW_API int vw_host_cores(void);
+VW_API uint64_t vw_host_memory(void);
 
 #ifdef __cplusplus
 }

@@ -10,7 +10,6 @@
 #include "vwalls/engine.h"
 
 #include <math.h>
-#include <sched.h>
 #include <stdarg.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -92,21 +91,6 @@ void vw_config_init(vw_config *c)
 }
 
 int vw__worker_process(const vw_world *w, int global_worker) { return global_worker / w->nworkers; }
-
-/* The cores this process may run on: its CPU affinity (taskset, a container's cpuset,
-   an MPI launcher's binding: Open MPI binds each of two processes to one core), as
-   nproc counts them, else the machine's. VW_CORES=N counts N cores instead (1 to
-   1024): so tests can play hosts of different sizes on one machine, and a container
-   can say its share of a CPU quota (cgroup cpu.max), which is not read. */
-int vw__default_workers(void)
-{
-    uint64_t c = env_u64("VW_CORES");
-    if (c >= 1 && c <= 1024) return (int)c;
-    cpu_set_t set;
-    if (sched_getaffinity(0, sizeof set, &set) == 0 && CPU_COUNT(&set) >= 1) return CPU_COUNT(&set);
-    long n = sysconf(_SC_NPROCESSORS_ONLN);
-    return n < 1 ? 1 : (int)n;
-}
 
 /* The per-worker lists of what each worker of this process hosts: the cells it is the
    master of, then the copies of duplicated cells (cell_rep says which). */
@@ -294,7 +278,7 @@ vw_status vw_world_create(const vw_module *m, void *user, const vw_decomp *d, co
     if (w->cfg.packet_bytes < 64) w->cfg.packet_bytes = 64;
     w->rank = 0;
     w->nprocs = 1;
-    w->nworkers = w->cfg.workers > 0 ? w->cfg.workers : vw__default_workers();
+    w->nworkers = w->cfg.workers > 0 ? w->cfg.workers : vw_host_cores();
     if (w->nworkers > 1024) {
         create_failed(VW_E_LIMIT, "vw_world_create: %d workers (at most 1024)", w->nworkers);
         free(w);
@@ -308,7 +292,7 @@ vw_status vw_world_create(const vw_module *m, void *user, const vw_decomp *d, co
         free(w);
         return VW_E_LIMIT;
     }
-    w->steal = w->cfg.steal > 0 || (w->cfg.steal < 0 && w->nworkers <= vw__default_workers());
+    w->steal = w->cfg.steal > 0 || (w->cfg.steal < 0 && w->nworkers <= vw_host_cores());
     w->cfg.cell_worker = NULL; /* copied into w->cell_worker below */
     pthread_mutex_init(&w->output_mu, NULL);
     pthread_mutex_init(&w->pool_mu, NULL);
@@ -328,7 +312,7 @@ vw_status vw_world_create(const vw_module *m, void *user, const vw_decomp *d, co
                                  "differ): every process must run the same build", r, w->m->name);
     }
     w->gworkers = w->nworkers * w->nprocs;
-    w->share_core = w->transport && w->nworkers >= vw__default_workers();
+    w->share_core = w->transport && w->nworkers >= vw_host_cores();
     if (st == VW_OK) {
         w->wstats = calloc((size_t)w->gworkers, sizeof *w->wstats);
         if (!w->wstats) st = VW_E_NOMEM;
@@ -1107,5 +1091,5 @@ vw_status vw_config_agree(const vw_config *c, vw_status local, char *msg, size_t
     return local;
 }
 void vw_engine_broadcast(void *buf, size_t n) { (void)buf, (void)n; }
-int vw_engine_workers(int workers) { return workers > 0 ? workers : vw__default_workers(); }
+int vw_engine_workers(int workers) { return workers > 0 ? workers : vw_host_cores(); }
 #endif

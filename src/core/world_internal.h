@@ -58,9 +58,11 @@ typedef struct vw__packet {
    speeds that is max / mean of t, DESIGN's definition. 1 with no work; INFINITY when a
    speed is not positive and finite or a t is negative, NaN or infinite. */
 double vw__lambda(const double *t, const double *speeds, int n);
-/* One worker per core of this machine (at least one; VW_CORES overrides the count): a
-   world's default worker count. */
-int vw__default_workers(void);
+/* What the host at `root` ("" for this one: a test lays out /proc and /sys in a
+   directory) gives this process (host.c): the CPU quota of its control groups in cores
+   (0: none), the least room left under their memory limits and /proc/meminfo's
+   MemAvailable, in bytes (0: not said). A NULL pointer skips what it would read. */
+void vw__host_probe(const char *root, double *quota_cores, uint64_t *cgroup_mem, uint64_t *meminfo_mem);
 
 /* A unit's (a cell's, or a copy's) measured busy time, and the inline hand-offs into it
    (vw_ctx_enter) that the meter (runtime.c) noted since its worker last read the clock. */

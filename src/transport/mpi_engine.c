@@ -176,7 +176,7 @@ void vw_engine_broadcast(void *buf, size_t n)
 int vw_engine_workers(int workers)
 {
     /* The reduction runs whatever this rank's workers, so every rank makes it. */
-    int cores = vw__default_workers(), fewest = cores;
+    int cores = vw_host_cores(), fewest = cores;
     if (mpi_up() && vw_engine_size() > 1) MPI_Allreduce(&cores, &fewest, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
     return workers > 0 ? workers : fewest;
 }

@@ -127,7 +127,7 @@ int main(int argc, char **argv)
     rt_object *objs;
     size_t n;
     rt_objects_from_scene(s, &objs, &n);
-    void *dev = rt_device_new();
+    void *dev = rt_device_new(1);
     bench b;
     memset(&b, 0, sizeof b);
     double t0 = now();

@@ -383,11 +383,17 @@ double rt_float_frame_norm1(const rt_float_frame *ff, const double p[3])
     return fmax(rel, 1e-7 * (fabs(p[0]) + fabs(p[1]) + fabs(p[2])));
 }
 
-void *rt_device_new(void)
+void *rt_device_new(int threads)
 {
-    /* Builds run on the worker thread that hosts the cell: the parallelism is in the
-       cells, and Embree's own thread pool would only compete with the workers. */
-    return rtcNewDevice("threads=1,set_affinity=0,verbose=0");
+    /* A cell's build runs on the worker that hosts it, and Embree may share it among as
+       many threads as the process has workers: the builds of different cells then
+       overlap as they did, and a cell that farmed copies share (one build, which the
+       other copies wait for) is built by them all. One thread did that build alone
+       while the others idled: 4.4 -> 3.4 ms for the level-4 sphereflake on two workers,
+       35 -> 25 ms for the size-5 one (median of 25 and 5 renders). */
+    char cfg[64];
+    snprintf(cfg, sizeof cfg, "threads=%d,set_affinity=0,verbose=0", threads > 1 ? threads : 1);
+    return rtcNewDevice(cfg);
 }
 
 void rt_device_free(void *device)

@@ -71,8 +71,9 @@ double rt_float_frame_norm1(const rt_float_frame *ff, const double p[3]);
 rt_float_frame rt_float_frame_make(const double origin[3], double scale);
 /* The identity frame (origin 0, scale 1), for tests and tools that trace raw scenes. */
 extern const rt_float_frame rt_float_frame_identity;
-/* One RTCDevice per process, shared by every cell (Embree's device is thread-safe). */
-void *rt_device_new(void);
+/* One RTCDevice per process, shared by every cell (Embree's device is thread-safe); a
+   build uses up to `threads` threads (the process's workers). */
+void *rt_device_new(int threads);
 void rt_device_free(void *device);
 
 #endif

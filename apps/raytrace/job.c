@@ -313,7 +313,9 @@ static vw_status job_prepare(rt_job *j, const vw_scene *s, const rt_params *p, r
                  dims[2], vw_status_message(st));
         return st;
     }
-    sh->device = rt_device_new();
+    /* Embree's threads: the process's workers (before the world that would say it). */
+    int workers = rt_job_config(p).workers;
+    sh->device = rt_device_new(workers > 0 ? workers : vw_host_cores());
     sh->geo_cache = sh->device ? rt_geo_cache_new(&sh->ff) : NULL;
     if (!sh->device || !sh->geo_cache) {
         snprintf(err, errlen, "cannot create the Embree device");

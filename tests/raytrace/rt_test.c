@@ -464,7 +464,7 @@ static int test_cone(void)
     memcpy(o.g.cone.apex, apex, sizeof apex);
     o.g.cone.r0 = 0.8;
     o.g.cone.r1 = 0.3;
-    void *dev = rt_device_new();
+    void *dev = rt_device_new(1);
     rt_cell_geo g;
     EXPECT(rt_cell_geo_build(dev, &o, 1, &rt_float_frame_identity, &g) == VW_OK, "build");
     int hits = 0, n = 0;
@@ -569,7 +569,7 @@ static int test_scale(void)
     o[2].g.cone.r0 = 0.5;
     o[2].g.cone.r1 = 0.2;
     static const double scales[] = {1.0, 0x1p-30, 0x1p30};
-    void *dev = rt_device_new();
+    void *dev = rt_device_new(1);
     rt_cell_geo g[3];
     for (int k = 0; k < 3; k++) {
         static const double zero[3] = {0, 0, 0};
@@ -650,7 +650,7 @@ static int test_watertight(void)
                 }
             }
         }
-    void *dev = rt_device_new();
+    void *dev = rt_device_new(1);
     rt_cell_geo g;
     EXPECT(rt_cell_geo_build(dev, tri, nt, &rt_float_frame_identity, &g) == VW_OK, "build");
     /* The target points: on the mesh's inner edges (in float, as Embree holds the

@@ -128,6 +128,14 @@ foreach(np 2 3)
                      $<TARGET_FILE:vwalls_tool> ${np})
 endforeach()
 
+# A process that runs another build of the program (VW_FAULT=build-id gives each its own
+# build ID): the world is not made, and says which process; VW_MIXED_BUILDS=1 lets it run.
+vw_mpi_script_test(mpi_build_check 2 must_say.sh 60 build
+                   "process 1 runs another build of this program than process 0"
+                   env VW_FAULT=build-id $<TARGET_FILE:vwalls_tool> example-pairs --spheres 300
+                   --cells 2x2x1 --quiet)
+vw_mpi_test(mpi_build_mixed 2 ENV "VW_FAULT=build-id;VW_MIXED_BUILDS=1"
+            COMMAND $<TARGET_FILE:vwalls_tool> example-pairs --spheres 300 --cells 2x2x1 --check --quiet)
 # A peer whose module has a message kind more (another build): the receiver checks every
 # packet from another process and stops the job, naming the sender.
 vw_mpi_script_test(mpi_wire_check 2 must_say.sh 60 wire

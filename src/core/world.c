@@ -9,6 +9,7 @@
 #include "core/world_internal.h"
 #include "vwalls/engine.h"
 
+#include <link.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdint.h>
@@ -237,6 +238,39 @@ static uint64_t module_fingerprint(const vw_module *m)
     return h;
 }
 
+/* The running program's GNU build ID (the linker's hash of the executable), hashed; 0
+   when it has none. Two processes with the same ID run the same machine code, so their
+   messages' records have the same layout, which module_fingerprint cannot see inside. */
+static int build_id_note(struct dl_phdr_info *info, size_t size, void *user)
+{
+    (void)size;
+    uint64_t *h = user;
+    for (int i = 0; i < info->dlpi_phnum; i++) {
+        const ElfW(Phdr) *ph = &info->dlpi_phdr[i];
+        if (ph->p_type != PT_NOTE) continue;
+        const char *p = (const char *)(info->dlpi_addr + ph->p_vaddr), *end = p + ph->p_memsz;
+        while (p + sizeof(ElfW(Nhdr)) <= end) {
+            const ElfW(Nhdr) *n = (const ElfW(Nhdr) *)p;
+            const char *name = p + sizeof *n;
+            const char *desc = name + ((n->n_namesz + 3) & ~3u);
+            if (desc + n->n_descsz > end) break;
+            if (n->n_type == NT_GNU_BUILD_ID && n->n_namesz == 4 && !memcmp(name, "GNU", 4)) {
+                *h = vw__fnv1a(VW__FNV_OFFSET, desc, n->n_descsz);
+                return 1;
+            }
+            p = desc + ((n->n_descsz + 3) & ~3u);
+        }
+    }
+    return 1; /* the first object is the program itself: stop there */
+}
+
+static uint64_t program_build_id(void)
+{
+    uint64_t h = 0;
+    dl_iterate_phdr(build_id_note, &h);
+    return h;
+}
+
 vw_status vw_world_create(const vw_module *m, void *user, const vw_decomp *d, const vw_config *c,
                           vw_world **out)
 {
@@ -310,6 +344,21 @@ vw_status vw_world_create(const vw_module *m, void *user, const vw_decomp *d, co
             st = vw__world_error(w, VW_E_INVAL, "process %d runs another module than process 0 "
                                  "(module '%s': its name, object size, message kinds or counters "
                                  "differ): every process must run the same build", r, w->m->name);
+    }
+    /* The same module by its shape can still lay out a record's bytes otherwise (another
+       version of the sources, another compiler): the programs' build IDs tell. A test
+       plays another build with VW_FAULT=build-id (each process's own ID); VW_MIXED_BUILDS=1
+       lets builds known to agree (rebuilt with other flags, say) run together. */
+    if (st == VW_OK && w->transport) {
+        uint64_t id = program_build_id();
+        if (vw_test_fault("build-id")) id ^= (uint64_t)w->rank + 1;
+        int r = vw__mpi_first_differing(w, id);
+        const char *mixed = getenv("VW_MIXED_BUILDS");
+        if (r >= 0 && !(mixed && !strcmp(mixed, "1")))
+            st = vw__world_error(w, VW_E_INVAL, "process %d runs another build of this program than "
+                                 "process 0 (their GNU build IDs differ): messages cross as raw bytes, "
+                                 "so every process must run the same build (the same sources, built "
+                                 "the same way); VW_MIXED_BUILDS=1 runs them anyway", r);
     }
     w->gworkers = w->nworkers * w->nprocs;
     w->share_core = w->transport && w->nworkers >= vw_host_cores();

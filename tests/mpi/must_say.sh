@@ -1,7 +1,8 @@
 #!/bin/sh
 # must_say.sh - a job that must fail within 20 s, non-zero, with a line matching PATTERN
-# (grep -E) in its output: a malformed packet (mpi_wire_check) or turn request
-# (mpi_turn_check) must stop the job with a message naming what is wrong and its sender.
+# (grep -E) in its output: another build (mpi_build_check), a malformed packet
+# (mpi_wire_check) or turn request (mpi_turn_check) must stop the job with a message
+# naming what is wrong and its sender.
 # usage: must_say.sh NAME PATTERN PROGRAM [ARGS...] "MPIEXEC -n N [flags]"
 name=$1 pattern=$2
 shift 2

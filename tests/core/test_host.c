@@ -37,6 +37,23 @@ static void put(const char *root, const char *rel, const char *text)
     CHECK(fclose(f) == 0);
 }
 
+/* A group's two files of one kind: its limit and its usage (memory), or its quota and
+   period (v1 CPU), each value a line. */
+static void put2(const char *root, const char *dir, const char *kind, const char *v1, const char *v2)
+{
+    static const char *const names[][2] = {{"memory.limit_in_bytes", "memory.usage_in_bytes"},
+                                           {"memory.max", "memory.current"},
+                                           {"cpu.cfs_quota_us", "cpu.cfs_period_us"}};
+    int k = !strcmp(kind, "v1 memory") ? 0 : !strcmp(kind, "v2 memory") ? 1 : 2;
+    const char *v[2] = {v1, v2};
+    for (int i = 0; i < 2; i++) {
+        char rel[512], line[64];
+        snprintf(rel, sizeof rel, "%s/%s", dir, names[k][i]);
+        snprintf(line, sizeof line, "%s\n", v[i]);
+        put(root, rel, line);
+    }
+}
+
 /* A fresh host directory named `name`. */
 static const char *host(const char *name)
 {
@@ -68,8 +85,7 @@ int main(void)
     put(r, "proc/self/mountinfo", "22 1 0:21 / / rw - overlay overlay rw\n" V2_MOUNT);
     put(r, "proc/meminfo", "MemTotal: 4000 kB\nMemFree: 100 kB\nMemAvailable: 2000 kB\n");
     put(r, "sys/fs/cgroup/cpu.max", "150000 100000\n");
-    put(r, "sys/fs/cgroup/memory.max", "1000000\n");
-    put(r, "sys/fs/cgroup/memory.current", "400000\n");
+    put2(r, "sys/fs/cgroup", "v2 memory", "1000000", "400000");
     probe(r, &q, &mem, &mi);
     CHECK_NEAR(q, 1.5, 1e-12);
     CHECK_EQ_INT(mem, 600000);
@@ -83,10 +99,8 @@ int main(void)
     put(r, "sys/fs/cgroup/batch/job7/cpu.max", "max 100000\n");
     put(r, "sys/fs/cgroup/batch/cpu.max", "50000 100000\n");
     put(r, "sys/fs/cgroup/cpu.max", "400000 100000\n");
-    put(r, "sys/fs/cgroup/batch/job7/memory.max", "max\n");
-    put(r, "sys/fs/cgroup/batch/job7/memory.current", "7000\n");
-    put(r, "sys/fs/cgroup/batch/memory.max", "5000000\n");
-    put(r, "sys/fs/cgroup/batch/memory.current", "1000000\n");
+    put2(r, "sys/fs/cgroup/batch/job7", "v2 memory", "max", "7000");
+    put2(r, "sys/fs/cgroup/batch", "v2 memory", "5000000", "1000000");
     probe(r, &q, &mem, &mi);
     CHECK_NEAR(q, 0.5, 1e-12);
     CHECK_EQ_INT(mem, 4000000);
@@ -102,14 +116,10 @@ int main(void)
         "32 31 0:29 / /sys/fs/cgroup/cpu,cpuacct rw,relatime - cgroup cgroup rw,cpu,cpuacct\n"
         "35 31 0:32 / /sys/fs/cgroup/memory rw,relatime - cgroup cgroup rw,memory\n"
         "41 31 0:38 / /sys/fs/cgroup/unified rw,relatime - cgroup2 cgroup2 rw\n");
-    put(r, "sys/fs/cgroup/cpu,cpuacct/cpu.cfs_quota_us", "-1\n");
-    put(r, "sys/fs/cgroup/cpu,cpuacct/cpu.cfs_period_us", "100000\n");
-    put(r, "sys/fs/cgroup/memory/process_api/abc/memory.limit_in_bytes", "9223372036854771712\n");
-    put(r, "sys/fs/cgroup/memory/process_api/abc/memory.usage_in_bytes", "1000\n");
-    put(r, "sys/fs/cgroup/memory/process_api/memory.limit_in_bytes", "3000000\n");
-    put(r, "sys/fs/cgroup/memory/process_api/memory.usage_in_bytes", "1000000\n");
-    put(r, "sys/fs/cgroup/memory/memory.limit_in_bytes", "9223372036854771712\n");
-    put(r, "sys/fs/cgroup/memory/memory.usage_in_bytes", "99999999\n");
+    put2(r, "sys/fs/cgroup/cpu,cpuacct", "v1 cpu", "-1", "100000");
+    put2(r, "sys/fs/cgroup/memory/process_api/abc", "v1 memory", "9223372036854771712", "1000");
+    put2(r, "sys/fs/cgroup/memory/process_api", "v1 memory", "3000000", "1000000");
+    put2(r, "sys/fs/cgroup/memory", "v1 memory", "9223372036854771712", "99999999");
     probe(r, &q, &mem, &mi);
     CHECK_NEAR(q, 0, 0);
     CHECK_EQ_INT(mem, 2000000);
@@ -123,12 +133,9 @@ int main(void)
     put(r, "proc/self/mountinfo",
         "40 31 0:29 /docker/xyz /sys/fs/cgroup/cpu ro,nosuid - cgroup cgroup rw,cpu\n"
         "41 31 0:30 /docker/xyz /sys/fs/cgroup/memory ro,nosuid - cgroup cgroup rw,memory\n");
-    put(r, "sys/fs/cgroup/cpu/cpu.cfs_quota_us", "250000\n");
-    put(r, "sys/fs/cgroup/cpu/cpu.cfs_period_us", "100000\n");
-    put(r, "sys/fs/cgroup/memory/memory.limit_in_bytes", "80000\n");
-    put(r, "sys/fs/cgroup/memory/memory.usage_in_bytes", "1000\n");
-    put(r, "sys/fs/cgroup/memory/task/memory.limit_in_bytes", "8000\n");
-    put(r, "sys/fs/cgroup/memory/task/memory.usage_in_bytes", "9000\n");
+    put2(r, "sys/fs/cgroup/cpu", "v1 cpu", "250000", "100000");
+    put2(r, "sys/fs/cgroup/memory", "v1 memory", "80000", "1000");
+    put2(r, "sys/fs/cgroup/memory/task", "v1 memory", "8000", "9000");
     probe(r, &q, &mem, &mi);
     CHECK_NEAR(q, 2.5, 1e-12);
     CHECK_EQ_INT(mem, 1);

@@ -253,16 +253,15 @@ static uint64_t env_count(const char *name, uint64_t max)
     return *end == 0 && v >= 1 && v <= max ? (uint64_t)v : 0;
 }
 
-/* The cores of the affinity and the quota, read once: a world asks at its creation, and
-   the files take a tenth of a millisecond. */
-static _Atomic int probed_cores;
+/* The CPU quota in cores, read once (0: none; -1: not read yet): a world asks at its
+   creation, and the files take a tenth of a millisecond. The affinity, one system call,
+   is read every time: a program may change it between two worlds. */
+static _Atomic double probed_quota = -1;
 
 int vw_host_cores(void)
 {
     uint64_t c = env_count("VW_CORES", 1024);
     if (c) return (int)c;
-    int cached = atomic_load(&probed_cores);
-    if (cached) return cached;
     int n = 0;
     cpu_set_t set;
     if (sched_getaffinity(0, sizeof set, &set) == 0) n = CPU_COUNT(&set);
@@ -270,13 +269,14 @@ int vw_host_cores(void)
         long m = sysconf(_SC_NPROCESSORS_ONLN);
         n = m < 1 ? 1 : m > 1 << 20 ? 1 << 20 : (int)m;
     }
-    double quota;
-    vw__host_probe("", &quota, NULL, NULL);
+    double quota = atomic_load(&probed_quota);
+    if (quota < 0) {
+        vw__host_probe("", &quota, NULL, NULL);
+        atomic_store(&probed_quota, quota); /* (two threads that race store the same) */
+    }
     /* A quota of 1.5 cores runs two workers: the half core is there to take. */
     if (quota > 0 && ceil(quota) < n) n = (int)ceil(quota);
-    n = n < 1 ? 1 : n;
-    atomic_store(&probed_cores, n); /* (two threads that race store the same) */
-    return n;
+    return n < 1 ? 1 : n;
 }
 
 uint64_t vw_host_memory(void)

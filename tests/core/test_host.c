@@ -167,6 +167,20 @@ int main(void)
     CHECK(cores >= 1 && cores <= CPU_COUNT(&set));
     CHECK(bytes > 0); /* (MemAvailable moves between two readings) */
     CHECK_EQ_INT(vw_engine_workers(0), cores);
+    /* The affinity is read at every call (a program may change it between worlds). */
+    if (CPU_COUNT(&set) > 1) {
+        cpu_set_t one;
+        CPU_ZERO(&one);
+        for (int c = 0; c < CPU_SETSIZE; c++)
+            if (CPU_ISSET(c, &set)) {
+                CPU_SET(c, &one);
+                break;
+            }
+        CHECK(sched_setaffinity(0, sizeof one, &one) == 0);
+        CHECK_EQ_INT(vw_host_cores(), 1);
+        CHECK(sched_setaffinity(0, sizeof set, &set) == 0);
+        CHECK_EQ_INT(vw_host_cores(), cores);
+    }
     /* The overrides, and bad ones ignored. */
     setenv("VW_CORES", "3", 1);
     setenv("VW_MEM_AVAILABLE", "12345", 1);

@@ -87,55 +87,86 @@ static vw_status polygon_records(const vw_scene *s, size_t i, poly_work *w, int 
     return VW_OK;
 }
 
-vw_status rt_objects_from_scene(const vw_scene *s, rt_object **out, size_t *n)
+size_t rt_objects_count(const vw_scene *s) { return s->nspheres + s->ncones + s->npolygons; }
+
+size_t rt_objects_room(const vw_scene *s, size_t *widest)
 {
-    size_t cap = s->nspheres + s->ncones;
+    size_t room = s->nspheres + s->ncones, w = 1;
     for (size_t i = 0; i < s->npolygons; i++)
-        if (s->polygons[i].count >= 3) cap += (size_t)s->polygons[i].count - 2;
-    rt_object *o = calloc(cap ? cap : 1, sizeof *o);
-    if (!o) return VW_E_NOMEM;
-    size_t k = 0;
-    for (size_t i = 0; i < s->nspheres; i++) {
-        const vw_sphere *sp = &s->spheres[i];
-        rt_object *r = &o[k++];
-        r->kind = RT_SPHERE;
-        r->id = sp->id;
-        material_of(s, sp->material, &r->mat);
-        memcpy(r->g.sphere.c, sp->center, sizeof r->g.sphere.c);
-        r->g.sphere.r = fabs(sp->radius);
-        /* NFF: a negative radius means only the inside is visible; as for cones, both
-           sides are shaded and the sign turns the normal inward. */
-        if (sp->radius < 0) r->flags |= RT_INSIDE;
-    }
-    for (size_t i = 0; i < s->ncones; i++) {
-        const vw_cone *c = &s->cones[i];
-        rt_object *r = &o[k++];
-        r->kind = RT_CONE;
-        r->id = c->id;
-        material_of(s, c->material, &r->mat);
-        memcpy(r->g.cone.base, c->base, sizeof r->g.cone.base);
-        memcpy(r->g.cone.apex, c->apex, sizeof r->g.cone.apex);
-        r->g.cone.r0 = fabs(c->base_radius);
-        r->g.cone.r1 = fabs(c->apex_radius);
-        /* NFF: negative radii mean only the inside is visible; we shade both sides,
-           so the sign only turns the normal (it matters for refraction). */
-        if (c->base_radius < 0 || c->apex_radius < 0) r->flags |= RT_INSIDE;
-    }
+        if (s->polygons[i].count >= 3) {
+            size_t t = (size_t)s->polygons[i].count - 2;
+            room += t;
+            if (t > w) w = t;
+        }
+    if (widest) *widest = w;
+    return room;
+}
+
+vw_status rt_objects_next(const vw_scene *s, size_t *next, rt_object *out, size_t room, size_t *n)
+{
+    size_t k = 0, i = *next, end = rt_objects_count(s);
     poly_work w = {NULL, NULL, 0};
     vw_status st = VW_OK;
-    for (size_t i = 0; i < s->npolygons && st == VW_OK; i++) {
-        size_t made;
-        st = polygon_records(s, i, &w, 0, &o[k], &made);
-        k += made;
+    /* Objects in the scene's order: its spheres, then its cones, then its polygons. */
+    for (; i < end && st == VW_OK; i++) {
+        if (i < s->nspheres) {
+            if (k == room) break;
+            const vw_sphere *sp = &s->spheres[i];
+            rt_object *r = &out[k++];
+            memset(r, 0, sizeof *r);
+            r->kind = RT_SPHERE;
+            r->id = sp->id;
+            material_of(s, sp->material, &r->mat);
+            memcpy(r->g.sphere.c, sp->center, sizeof r->g.sphere.c);
+            r->g.sphere.r = fabs(sp->radius);
+            /* NFF: a negative radius means only the inside is visible; as for cones, both
+               sides are shaded and the sign turns the normal inward. */
+            if (sp->radius < 0) r->flags |= RT_INSIDE;
+        } else if (i < s->nspheres + s->ncones) {
+            if (k == room) break;
+            const vw_cone *c = &s->cones[i - s->nspheres];
+            rt_object *r = &out[k++];
+            memset(r, 0, sizeof *r);
+            r->kind = RT_CONE;
+            r->id = c->id;
+            material_of(s, c->material, &r->mat);
+            memcpy(r->g.cone.base, c->base, sizeof r->g.cone.base);
+            memcpy(r->g.cone.apex, c->apex, sizeof r->g.cone.apex);
+            r->g.cone.r0 = fabs(c->base_radius);
+            r->g.cone.r1 = fabs(c->apex_radius);
+            /* NFF: negative radii mean only the inside is visible; we shade both sides,
+               so the sign only turns the normal (it matters for refraction). */
+            if (c->base_radius < 0 || c->apex_radius < 0) r->flags |= RT_INSIDE;
+        } else {
+            size_t pi = i - s->nspheres - s->ncones, made;
+            int count = s->polygons[pi].count;
+            if (count >= 3 && (size_t)count - 2 > room - k) {
+                if (k == 0) st = VW_E_INVAL; /* room for its triangles was promised */
+                break;
+            }
+            st = polygon_records(s, pi, &w, 0, &out[k], &made);
+            k += made;
+        }
     }
     free(w.v);
     free(w.tri);
+    if (st != VW_OK) return st;
+    *next = i;
+    *n = k;
+    return VW_OK;
+}
+
+vw_status rt_objects_from_scene(const vw_scene *s, rt_object **out, size_t *n)
+{
+    size_t room = rt_objects_room(s, NULL), next = 0;
+    rt_object *o = malloc((room ? room : 1) * sizeof *o);
+    if (!o) return VW_E_NOMEM;
+    vw_status st = rt_objects_next(s, &next, o, room, n);
     if (st != VW_OK) {
         free(o);
         return st;
     }
     *out = o;
-    *n = k;
     return VW_OK;
 }
 

@@ -47,6 +47,15 @@ typedef struct rt_object {
 /* The scene's primitives as records (polygons by vw_polygon_triangulate, degenerate triangles
    dropped). *out is malloc'ed; returns VW_E_NOMEM on failure. */
 vw_status rt_objects_from_scene(const vw_scene *s, rt_object **out, size_t *n);
+/* The same records a part at a time, so that a large scene's records need not all exist
+   beside the world's copy: rt_objects_count is the scene's objects (spheres, cones,
+   polygons); rt_objects_room the records they make at most, and *widest (if not NULL) the
+   most one polygon makes. rt_objects_next writes the records of objects *next, *next + 1,
+   ... into out while they fit its room (which must hold widest at least), sets *n to the
+   records written and *next past the last object done; done when *next is the count. */
+size_t rt_objects_count(const vw_scene *s);
+size_t rt_objects_room(const vw_scene *s, size_t *widest);
+vw_status rt_objects_next(const vw_scene *s, size_t *next, rt_object *out, size_t room, size_t *n);
 /* Bounds of one record, widened by pad on every side. */
 void rt_object_bounds(const rt_object *o, double pad, vw_box *out);
 

@@ -15,7 +15,8 @@
 #   * a scene that differs on ranks 1 and up (one sphere 2e-62 across, a sphere beyond
 #     the ray tracer's coordinate limit), for render and animate: another scene
 #     (vw_cli_same_scene); memory for the job on rank 1 alone (job-nomem, rt_job_create);
-#     with NP 3, ranks 1 and 2 both fail and the message is rank 1's;
+#     with NP 3, ranks 1 and 2 both fail and the message is rank 1's; memory for a part of
+#     the scene's records on rank 1 alone (job-records-nomem, between the world's steps);
 #   * memory, by the test switch VW_FAULT: for the image sums, which rank 0 alone keeps
 #     (job-accum-nomem); on rank 1 alone for the mapping (map-nomem, rt_job_map), the
 #     farming (farm-nomem, rt_job_farm), animate's records (anim-nomem, rt_anim_create),
@@ -150,6 +151,11 @@ for c in render animate; do
     must_agree "$c, no memory for the job on rank 1" 1 "^vwalls $c: rank 1: out of memory" \
         "[ $rank = 1 ] && export VW_FAULT=job-nomem; \"$vwalls\" $c \"$dir/balls.nff\" $args $small"
 done
+# The scene's records are converted a part at a time between the world's collective
+# steps: rank 1 alone without room for a part stops every rank there.
+must_agree "render, no memory for the scene's records on rank 1" 1 \
+    "^vwalls render: rank 1: the scene's records: out of memory" \
+    "[ $rank = 1 ] && export VW_FAULT=job-records-nomem; \"$vwalls\" render \"$dir/balls.nff\" -o \"$dir/r.png\" $small"
 must_agree "render, no memory for the image sums (rank 0 alone keeps them)" 1 \
     "^vwalls render: rank 0: out of memory for the 32x32 image" \
     "VW_FAULT=job-accum-nomem \"$vwalls\" render \"$dir/balls.nff\" -o \"$dir/r.png\" $small"

@@ -21,9 +21,12 @@ cpu=$(sed -n 's/^model name[^:]*: //p' /proc/cpuinfo | head -1)
 mem=$(awk '/^MemTotal/ { printf "%.1f GiB", $2 / 1048576 }' /proc/meminfo)
 os=$(. /etc/os-release 2>/dev/null && echo "$PRETTY_NAME")
 
-# q AWK-PROGRAM: run over results.csv with c["column"] -> index and v(name)
+# q AWK-PROGRAM: run over results.csv with c["column"] -> index, v(name), and laid(): the
+# cells of the row's layout (divide's rows end with more cells than their layout had)
 q() { awk -F, -v nproc="$(env_ nproc)" "NR == 1 { for (i = 1; i <= NF; i++) c[\$i] = i; next }
-  function v(k) { return \$(c[k]) } $1" "$CSV"; }
+  function v(k) { return \$(c[k]) }
+  function laid(   d, i, n, p) { n = split(v(\"layout\"), d, \"x\"); p = 1; for (i = 1; i <= n; i++) p *= d[i]; return p }
+  $1" "$CSV"; }
 
 true_rt=$(q '$1 == "raytrace" && v("scene") ~ /^s1000-/ && v("engine") == "threads" && v("balance") == "none" && v("workers") == nproc && nproc > 1 {
   printf "%s%s on %s cells: %.2f", (n++ ? "; " : ""), v("scene"), v("layout"), v("speedup") }')
@@ -31,7 +34,7 @@ true_farm=$(q '$1 == "raytrace" && v("scene") ~ /^s1000-/ && v("engine") == "thr
   printf "%s%s on %s cells: %.2f", (n++ ? "; " : ""), v("scene"), v("layout"), v("speedup") }')
 true_rad=$(q '$1 == "radiosity" && v("engine") == "threads" && v("balance") == "none" && v("workers") == nproc && nproc > 1 {
   printf "%s%s cells: %.2f (efficiency %.2f)", (n++ ? "; " : ""), v("layout"), v("speedup"), v("efficiency") }')
-lb8=$(q '$1 == "raytrace" && v("engine") == "threads" && v("cells") == 8 && v("workers") == 8 {
+lb8=$(q '$1 == "raytrace" && v("engine") == "threads" && laid() == 8 && v("workers") == 8 {
   cl = v("scene"); sub(/.*-c/, "", cl); s[v("balance") " " cl] += v("lb_eff"); k[v("balance") " " cl]++ }
   END { for (x in s) { split(x, a, " "); printf "%s|%s|%.2f\n", a[1], a[2], s[x] / k[x] } }' | sort)
 lb8_text=$(echo "$lb8" | awk -F'|' 'NF == 3 { printf "%s%s %s%% clustered: %s", (n++ ? "; " : ""), $1, $2 * 100, $3 }')
@@ -52,7 +55,7 @@ read -r rd_e rd_l rd_m <<< "$(m8 radiosity threads none)"
 read -r rdm_e rdm_l rdm_m <<< "$(m8 radiosity mpi none)"
 rt_model_best=$(q '$1 == "raytrace" && v("workers") == 8 { if (v("eff_model") > b) { b = v("eff_model"); w = v("scene") " " v("balance") } } END { printf "%.2f (%s)", b, w }')
 # balanced against unbalanced, same scene and layout: rows where 1/lambda rose
-bal_better=$(q '$1 == "raytrace" && v("engine") == "threads" && v("workers") == v("cells") {
+bal_better=$(q '$1 == "raytrace" && v("engine") == "threads" && v("workers") == laid() {
   k = v("scene") "/" v("layout"); if (v("balance") == "none") u[k] = v("lb_eff"); else b[k, ++nb[k]] = v("lb_eff") }
   END { for (k in nb) if (k in u) for (i = 1; i <= nb[k]; i++) { n++; if (b[k, i] > u[k]) up++ } printf "%d of %d", up, n }')
 # how much of a core the one-worker runs got (CPU / wall): the rest went to other jobs
@@ -131,7 +134,7 @@ bench/experiments.sh --smoke             # the ctest version (label bench): seco
   holding every cell: what \`vwalls render\` does by default): ${true_farm:-n/a}.
 - **Radiosity, $(env_ nproc) workers**: ${true_rad:-n/a}; on 8 workers: ${rad8:-n/a}
   (sequential: $rad1).
-- **Load-balance efficiency 1/λ on 8 cells** (mean over 100/500/1000 spheres): ${lb8_text:-n/a}.
+- **Load-balance efficiency 1/λ on 8 cells** (divide's split further; mean over 100/500/1000 spheres): ${lb8_text:-n/a}.
 - **Model efficiency on 8 cells** (counted work, no timer; mean over the sphere scenes):
   ray tracing $rt_m unbalanced, $rtb_m balanced; radiosity $rd_m (paper: ~1 and 0.68).
 - **Cost of the walls**: 8 cells trace ${segs:-n/a}× the ray segments of 1 cell (every
@@ -170,7 +173,12 @@ cat <<EOF
 ## Peers and limits
 
 POV-Ray is timed as a whole process (parse, build, render, write) against a whole
-\`vwalls render\` process on 1 cell with the same number of threads; Embree's raw loop
+\`vwalls render\` process on 1 cell with the same number of threads, on the scene
+\`bench/nff2pov.py\` converts (polygons of more than three corners as POV-Ray polygons,
+\`pp\` ones by ear clipping, so concave ones cover what vwalls covers: test
+\`bench_nff2pov_concave\`; the \`#vw Ks\` and \`#vw Ke\` extension lines as far as POV-Ray's
+finish can follow them, saying on stderr where it cannot: test \`bench_nff2pov_ext\`);
+Embree's raw loop
 (\`vw_bench_embree_raw\`: the same ray tree by plain rtcIntersect1/rtcOccluded1 recursion)
 against vwalls' compute phase on 1 cell and 1 worker. The two count rays differently (the
 raw loop counts every eye ray, vwalls only those entering the world box), so compare
@@ -233,9 +241,9 @@ What this says, honestly:
   rays differently (the raw loop also traces the eye rays that miss the world box, which
   vwalls never starts) and both last tens of milliseconds, so take it as a rough bound.
 - **Memory**: with 8 MPI processes each process's peak RSS is ${mem8:-n/a}× one process's
-  on the 200000-sphere scene: it falls, but nowhere near 1/8, because every process still
-  reads and places the whole scene before keeping its own cells (as \`bench/mpi.sh\`
-  notes), and the sum over processes grows with P.
+  on the 200000-sphere scene, where 1/8 would be the ideal: every process still reads and
+  places the whole scene before keeping its own cells (as \`bench/mpi.sh\` notes), and
+  that load, not the cells, sets the peak; the sum over processes grows with P.
 
 ## What is missing
 

@@ -26,6 +26,13 @@ add_test(NAME raytrace_illum COMMAND vw_test_raytrace illum
 # Concave polygons (the SPD gears' faces) become triangles inside them, not a fan.
 add_test(NAME raytrace_concave COMMAND vw_test_raytrace concave
          ${PROJECT_SOURCE_DIR}/tests/data/good/concave.nff)
+# The scene's records a part at a time equal the whole conversion (rt_job_create adds
+# them so): every entity kind, concave polygons, the sphereflake.
+add_test(NAME raytrace_parts_mixed COMMAND vw_test_raytrace parts
+         ${PROJECT_SOURCE_DIR}/tests/data/good/mixed.nff)
+add_test(NAME raytrace_parts_concave COMMAND vw_test_raytrace parts
+         ${PROJECT_SOURCE_DIR}/tests/data/good/concave.nff)
+add_test(NAME raytrace_parts_balls COMMAND vw_test_raytrace parts gen:balls:2)
 # Layouts 1, 2, 2x4, 2x2x2, 4x4x4 x workers 1, 2, 4 against 1 cell on 1 worker; also
 # checks that every ray created is ended and that every layout creates the same rays.
 add_test(NAME raytrace_identical_balls COMMAND vw_test_raytrace identical gen:balls:2 96x96)

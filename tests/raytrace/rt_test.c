@@ -741,6 +741,54 @@ static int write_nff(const char *spec)
     return st == VW_OK ? 0 : 1;
 }
 
+/* The scene's records a part at a time (rt_objects_next, as rt_job_create adds them to
+   the world) are the whole conversion's (rt_objects_from_scene), byte for byte and in
+   order, for every room from the widest polygon's triangles up to all of them: parts
+   that end inside the spheres, at a cone, before a polygon that does not fit. A room
+   smaller than the widest polygon is refused, not overrun. */
+static int test_parts(const char *spec)
+{
+    vw_scene *s = load(spec);
+    rt_object *all;
+    size_t nall, widest;
+    CHECK(rt_objects_from_scene(s, &all, &nall) == VW_OK);
+    size_t room = rt_objects_room(s, &widest), count = rt_objects_count(s);
+    CHECK(nall <= room);
+    rt_object *part = malloc((room + 1) * sizeof *part);
+    CHECK(part != NULL);
+    size_t rooms = 0;
+    for (size_t r = widest; r <= room + 1; r++, rooms++) {
+        size_t next = 0, at = 0, parts = 0;
+        while (next < count) {
+            size_t n = 99, before = next;
+            CHECK(rt_objects_next(s, &next, part, r, &n) == VW_OK);
+            CHECK(next > before); /* every part advances */
+            CHECK(n <= r && at + n <= nall);
+            CHECK(n == 0 || !memcmp(part, &all[at], n * sizeof *part));
+            at += n;
+            parts++;
+        }
+        CHECK_EQ_INT(at, nall);
+        CHECK(r < room || parts == 1); /* room for all: one part */
+    }
+    if (widest > 1) {
+        /* The widest polygon alone in a part with less room than its triangles. */
+        size_t next = 0, n;
+        int refused = 0;
+        while (next < count && !refused) {
+            vw_status st = rt_objects_next(s, &next, part, widest - 1, &n);
+            refused = st != VW_OK;
+        }
+        CHECK(refused);
+    }
+    printf("parts: %zu records of %zu objects (widest polygon %zu triangles) equal in %zu room sizes\n",
+           nall, count, widest, rooms);
+    free(part);
+    free(all);
+    vw_scene_free(s);
+    return 0;
+}
+
 int main(int argc, char **argv)
 {
     if (argc >= 3 && !strcmp(argv[1], "nff")) return write_nff(argv[2]);
@@ -752,6 +800,7 @@ int main(int argc, char **argv)
     if (argc >= 3 && !strcmp(argv[1], "illum")) return test_illum(argv[2]);
     if (argc >= 2 && !strcmp(argv[1], "watertight")) return test_watertight();
     if (argc >= 3 && !strcmp(argv[1], "concave")) return test_concave(argv[2]);
+    if (argc >= 3 && !strcmp(argv[1], "parts")) return test_parts(argv[2]);
     if (argc >= 2 && !strcmp(argv[1], "write")) return write_png(argc, argv);
     fprintf(stderr, "usage: rt_test identical SCENE [WxH] | analytic | cone | write ...\n");
     return 2;

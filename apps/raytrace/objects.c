@@ -102,6 +102,17 @@ size_t rt_objects_room(const vw_scene *s, size_t *widest)
     return room;
 }
 
+/* A fresh record (every byte set: the geometry cache compares records by their bytes)
+   of this kind, scene id and material. */
+static rt_object *record(const vw_scene *s, rt_object *r, int kind, int id, int material)
+{
+    memset(r, 0, sizeof *r);
+    r->kind = kind;
+    r->id = id;
+    material_of(s, material, &r->mat);
+    return r;
+}
+
 vw_status rt_objects_next(const vw_scene *s, size_t *next, rt_object *out, size_t room, size_t *n)
 {
     size_t k = 0, i = *next, end = rt_objects_count(s);
@@ -112,11 +123,7 @@ vw_status rt_objects_next(const vw_scene *s, size_t *next, rt_object *out, size_
         if (i < s->nspheres) {
             if (k == room) break;
             const vw_sphere *sp = &s->spheres[i];
-            rt_object *r = &out[k++];
-            memset(r, 0, sizeof *r);
-            r->kind = RT_SPHERE;
-            r->id = sp->id;
-            material_of(s, sp->material, &r->mat);
+            rt_object *r = record(s, &out[k++], RT_SPHERE, sp->id, sp->material);
             memcpy(r->g.sphere.c, sp->center, sizeof r->g.sphere.c);
             r->g.sphere.r = fabs(sp->radius);
             /* NFF: a negative radius means only the inside is visible; as for cones, both
@@ -125,11 +132,7 @@ vw_status rt_objects_next(const vw_scene *s, size_t *next, rt_object *out, size_
         } else if (i < s->nspheres + s->ncones) {
             if (k == room) break;
             const vw_cone *c = &s->cones[i - s->nspheres];
-            rt_object *r = &out[k++];
-            memset(r, 0, sizeof *r);
-            r->kind = RT_CONE;
-            r->id = c->id;
-            material_of(s, c->material, &r->mat);
+            rt_object *r = record(s, &out[k++], RT_CONE, c->id, c->material);
             memcpy(r->g.cone.base, c->base, sizeof r->g.cone.base);
             memcpy(r->g.cone.apex, c->apex, sizeof r->g.cone.apex);
             r->g.cone.r0 = fabs(c->base_radius);

@@ -312,7 +312,10 @@ vw_status vw_world_create(const vw_module *m, void *user, const vw_decomp *d, co
     if (w->cfg.packet_bytes < 64) w->cfg.packet_bytes = 64;
     w->rank = 0;
     w->nprocs = 1;
-    w->nworkers = w->cfg.workers > 0 ? w->cfg.workers : vw_host_cores();
+    /* The cores this process may run on: the default worker count, and whether the
+       workers leave a core to spare (steal, share_core below). */
+    int cores = vw_host_cores();
+    w->nworkers = w->cfg.workers > 0 ? w->cfg.workers : cores;
     if (w->nworkers > 1024) {
         create_failed(VW_E_LIMIT, "vw_world_create: %d workers (at most 1024)", w->nworkers);
         free(w);
@@ -326,7 +329,7 @@ vw_status vw_world_create(const vw_module *m, void *user, const vw_decomp *d, co
         free(w);
         return VW_E_LIMIT;
     }
-    w->steal = w->cfg.steal > 0 || (w->cfg.steal < 0 && w->nworkers <= vw_host_cores());
+    w->steal = w->cfg.steal > 0 || (w->cfg.steal < 0 && w->nworkers <= cores);
     w->cfg.cell_worker = NULL; /* copied into w->cell_worker below */
     pthread_mutex_init(&w->output_mu, NULL);
     pthread_mutex_init(&w->pool_mu, NULL);
@@ -361,7 +364,7 @@ vw_status vw_world_create(const vw_module *m, void *user, const vw_decomp *d, co
                                  "the same way); VW_MIXED_BUILDS=1 runs them anyway", r);
     }
     w->gworkers = w->nworkers * w->nprocs;
-    w->share_core = w->transport && w->nworkers >= vw_host_cores();
+    w->share_core = w->transport && w->nworkers >= cores;
     if (st == VW_OK) {
         w->wstats = calloc((size_t)w->gworkers, sizeof *w->wstats);
         if (!w->wstats) st = VW_E_NOMEM;

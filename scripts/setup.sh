@@ -30,5 +30,13 @@ echo "setup: installing ${missing[*]}" >&2
 SUDO=""
 if [ "$(id -u)" != 0 ]; then SUDO="sudo"; fi
 export DEBIAN_FRONTEND=noninteractive
-$SUDO apt-get update -qq
-$SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}" >&2
+# dpkg's hundreds of lines go to a log, shown (its end) only if something fails.
+log=$(mktemp "${TMPDIR:-/tmp}/vwalls-setup.XXXXXX")
+if ! { $SUDO apt-get update -qq &&
+       $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"; } > "$log" 2>&1; then
+  tail -n 40 "$log" >&2
+  echo "setup: apt-get failed; its whole output is in $log" >&2
+  exit 1
+fi
+rm -f "$log"
+echo "setup: installed ${#missing[@]} packages and what they need" >&2

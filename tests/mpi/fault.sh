@@ -1,10 +1,11 @@
 #!/bin/sh
 # fault.sh - one rank of a 4-process storm dies (kill: SIGKILL mid-run), exits early
 # (exit: status 3, without MPI_Finalize, while the others wait for it) or hangs while
-# alive (hang: a handler that never returns). The job must end within 10 s, with a
-# non-zero status and a message naming the rank; a hung rank sends no such message
-# (nothing has failed), so that job must end by the launcher's time limit
-# (MPIEXEC_TIMEOUT, honoured by Open MPI's mpirun and MPICH's Hydra alike), saying so.
+# alive (hang: a handler that never returns). The job must end within 10 s (beyond what
+# a job of the same processes takes to start MPI and end it), with a non-zero
+# status and a message naming the rank; a hung rank sends no such message (nothing has
+# failed), so that job must end by the launcher's time limit (MPIEXEC_TIMEOUT, honoured
+# by Open MPI's mpirun and MPICH's Hydra alike), saying so.
 # usage: fault.sh kill|exit|hang TEST_MPI_STORM "MPIEXEC -n 4 [flags]"
 mode=$1 prog=$2 launch=$3
 case $mode in
@@ -14,8 +15,10 @@ hang) args="--hang-rank 1" rank=1 ;;
 *) echo "fault.sh: unknown mode '$mode'"; exit 2 ;;
 esac
 . "$(dirname "$0")/must_fail.sh"
+# shellcheck disable=SC2086
+base_ms=$(launcher_ms $launch "$prog" --seeds 0)
 if [ "$mode" = hang ]; then
-    export MPIEXEC_TIMEOUT=4
+    export MPIEXEC_TIMEOUT=$((4 + (base_ms + 999) / 1000))
     # shellcheck disable=SC2086
     must_fail "fault.sh: $mode" 10 60 $launch "$prog" --workers 2 --seeds 20 $args
     grep -q "rank 1 hangs on purpose" "$out" || { echo "fault.sh: FAIL: rank 1 did not hang"; fail=1; }

@@ -5,6 +5,8 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
+#include <sys/stat.h>
 
 #include "cli.h"
 #include "commands.h"
@@ -31,7 +33,7 @@ static void gen_usage(FILE *f)
             "  --cluster F       fraction of spheres in the cluster region, 0..1 (default 0)\n"
             "                    (an option the scene has no use for is an error)\n"
             "  --resolution WxH  camera resolution (default 512x512)\n"
-            "  -o FILE           write to FILE (atomically) instead of stdout; under mpirun\n"
+            "  -o FILE.nff       write to FILE.nff (atomically) instead of stdout; under mpirun\n"
             "                    the first process alone writes it\n"
             "  --help            this text\n"
             "\nexit status: 0 success, 2 bad input or usage, 1 any other failure\n");
@@ -93,6 +95,17 @@ int vw_cmd_gen(int argc, char **argv)
         } else {
             name = a;
         }
+    }
+    /* vwalls reads a scene file by its name's ending (vw_scene_read_file): NFF written
+       as x.obj would be read back as OBJ and fail at its second line. A FIFO or a
+       device (/dev/stdout) is not read back by name, so any name will do there. */
+    size_t olen = out ? strlen(out) : 0;
+    struct stat sb;
+    int special = out && stat(out, &sb) == 0 && !S_ISREG(sb.st_mode);
+    if (out && !special && !(olen > 4 && !strcasecmp(out + olen - 4, ".nff"))) {
+        vw_cli_error(cmd, "-o %s: the scene is written as NFF, which vwalls reads only from "
+                          "a name ending in .nff", out);
+        return VW_EXIT_USAGE;
     }
     if (!name) {
         vw_cli_error(cmd, "which scene? balls, rings, tree, spheres, cornell or room "

@@ -121,6 +121,20 @@ int main(int argc, char **argv)
     CHECK(strcmp(t, "vwalls gen: -o: empty file name\n") == 0);
     free(t);
 
+    /* -o must end in .nff, as the readers choose the format by the name: written as
+       room.obj it would be read back as OBJ. A usage error, and nothing written. */
+    snprintf(file, sizeof file, "%s/room.obj", dir);
+    CHECK_EQ_INT(run(vw_cmd_gen, (const char *[]){"gen", "room", "-o", file, NULL}), 2);
+    CHECK(access(file, F_OK) != 0);
+    t = text_of(err_path);
+    CHECK(strstr(t, "room.obj: the scene is written as NFF, which vwalls reads only from a "
+                    "name ending in .nff") != NULL && lines(t) == 1);
+    free(t);
+    snprintf(file, sizeof file, "%s/ROOM.NFF", dir);
+    CHECK_EQ_INT(run(vw_cmd_gen, (const char *[]){"gen", "room", "-o", file, NULL}), 0);
+    unlink(file);
+    snprintf(file, sizeof file, "%s/flake.nff", dir);
+
     /* NFF to stdout equals NFF to -o. */
     CHECK_EQ_INT(run(vw_cmd_gen, (const char *[]){"gen", "balls", "--size", "2", "--resolution",
                                                   "320x240", NULL}), 0);

@@ -12,6 +12,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 #include <time.h>
 #include <unistd.h>
 
@@ -196,6 +197,18 @@ const char *vw_cli_output(const char *cmd, int argc, char **argv, int *i)
         return NULL;
     }
     return v;
+}
+
+int vw_cli_scene_output(const char *cmd, const char *opt, const char *path, const char *ext,
+                        const char *format)
+{
+    size_t n = strlen(path), m = strlen(ext);
+    struct stat sb;
+    if ((n > m && !strcasecmp(path + n - m, ext)) || (stat(path, &sb) == 0 && !S_ISREG(sb.st_mode)))
+        return 0;
+    vw_cli_error(cmd, "%s %s: written as %s, which vwalls reads only from a name ending in %s",
+                 opt, path, format, ext);
+    return -1;
 }
 
 double vw_cli_now(void)

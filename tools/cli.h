@@ -45,6 +45,13 @@ const char *vw_cli_value(const char *cmd, int argc, char **argv, int *i);
    when the file is written. */
 const char *vw_cli_output(const char *cmd, int argc, char **argv, int *i);
 
+/* An output that vwalls reads back as a scene (gen -o: NFF, radiosity -o: PLY), which
+   it recognises by the name's ending: 0 when path ends in ext (".nff", any case) or is
+   a device or a FIFO (not read back by name), else "vwalls CMD: OPT PATH: written as
+   FORMAT, which vwalls reads only from a name ending in EXT" and -1. */
+int vw_cli_scene_output(const char *cmd, const char *opt, const char *path, const char *ext,
+                        const char *format);
+
 /* Fault injection for tests: is name one of the comma-separated words of the
    environment variable VW_FAULT (e.g. VW_FAULT=ledger: vwalls radiosity takes its
    energy ledger as off)? vw_test_fault, which the applications use too. Never set

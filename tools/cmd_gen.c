@@ -5,8 +5,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <strings.h>
-#include <sys/stat.h>
 
 #include "cli.h"
 #include "commands.h"
@@ -96,17 +94,9 @@ int vw_cmd_gen(int argc, char **argv)
             name = a;
         }
     }
-    /* vwalls reads a scene file by its name's ending (vw_scene_read_file): NFF written
-       as x.obj would be read back as OBJ and fail at its second line. A FIFO or a
-       device (/dev/stdout) is not read back by name, so any name will do there. */
-    size_t olen = out ? strlen(out) : 0;
-    struct stat sb;
-    int special = out && stat(out, &sb) == 0 && !S_ISREG(sb.st_mode);
-    if (out && !special && !(olen > 4 && !strcasecmp(out + olen - 4, ".nff"))) {
-        vw_cli_error(cmd, "-o %s: the scene is written as NFF, which vwalls reads only from "
-                          "a name ending in .nff", out);
-        return VW_EXIT_USAGE;
-    }
+    /* vwalls reads a scene file by its name's ending: NFF written as x.obj would be
+       read back as OBJ and fail at its second line. */
+    if (out && vw_cli_scene_output(cmd, "-o", out, ".nff", "NFF")) return VW_EXIT_USAGE;
     if (!name) {
         vw_cli_error(cmd, "which scene? balls, rings, tree, spheres, cornell or room "
                           "(try vwalls gen --help)");

@@ -329,7 +329,9 @@ int vw_cmd_radiosity(int argc, char **argv)
                      "or --checkpoint F");
         return VW_EXIT_USAGE;
     }
-    /* Before the solve: a picture that cannot be written would be found only after it. */
+    /* Before the solve: a picture that cannot be written would be found only after it,
+       and a mesh named x.obj would be written as PLY and read back as OBJ. */
+    if (r.out && vw_cli_scene_output(CMD, "-o", r.out, ".ply", "PLY")) return VW_EXIT_USAGE;
     if (r.image && vw_image_format_of(r.image) == VW_IMAGE_NONE) {
         vw_cli_error(CMD, "--image %s: the picture must end in .png or .pfm", r.image);
         return VW_EXIT_USAGE;

@@ -127,8 +127,8 @@ int main(int argc, char **argv)
     CHECK_EQ_INT(run(vw_cmd_gen, (const char *[]){"gen", "room", "-o", file, NULL}), 2);
     CHECK(access(file, F_OK) != 0);
     t = text_of(err_path);
-    CHECK(strstr(t, "room.obj: the scene is written as NFF, which vwalls reads only from a "
-                    "name ending in .nff") != NULL && lines(t) == 1);
+    CHECK(strstr(t, "vwalls gen: -o ") && strstr(t, "room.obj: written as NFF, which vwalls "
+                    "reads only from a name ending in .nff") && lines(t) == 1);
     free(t);
     snprintf(file, sizeof file, "%s/ROOM.NFF", dir);
     CHECK_EQ_INT(run(vw_cmd_gen, (const char *[]){"gen", "room", "-o", file, NULL}), 0);

@@ -118,6 +118,14 @@ awk -F, '$1 == 0 && $3 == 1 && $4 == 1 && $5 == 1 { ok = 1 } END { exit !ok }' "
 [ $rc -eq 2 ] || fail "--image .jpg: exit $rc"
 grep -q "image .*v.jpg: the picture must end in .png or .pfm" "$T/err" || fail "--image .jpg: message: $(cat "$T/err")"
 [ ! -e "$T/v.jpg" ] && [ ! -e "$T/v.ply" ] || fail "--image .jpg: output written"
+# -o is read back as a scene by its name: a mesh named .obj (PLY inside) is refused
+# before the solve; a device takes any name.
+"$V" radiosity "$T/cornell.nff" -o "$T/m.obj" --max-shots 4 --quiet 2>"$T/err"; rc=$?
+[ $rc -eq 2 ] || fail "-o m.obj: exit $rc"
+grep -q "radiosity: -o .*m.obj: written as PLY, which vwalls reads only from a name ending in .ply" "$T/err" ||
+  fail "-o m.obj: message: $(cat "$T/err")"
+[ ! -e "$T/m.obj" ] || fail "-o m.obj: output written"
+"$V" radiosity "$T/cornell.nff" -o /dev/null --max-shots 4 --quiet || fail "-o /dev/null: exit $?"
 # A scene file's own resolution beyond 16384 a side: refused before the solve, as render
 # refuses it (it was allocated after the solve); --size overrides it.
 sed 's/^resolution .*/resolution 20000 10/' "$T/cornell.nff" > "$T/wide.nff"

@@ -90,6 +90,12 @@ vw_mpi_script_test(mpi_print_once 3 print_once.sh 120
 vw_mpi_script_test(mpi_rank_input 2 rank_input.sh 240
                    $<TARGET_FILE:vwalls_tool> ${PROJECT_SOURCE_DIR}/tests/data/good/mixed.nff)
 
+# The default worker count: processes of one host that may run on the same CPUs share
+# its cores (two unbound processes: half each, as their affinity masks overlap).
+vw_mpi_script_test(mpi_core_share 2 core_share.sh 120
+                   $<TARGET_FILE:vwalls_tool> ${PROJECT_SOURCE_DIR}/tests/data/good/mixed.nff
+                   ${VW_MPI_FLAVOUR})
+
 # A check one rank alone fails (its own copy of the scene, its memory) stops every rank.
 vw_mpi_script_test(mpi_rank_alone 2 rank_alone.sh 150
                    $<TARGET_FILE:vwalls_tool> ${PROJECT_SOURCE_DIR}/tests/data/good/mixed.nff)

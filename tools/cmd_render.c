@@ -32,7 +32,7 @@ static void help(void)
            "  --cells L        layout of cells, like 4, 2x4, 2x2x2 (default 1)\n"
            "  --workers W      worker threads per process (default: the cores it may run on,\n"
            "                   as nproc counts, or a cgroup CPU quota's rounded up; under\n"
-           "                   MPI, the fewest of any process)\n"
+           "                   MPI, its share of its host's, the fewest of any process)\n"
            "  --size WxH       image size (default: the scene's, else 512x512)\n"
            "  --depth D        maximum ray depth, eye rays being depth 1 (default 5)\n"
            "  --from X,Y,Z --at X,Y,Z --up X,Y,Z --angle DEG\n"
@@ -389,8 +389,8 @@ int vw_cmd_render(int argc, char **argv)
     }
 
     /* Workers of the whole job, for --speeds and --slow (the world's own default when
-       --workers is not given: one per core, under MPI the fewest cores of any host, so
-       every host expects as many speeds). */
+       --workers is not given: one per core, under MPI each process's share of its
+       host's cores, the fewest of any, so every host expects as many speeds). */
     int gw = vw_cli_job_workers(workers);
     /* Up to the world's creation, each process checks what it has itself (its memory,
        its scene file: every process reads its own copy) and all agree at the end of

@@ -41,7 +41,8 @@ extern "C" {
 typedef struct vw_world vw_world;
 
 typedef struct vw_config {
-    int workers;             /* worker threads per process; 0 = number of cores */
+    int workers;             /* worker threads per process; 0 = number of cores (under
+                                MPI its share of the host's: vw_engine_workers) */
     size_t packet_bytes;     /* flush a packet when it holds this much (default 32 KiB;
                                 at most 1 GiB, VW_E_LIMIT above) */
     size_t cap_bytes;        /* a worker whose unconsumed sent bytes exceed this drains its

@@ -279,6 +279,8 @@ int vw_host_cores(void)
     return n < 1 ? 1 : n;
 }
 
+int vw__host_cores_given(void) { return env_count("VW_CORES", 1024) != 0; }
+
 uint64_t vw_host_memory(void)
 {
     uint64_t env = env_count("VW_MEM_AVAILABLE", UINT64_MAX);

@@ -341,6 +341,10 @@ double vw__replica_load(vw_world *w, int cell, int rep);
 void vw__stats_local(vw_world *w);
 uint64_t vw__peak_rss(void);
 
+/* Whether VW_CORES gives this process's cores (host.c): then they are not shared with
+   other processes of the host (vw__mpi_core_share). */
+int vw__host_cores_given(void);
+
 /* transport/mpi.c (stubs in world.c without MPI). vw__mpi_attach decides the engine at
    create: it sets rank, nprocs and w->transport when the world runs under MPI. */
 vw_status vw__mpi_attach(vw_world *w);

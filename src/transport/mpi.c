@@ -710,6 +710,12 @@ vw_status vw__mpi_attach(vw_world *w)
         return vw__world_error(w, VW_E_MPI, "MPI was initialised with thread level %d; vwalls needs "
                                "at least MPI_THREAD_FUNNELED", level);
     if (size == 1) return VW_OK; /* one process: the threads engine, without polling */
+    /* By default (workers = 0) a process runs its share of its host's cores: several
+       processes on one host that may all run on every core would otherwise each start a
+       worker per core (Open MPI binds more than two processes to a socket, or none at
+       all when oversubscribed), k times the cores in all. Collective, so before the
+       allocation below can fail. */
+    if (w->cfg.workers <= 0) w->nworkers = vw__mpi_core_share(base, w->nworkers);
     /* Every process needs the same worker count (global worker = rank * W + local). With
        workers = 0 (as many as cores) the machines may differ: take the smallest. The same
        reduction finds the lowest process that could not allocate the transport: all

@@ -6,6 +6,7 @@
 #include "vwalls/engine.h"
 
 #include <errno.h>
+#include <sched.h>
 #include <limits.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -173,11 +174,37 @@ void vw_engine_broadcast(void *buf, size_t n)
     }
 }
 
+int vw__mpi_core_share(MPI_Comm comm, int cores)
+{
+    MPI_Comm host;
+    if (MPI_Comm_split_type(comm, MPI_COMM_TYPE_SHARED, 0, MPI_INFO_NULL, &host) != MPI_SUCCESS)
+        return cores;
+    int n = 1;
+    MPI_Comm_size(host, &n);
+    if (n > 1) {
+        /* The masks' union by a bitwise or of their bytes, their sizes by a sum: two
+           reductions, whatever the number of processes on the host. */
+        cpu_set_t mine, any;
+        CPU_ZERO(&mine);
+        if (sched_getaffinity(0, sizeof mine, &mine) != 0) CPU_SET(0, &mine);
+        long count = CPU_COUNT(&mine), sum = 0;
+        MPI_Allreduce(&mine, &any, (int)sizeof mine, MPI_BYTE, MPI_BOR, host);
+        MPI_Allreduce(&count, &sum, 1, MPI_LONG, MPI_SUM, host);
+        long share = sum > 0 ? (long)cores * CPU_COUNT(&any) / sum : cores;
+        if (!vw__host_cores_given()) cores = share < 1 ? 1 : share < cores ? (int)share : cores;
+    }
+    MPI_Comm_free(&host);
+    return cores;
+}
+
 int vw_engine_workers(int workers)
 {
-    /* The reduction runs whatever this rank's workers, so every rank makes it. */
+    /* The reductions run whatever this rank's workers, so every rank makes them. */
     int cores = vw_host_cores(), fewest = cores;
-    if (mpi_up() && vw_engine_size() > 1) MPI_Allreduce(&cores, &fewest, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
+    if (mpi_up() && vw_engine_size() > 1) {
+        cores = vw__mpi_core_share(MPI_COMM_WORLD, cores);
+        MPI_Allreduce(&cores, &fewest, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
+    }
     return workers > 0 ? workers : fewest;
 }
 

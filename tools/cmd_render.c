@@ -69,7 +69,7 @@ static void help(void)
            "                   maps by them, and copies of cells take shares of the work\n"
            "                   in proportion (--slow W:K gives worker W the speed 1/K);\n"
            "                   one per worker of the job: processes x --workers (default:\n"
-           "                   the cores of the host with fewest)\n"
+           "                   the fewest cores of any process, see --workers)\n"
            "  --slow W:K[,..]  worker W does its work K times slower, K from 1 to 1000\n"
            "                   (emulates a slow machine)\n"
            "  --steal S        auto (default) | on | off: a copy that is done takes the\n"
@@ -410,8 +410,8 @@ int vw_cmd_render(int argc, char **argv)
                              vw_engine_size() == 1 ? "" : "es", gw / vw_engine_size(),
                              gw / vw_engine_size() == 1 ? "" : "s",
                              workers > 0 ? "" : vw_engine_size() == 1 ? ", one per core; --workers sets them"
-                                                                      : ", one per core of the host with "
-                                                                        "fewest; --workers sets them");
+                                                                      : ", the fewest cores of any "
+                                                                        "process; --workers sets them");
     }
     if (rc == VW_EXIT_OK && slow_s) {
         slowdown = malloc(sizeof(double) * (size_t)gw);

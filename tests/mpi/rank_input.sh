@@ -132,7 +132,7 @@ cores='$(('"$rank"' + 2))'
 run "render --speeds, hosts of 2 and 3 cores" 0 "" \
     sh -c "export VW_CORES=$cores; exec \"$vwalls\" render \"$scene\" -o \"$dir/r.png\" --size 48x48 --cells 2x2x2 --speeds 1,2,1,2 --quiet"
 run "render --speeds, a wrong count on hosts of 2 and 3 cores" 2 \
-    "expected 4 positive numbers, one per worker: 2 processes x 2 workers, one per core of the host with fewest; --workers sets them" \
+    "expected 4 positive numbers, one per worker: 2 processes x 2 workers, the fewest cores of any process; --workers sets them" \
     sh -c "export VW_CORES=$cores; exec \"$vwalls\" render \"$scene\" -o \"$dir/r.png\" --size 48x48 --cells 2x2x2 --speeds 1,2,1,2,1,2 --quiet"
 
 # Outputs into a missing directory: status 1, as the single process's (the frames'

@@ -542,9 +542,10 @@ int vw_cmd_radiosity(int argc, char **argv)
         if (!o.quiet) {
             char layout[64];
             vw_decomp_layout_string(d, layout, sizeof layout);
-            printf("radiosity: %s, %zu pieces, %zu elements, cells %s, %d workers x %d process%s\n",
+            printf("radiosity: %s, %zu pieces, %zu elements, cells %s, %d worker%s x %d process%s\n",
                    converged ? "converged" : "stopped", mesh.npieces, ne, layout, vw_world_workers(w),
-                   vw_world_processes(w), vw_world_processes(w) == 1 ? "" : "es");
+                   vw_world_workers(w) == 1 ? "" : "s", vw_world_processes(w),
+                   vw_world_processes(w) == 1 ? "" : "es");
             printf("shots %lld, unshot ratio %.3g (sf %.3g), energy error %.2e, time %.3f s\n",
                    (long long)rad_solver_shots(s), rad_solver_unshot_ratio(s), o.sf, L.error, t4 - t3);
             printf("shot messages %lld (%lld bytes), full notices %lld\n", (long long)sm, (long long)sb,

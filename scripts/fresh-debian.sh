@@ -8,8 +8,9 @@
 # usage: scripts/fresh-debian.sh [--keep] [DIR] [demo|test]...
 #   DIR     where the system goes (default: a new temporary folder, removed afterwards
 #           unless --keep; an existing DIR with a system in it is reused as it is)
-# Needs root, debootstrap (scripts/setup.sh does not install it: apt-get install
-# debootstrap) and Debian's mirror (VW_DEBIAN_MIRROR, default http://deb.debian.org/debian).
+# Needs root (it installs debootstrap when missing: scripts/setup.sh fresh) and Debian's
+# mirror (VW_DEBIAN_MIRROR, default http://deb.debian.org/debian). Exit status 77 when
+# the system cannot be made (no mirror, no chroot): nothing was tested.
 set -euo pipefail
 ROOT=$(cd "$(dirname "$0")/.." && pwd)
 keep=0
@@ -22,8 +23,7 @@ for c in "${cmds[@]}"; do
   case "$c" in demo|test) ;; *) echo "fresh-debian.sh: unknown command '$c' (demo, test)" >&2; exit 2 ;; esac
 done
 [ "$(id -u)" = 0 ] || { echo "fresh-debian.sh: needs root (debootstrap, chroot, mounts)" >&2; exit 2; }
-command -v debootstrap > /dev/null ||
-  { echo "fresh-debian.sh: needs debootstrap (apt-get install debootstrap)" >&2; exit 2; }
+"$ROOT/scripts/setup.sh" fresh || exit 77
 
 made=0
 if [ -z "$dir" ]; then dir=$(mktemp -d "${TMPDIR:-/tmp}/vwalls-debian.XXXXXX"); made=1; fi
@@ -31,7 +31,14 @@ mounted=()
 cleanup() {
   local i
   for ((i = ${#mounted[@]} - 1; i >= 0; i--)); do umount -l "${mounted[$i]}" 2>/dev/null || true; done
-  if [ "$made" = 1 ] && [ "$keep" = 0 ]; then rm -rf "$dir"; fi
+  if [ "$made" = 1 ] && [ "$keep" = 0 ]; then
+    # Never through a mount that is still there: the host's /dev is bound into it.
+    if grep -q " $dir/" /proc/mounts; then
+      echo "fresh-debian.sh: $dir still has mounts; left in place" >&2
+    else
+      rm -rf --one-file-system "$dir"
+    fi
+  fi
 }
 trap cleanup EXIT
 
@@ -41,7 +48,7 @@ if [ ! -x "$dir/bin/bash" ]; then
   echo "fresh-debian: debootstrap --variant=minbase bookworm into $dir" >&2
   debootstrap --variant=minbase bookworm "$dir" "${VW_DEBIAN_MIRROR:-http://deb.debian.org/debian}" \
     > "$dir.debootstrap.log" 2>&1 ||
-    { tail -n 20 "$dir.debootstrap.log" >&2; echo "fresh-debian.sh: debootstrap failed" >&2; exit 1; }
+    { tail -n 20 "$dir.debootstrap.log" >&2; echo "fresh-debian.sh: debootstrap failed" >&2; exit 77; }
   rm -f "$dir.debootstrap.log"
   # What an installed system has and debootstrap leaves out: without /etc/hosts every
   # mpirun waits seconds for the host name to resolve.
@@ -56,8 +63,13 @@ for tool in gcc cc make cmake git; do
   fi
 done
 
-for m in proc sys dev dev/pts; do mount --bind "/$m" "$dir/$m"; mounted+=("$dir/$m"); done
-mount -t tmpfs tmpfs "$dir/run"; mounted+=("$dir/run")
+cannot_mount() { echo "fresh-debian.sh: cannot mount $1 in $dir (no privilege here?)" >&2; exit 77; }
+for m in proc sys dev dev/pts; do
+  mount --bind "/$m" "$dir/$m" || cannot_mount "/$m"
+  mounted+=("$dir/$m")
+done
+mount -t tmpfs tmpfs "$dir/run" || cannot_mount /run
+mounted+=("$dir/run")
 
 if [ ! -d "$dir/root/vwalls/main" ]; then
   mkdir -p "$dir/root/vwalls"

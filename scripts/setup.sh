@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # setup.sh - installs the Debian packages vwalls needs, and only those missing.
 # Idempotent: a second run installs nothing and does not touch the network.
-# usage: scripts/setup.sh [build|bench|fuzz|mpich]...   (default: build)
+# usage: scripts/setup.sh [build|bench|fuzz|mpich|docs|fresh]...   (default: build)
 set -euo pipefail
 
 want=()
@@ -14,7 +14,8 @@ for what in "${@:-build}"; do
     fuzz)  want+=(clang libclang-rt-14-dev) ;;
     mpich) want+=(libmpich-dev mpich) ;;
     docs)  want+=(doxygen) ;;
-    *) echo "setup.sh: unknown package set '$what' (build, bench, fuzz, mpich, docs)" >&2; exit 2 ;;
+    fresh) want+=(debootstrap git) ;;   # scripts/fresh-debian.sh
+    *) echo "setup.sh: unknown package set '$what' (build, bench, fuzz, mpich, docs, fresh)" >&2; exit 2 ;;
   esac
 done
 

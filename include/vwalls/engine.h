@@ -72,8 +72,8 @@ VW_API void vw_engine_broadcast(void *buf, size_t n);
    workers: workers when positive; otherwise one per core (vw_host_cores), and under MPI
    each process's share of its host's cores (processes on one host that may run on the
    same cores split them), the fewest of any process, which every process of the world
-   then runs (global worker = rank * W + local). So a tool can size per-worker options (speeds) before the world exists, the
-   same on every host. Collective under MPI: every rank must call it. */
+   then runs (global worker = rank * W + local). So a tool can size per-worker options
+   (speeds) before the world exists, the same on every host. Collective under MPI: every rank must call it. */
 VW_API int vw_engine_workers(int workers);
 /* What this host gives the process (not collective). vw_host_cores: the cores it may
    run on, the default worker count: its CPU affinity (taskset, a container's cpuset, an

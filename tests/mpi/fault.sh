@@ -16,7 +16,7 @@ hang) args="--hang-rank 1" rank=1 ;;
 esac
 . "$(dirname "$0")/must_fail.sh"
 # shellcheck disable=SC2086
-base_ms=$(launcher_ms $launch "$prog" --seeds 0)
+base_ms=$(startup_ms $launch "$prog" --seeds 0)
 if [ "$mode" = hang ]; then
     export MPIEXEC_TIMEOUT=$((4 + (base_ms + 999) / 1000))
     # shellcheck disable=SC2086

@@ -8,7 +8,7 @@
 step=$1 np=$2 prog=$3 launch=$4
 . "$(dirname "$0")/must_fail.sh"
 # shellcheck disable=SC2086
-base_ms=$(launcher_ms $launch "$prog" --seeds 0)
+base_ms=$(startup_ms $launch "$prog" --seeds 0)
 # shellcheck disable=SC2086
 must_fail "local_fail.sh: $step" 20 30 $launch "$prog" --workers 2 --fail "$step" --fail-rank 1
 r=0

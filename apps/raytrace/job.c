@@ -193,7 +193,7 @@ vw_config rt_job_config(const rt_params *p)
    records, the world box and the decomposition, and the Embree device. Each process
    does it on its own copy of the scene, so it can fail on one process only; the caller
    agrees on the outcome before the world (collective) is made. */
-static vw_status job_prepare(rt_job *j, const vw_scene *s, const rt_params *p, const vw_config *cfg,
+static vw_status job_prepare(rt_job *j, const vw_scene *s, const rt_params *p, int threads,
                              char *err, size_t errlen)
 {
     rt_shared *sh = &j->sh;
@@ -304,7 +304,7 @@ static vw_status job_prepare(rt_job *j, const vw_scene *s, const rt_params *p, c
         return st;
     }
     /* Embree's threads: the process's workers (before the world that would say it). */
-    sh->device = rt_device_new(cfg->workers > 0 ? cfg->workers : vw_host_cores());
+    sh->device = rt_device_new(threads);
     sh->geo_cache = sh->device ? rt_geo_cache_new(&sh->ff) : NULL;
     if (!sh->device || !sh->geo_cache) {
         snprintf(err, errlen, "cannot create the Embree device");
@@ -349,7 +349,11 @@ vw_status rt_job_create(const vw_scene *s, const rt_params *p, rt_job **out, cha
         atomic_init(&j->sh.entries, 0);
         atomic_init(&j->sh.rays, 0);
     }
-    vw_status st = j ? job_prepare(j, s, p, &cfg, err, errlen) : VW_E_NOMEM;
+    /* Embree's threads: the workers the world will run, its default under MPI included
+       (a share of the host's cores). Collective, so every process asks before anything
+       can fail on one alone. */
+    int threads = vw_engine_workers(cfg.workers);
+    vw_status st = j ? job_prepare(j, s, p, threads, err, errlen) : VW_E_NOMEM;
     if (st != VW_OK && errlen && !err[0]) snprintf(err, errlen, "%s", vw_status_message(st));
     /* What failed on one process alone fails on all (with the lowest failing rank's
        message), before the world: the others would otherwise wait for it there. */

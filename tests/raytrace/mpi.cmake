@@ -18,10 +18,10 @@ endif()
 # np; cells; workers; farm (copies of cells: none, on idle workers and processes
 # (1 cell on 2 processes), on every worker); a check below: "quarter" (speeds 1,3, no
 # turns taken: the shares follow the speeds across processes) or "stolen" (process 1
-# slowed 8x, equal shares: process 0 takes process 1's turns); more flags, '|' between.
+# slowed 100x, equal shares: process 0 takes process 1's turns); more flags, '|' between.
 foreach(case "2;2x2x2;1;none" "2;4x1x2;2;none" "3;2x2;1;none" "2;1;1;idle" "3;1;2;idle"
              "2;2x2x2;2;all" "2;1;1;idle;quarter;--speeds|1,3|--steal|off"
-             "2;1;1;idle;stolen;--slow|1:8|--speeds|1,1|--steal|on|--size|160x120")
+             "2;1;1;idle;stolen;--slow|1:100|--speeds|1,1|--steal|on|--size|160x120")
   list(GET case 0 np)
   list(GET case 1 cells)
   list(GET case 2 workers)
@@ -78,9 +78,12 @@ foreach(case "2;2x2x2;1;none" "2;4x1x2;2;none" "3;2x2;1;none" "2;1;1;idle" "3;1;
       message(FATAL_ERROR "${flags}: turns taken across processes (${t0}, ${t1}) with --steal off")
     endif()
   elseif(check STREQUAL "stolen")
-    # Equal shares, process 1 eight times slower: process 0, done with its half, takes
-    # process 1's turns by asking (0.73-0.76 of the eye rays measured; exactly half
-    # without: the share).
+    # Equal shares, process 1 100 times slower: process 0, done with its half, takes
+    # process 1's turns by asking (exactly half without: the share). How many depends on
+    # how the machine's load shares the cores between the processes: with 8x, 0.75-0.83
+    # on a quiet machine but 0.50-0.89 with one or two busy loops beside (0.63 missed 13
+    # times in 24, once with no turn taken at all); with 100x, 0.81-0.98 under that load
+    # (11 runs).
     math(EXPR lo "${all} * 63 / 100")
     if(p0 LESS lo)
       message(FATAL_ERROR "${flags}: process 0 made only ${p0} of ${all} eye rays: no turns "

@@ -51,7 +51,7 @@ if [ ! -x "$dir/bin/bash" ]; then
     { tail -n 20 "$dir.debootstrap.log" >&2; echo "fresh-debian.sh: debootstrap failed" >&2; exit 77; }
   rm -f "$dir.debootstrap.log"
   # What an installed system has and debootstrap leaves out: without /etc/hosts every
-  # mpirun waits seconds for the host name to resolve.
+  # MPI process waits seconds in MPI_Init for the host name to resolve.
   printf '127.0.0.1\tlocalhost\n127.0.1.1\t%s\n' "$(hostname)" > "$dir/etc/hosts"
   cp /etc/resolv.conf "$dir/etc/resolv.conf"
 fi

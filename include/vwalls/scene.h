@@ -40,6 +40,7 @@ typedef struct vw_camera {
     double hither;      /* near distance */
     int width, height;  /* resolution */
     int valid;          /* 1 when the scene file gave a camera */
+    int resolution_line; /* the file's line of 'resolution' (0: none), for messages */
 } vw_camera;
 
 typedef enum vw_prim_kind {
@@ -48,19 +49,22 @@ typedef enum vw_prim_kind {
     VW_PRIM_POLYGON = 2     /* planar polygon, >= 3 vertices (NFF p/pp, OBJ f) */
 } vw_prim_kind;
 
+/* An object's `line` is the line of the file that gave it (OBJ: its face's), so that a
+   problem found after parsing can still be reported as file:line; 0 when it came from no
+   file (vw_gen, a program). */
 typedef struct vw_sphere {
-    int id, material;
+    int id, material, line;
     double center[3], radius;      /* never 0; negative means "inside visible" (NFF) */
 } vw_sphere;
 
 typedef struct vw_cone {
-    int id, material;
+    int id, material, line;
     double base[3], base_radius;   /* a negative radius means "inside visible" (NFF) */
     double apex[3], apex_radius;
 } vw_cone;
 
 typedef struct vw_polygon {
-    int id, material;
+    int id, material, line;
     int first;        /* index into vw_scene.indices of the first vertex index */
     int count;        /* number of vertices, >= 3 */
     int has_normals;  /* 1 for NFF pp / OBJ with vn: normals[first..first+count) valid */

@@ -47,6 +47,7 @@ typedef struct vw__sb {
     size_t cap_lights, cap_materials, cap_spheres, cap_cones, cap_polygons;
     size_t cap_vertices, cap_indices;
     int next_id;
+    int line;                /* the reader's: the line of the object being added */
     size_t poly_first;       /* first index of the polygon being built */
     int *mat_hash;           /* open addressing over material indices, -1 empty */
     size_t mat_hash_cap;

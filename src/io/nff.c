@@ -240,6 +240,7 @@ static void begin(nff *P, const char *entity, int line)
 {
     P->entity = entity;
     P->entity_line = line;
+    P->b.line = line;
 }
 
 /* ---- entities ----------------------------------------------------------------- */
@@ -286,6 +287,7 @@ static vw_status parse_view(nff *P)
                 st = fail(P, t.line, "hither must not be negative");
         } else if (tok_is(&t, "resolution")) {
             begin(P, "resolution", t.line);
+            cam->resolution_line = t.line;
             st = read_int(P, "resolution", 0, 1L << 20, &cam->width);
             if (st == VW_OK)
                 st = read_int(P, "resolution", 0, 1L << 20, &cam->height);

@@ -570,6 +570,7 @@ static vw_status parse_face(obj *O, span *line)
     char sb[48];
     span t;
     int n = 0, all_normals = 1;
+    O->b.line = O->line; /* the statement's first line */
     vw__sb_polygon_begin(&O->b);
     while (next_tok(O, line, &t)) {
         /* v, v/vt, v//vn or v/vt/vn */

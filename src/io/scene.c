@@ -302,6 +302,7 @@ vw_status vw__sb_add_sphere(vw__sb *b, int material, const double c[3], double r
     if (st != VW_OK)
         return st;
     sp->material = material;
+    sp->line = b->line;
     memcpy(sp->center, c, sizeof sp->center);
     sp->radius = r;
     s->nspheres++;
@@ -319,6 +320,7 @@ vw_status vw__sb_add_cone(vw__sb *b, int material, const double base[3], double 
     if (st != VW_OK)
         return st;
     c->material = material;
+    c->line = b->line;
     memcpy(c->base, base, sizeof c->base);
     c->base_radius = base_r;
     memcpy(c->apex, apex, sizeof c->apex);
@@ -393,6 +395,7 @@ vw_status vw__sb_polygon_end(vw__sb *b, int material, int has_normals)
     if (st != VW_OK)
         return st;
     p->material = material;
+    p->line = b->line;
     p->first = (int)b->poly_first;
     p->count = (int)count;
     p->has_normals = has_normals && s->normals ? 1 : 0;

@@ -294,6 +294,21 @@ int main(int argc, char **argv)
         vw_scene_free(a);
     }
 
+    /* Each object keeps the line it began on (the statement's keyword), however the
+       tokens fall on lines, and the camera its 'resolution' line: messages found after
+       parsing (the radiosity mesher's, a size the ray tracer refuses) name them. */
+    {
+        vw_scene *a = read_text("lines.nff", VIEW "s 0 0 0 1\np 3 0 0 0 1 0 0 0 1 0 p 3\n0 0 0\n"
+                                                  "1 0 0\n0 1 0\nc 0 0 0 1\n0 0 1 1\n");
+        CHECK(a->nspheres == 1 && a->npolygons == 2 && a->ncones == 1);
+        CHECK_EQ_INT(a->camera.resolution_line, 1);
+        CHECK_EQ_INT(a->spheres[0].line, 2);
+        CHECK_EQ_INT(a->polygons[0].line, 3);
+        CHECK_EQ_INT(a->polygons[1].line, 3);
+        CHECK_EQ_INT(a->cones[0].line, 7);
+        vw_scene_free(a);
+    }
+
     /* A negative sphere radius is NFF's "only the inside is visible": kept, bounded by
        its size, and written back as it was read. */
     {
@@ -331,6 +346,8 @@ int main(int argc, char **argv)
         char *w = nff_string(a, NULL);
         CHECK(w != NULL);
         vw_scene *b = read_text("bare2.nff", w);
+        CHECK(a->camera.resolution_line == 0 && b->camera.resolution_line == 8);
+        b->camera.resolution_line = 0; /* the writer gives it a line of its own */
         CHECK(memcmp(&a->camera, &b->camera, sizeof a->camera) == 0);
         vw_scene_free(b);
         free(w);

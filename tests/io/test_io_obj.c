@@ -285,6 +285,12 @@ int main(int argc, char **argv)
     CHECK_EQ_INT(vw_scene_read_obj("m.obj", t, strlen(t), NULL, &n, err, sizeof err), VW_OK);
     CHECK_EQ_INT(n->nmaterials, 1);
     CHECK(n->materials[0].diffuse[0] == 0.8f);
+    CHECK_EQ_INT(n->polygons[0].line, 6);
+    vw_scene_free(n);
+    /* A face keeps its statement's first line, continued or not. */
+    t = "v 0 0 0\nv 1 0 0\nv 0 1 0\n\nf 1 2 \\\n 3\nf 1 2 3\n";
+    CHECK_EQ_INT(vw_scene_read_obj("m.obj", t, strlen(t), NULL, &n, err, sizeof err), VW_OK);
+    CHECK(n->npolygons == 2 && n->polygons[0].line == 5 && n->polygons[1].line == 7);
     vw_scene_free(n);
     /* With one, a missing library and a name it would have defined are warnings, once
        each (common OBJ tools read such a mesh; it used to be refused), and the faces

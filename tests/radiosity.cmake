@@ -40,3 +40,17 @@ if(VW_HAVE_MPI)
                          ENVIRONMENT "${VW_MPI_ENV}" PROCESSORS 2)
   endforeach()
 endif()
+
+# The stopping rule compares patches, whatever the walls cut them into: the same share
+# of the emitted power is left unshot on 1, 2x2x2 and 6x6x6 cells.
+add_test(NAME radiosity_stopping
+         COMMAND sh ${PROJECT_SOURCE_DIR}/tests/radiosity/stopping.sh $<TARGET_FILE:vwalls_tool>
+                 ${CMAKE_CURRENT_BINARY_DIR}/radiosity_stopping $<TARGET_FILE:test_radiosity>)
+set_tests_properties(radiosity_stopping PROPERTIES LABELS "radiosity;threads" TIMEOUT 60)
+
+# Spheres and cones as facets, PLY without emission, mesh warnings' lines, a huge
+# --patch-size, and --view on a tiny scene and near vertical.
+add_test(NAME radiosity_input
+         COMMAND sh ${PROJECT_SOURCE_DIR}/tests/radiosity/input.sh $<TARGET_FILE:vwalls_tool>
+                 ${CMAKE_CURRENT_BINARY_DIR}/radiosity_input $<TARGET_FILE:test_radiosity>)
+set_tests_properties(radiosity_input PROPERTIES LABELS "radiosity;threads" TIMEOUT 60)

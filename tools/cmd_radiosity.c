@@ -19,22 +19,26 @@ static const char *const CMD = "radiosity";
 
 static void help(void)
 {
-    printf("usage: vwalls radiosity SCENE.(obj|nff|ply) -o OUT.ply [options]\n"
+    printf("usage: vwalls radiosity SCENE.(obj|nff) -o OUT.ply [options]\n"
            "\n"
            "Progressive refinement radiosity, distributed over cells: every cell shoots its\n"
            "patch of largest unshot power; a shot travels from cell to cell as a hemicube\n"
            "coverage bitmap, front to back from the shooter, never as geometry.\n"
            "Emission comes from MTL 'Ke' (NFF: '#vw Ke r g b' after an 'f'), reflectance\n"
-           "from 'Kd' (NFF: colour * Kd). At least one output: -o, --csv, --image, --stats,\n"
-           "--trace or --checkpoint.\n"
+           "from 'Kd' (NFF: colour * Kd). PLY has no emission, so a PLY scene has no light:\n"
+           "convert it to OBJ+MTL or NFF and give it one. Spheres and cones are meshed as\n"
+           "fixed facets (a sphere 16 x 8, a cone 16 around). At least one output: -o,\n"
+           "--csv, --image, --stats, --trace or --checkpoint.\n"
            "  -o FILE.ply          vertex-coloured mesh of the solution\n"
            "  --cells L            layout of cells, like 2x2x2 (default: 1 on one worker, else\n"
            "                       at least 4 cells a worker: 2x2x2 for 2 workers)\n"
            "  --workers W          worker threads per process (default: the cores it may run\n"
            "                       on)\n"
-           "  --sf X               stop when max unshot power / emitted < X (default 1e-3)\n"
+           "  --sf X               stop when the largest unshot power of a patch / emitted\n"
+           "                       < X (default 1e-3), whatever the walls cut the patches into\n"
            "  --hemicube RES       hemicube resolution, even, <= %d (default 64)\n"
-           "  --patch-size S       largest patch side (default: scene extent / 10)\n"
+           "  --patch-size S       largest patch side (default: scene extent / 10); a side\n"
+           "                       above a polygon's size makes it one patch and one element\n"
            "  --elements K         receiver elements per patch side (default 2), about 300\n"
            "                       bytes each: a solve that needs more memory than the\n"
            "                       host has left is refused before it starts\n"
@@ -52,7 +56,8 @@ static void help(void)
            "                       mapped) or .pfm (float: radiosity, not tone mapped)\n"
            "  --view F,A[,FOV]     camera: from x,y,z, at x,y,z, vertical angle (degrees,\n"
            "                       above 0 and below 180, default 45); +y up (+z for a\n"
-           "                       vertical view)\n"
+           "                       view within 1 degree of vertical); near plane 1e-3 of the\n"
+           "                       distance or of the scene's size, the smaller\n"
            "  --size WxH           picture size (default: the camera's, or 512x512)\n"
            "  --snapshot-every N   rewrite the outputs every N shots while solving\n"
            "  --stats FILE.json    stats JSON (radiosity: shots, unshot_ratio, energy_error)\n"
@@ -157,8 +162,9 @@ static const char *json_number(double x, char buf[32])
     return buf;
 }
 
-/* --view fx,fy,fz,ax,ay,az[,fov]: the camera, +y up (+z when the view is vertical);
-   -1 after the message when it gives no view. */
+/* --view fx,fy,fz,ax,ay,az[,fov]: the camera, +y up (+z when the view is within a
+   degree of vertical); -1 after the message when it gives no view. Its near plane is
+   set once the scene is read (view_hither). */
 static int parse_view(const char *v, vw_camera *cam)
 {
     double x[7];
@@ -171,15 +177,36 @@ static int parse_view(const char *v, vw_camera *cam)
                      "degrees)", cam->angle);
         return -1;
     }
-    int vertical = cam->from[0] == cam->at[0] && cam->from[2] == cam->at[2];
+    /* Not only an exactly vertical view: +y up for a view some 1e-10 radians off
+       vertical made the picture's right +z or -x as the tilt fell, a quarter turn
+       from the exactly vertical view's for a change in the last digits of 'at'. Within
+       a degree the picture turns with the tilt no more (any one up must flip
+       somewhere; a degree off vertical is where a user tilts on purpose). */
+    double d[3] = {cam->at[0] - cam->from[0], cam->at[1] - cam->from[1], cam->at[2] - cam->from[2]};
+    double len = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+    int vertical = len > 0 && fabs(d[1]) >= 0.99984769515639124 * len; /* cos 1 degree */
     cam->up[0] = 0, cam->up[1] = vertical ? 0 : 1, cam->up[2] = vertical ? 1 : 0;
-    cam->hither = 1e-3;
     const char *problem = vw_camera_problem(cam);
     if (problem) {
         vw_cli_error(CMD, "--view: %s", problem);
         return -1;
     }
     return 0;
+}
+
+/* The near plane of a --view: a thousandth of the distance looked across or of the
+   scene's size, whichever is less, as the default camera's (vw_scene_default_camera).
+   It was 1e-3 absolute, and a scene 5.6e-5 across lay wholly in front of it, black. */
+static double view_hither(const vw_camera *cam, const vw_scene *sc)
+{
+    double lo[3], hi[3], size = 0, dist = 0;
+    vw_scene_bounds(sc, lo, hi);
+    for (int k = 0; k < 3; k++) {
+        size += (hi[k] - lo[k]) * (hi[k] - lo[k]);
+        dist += (cam->at[k] - cam->from[k]) * (cam->at[k] - cam->from[k]);
+    }
+    size = sqrt(size), dist = sqrt(dist);
+    return 1e-3 * (size > 0 && size < dist ? size : dist);
 }
 
 /* The elements' memory, known once the scene is meshed, against what this host has
@@ -417,9 +444,10 @@ int vw_cmd_radiosity(int argc, char **argv)
     r.scene = sc;
     r.mesh = &mesh;
     r.sf = o.sf;
-    if (view)
+    if (view) {
         r.cam = cam_view;
-    else if (sc->camera.valid)
+        r.cam.hither = view_hither(&cam_view, sc);
+    } else if (sc->camera.valid)
         r.cam = sc->camera;
     else
         vw_scene_default_camera(sc, &r.cam);

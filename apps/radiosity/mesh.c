@@ -1,6 +1,7 @@
 /* mesh.c - meshing for the radiosity solver: polygons are cut into patches (the shooters)
  * along a square grid in each polygon's own frame, and the patches are clipped at the
- * walls (Sutherland-Hodgman against the planes of the cell boxes) into pieces.
+ * walls (Sutherland-Hodgman against the planes of the cell boxes) into pieces. Spheres
+ * and cones become polygons first: a fixed set of facets each (add_curved).
  *
  * A piece is kept only by the cell vw_decomp_locate() gives for its centroid with the
  * piece normal as direction, so a piece lying in a wall plane is kept once, by the cell
@@ -180,8 +181,13 @@ int rad_elem_polygon(const rad_piece *pc, int level, int gi, int gj, rad_poly *o
        as it was scaled or moved. A sliver wins no pixel, so its radiosity stays 0, and
        subdivision split its neighbours for differing from it. Squares covering no more
        than 1e-9 of themselves are no elements: rounding stays below that while the
-       coordinates are under about 1e6 element sides. */
-    if (out->n >= 3 && !(rad_poly_area(out, NULL, NULL) > 1e-9 * h * h)) out->n = 0;
+       coordinates are under about 1e6 element sides. But only when they are also at
+       most a millionth of their piece: a piece far smaller than an element square
+       (a small polygon under a large --patch-size) is no sliver, and dropping it left
+       it without elements (--patch-size 1e30 kept no element at all, not even the
+       emitter's). A rounding sliver is some 1e-13 of the piece wide. */
+    double a = out->n >= 3 ? rad_poly_area(out, NULL, NULL) : 0;
+    if (out->n >= 3 && !(a > 1e-9 * h * h) && !(a > 1e-6 * pc->area)) out->n = 0;
     return out->n;
 }
 
@@ -206,49 +212,20 @@ double rad_default_patch_size(const vw_scene *s)
     return ext > 0 ? ext / 10 : 1;
 }
 
-/* The line of the k-th polygon statement of a scene file (OBJ "f", NFF "p"/"pp"), so
-   that geometry errors found after parsing can still be reported as file:line. 0 when
-   it cannot be told. The format follows the name, as vw_scene_read_file decides it: in
-   NFF an "f" line is a material, not a polygon, and counting it named the wrong line
-   (the Cornell box's red wall, line 57, was reported at line 44). */
-static int polygon_line(const char *path, size_t k)
+/* Where polygon pg (the k-th) of the meshed scene came from: file:line as its reader
+   recorded it, a facet's from its sphere or cone (the first nfile are the file's
+   polygons), or its index when no file gave it (a generated scene). */
+static void where(char *out, size_t len, const char *path, const vw_polygon *pg, size_t k,
+                  size_t nfile, const rad_mesh *m)
 {
-    size_t plen = path ? strlen(path) : 0;
-    int nff = plen >= 4 && !strcasecmp(path + plen - 4, ".nff");
-    FILE *f = path ? fopen(path, "r") : NULL;
-    if (!f) return 0;
-    char buf[4096];
-    int line = 0, found = 0;
-    size_t count = 0;
-    while (fgets(buf, sizeof buf, f)) {
-        line++;
-        const char *p = buf;
-        while (*p == ' ' || *p == '\t') p++;
-        int is_poly;
-        if (nff) {
-            const char *q = p[0] == 'p' ? p + 1 + (p[1] == 'p') : NULL; /* after "p", "pp" */
-            is_poly = q && (!*q || *q == ' ' || *q == '\t' || *q == '\n' || *q == '\r');
-        } else {
-            is_poly = p[0] == 'f' && (p[1] == ' ' || p[1] == '\t');
-        }
-        size_t n = strlen(buf);
-        while (n == sizeof buf - 1 && buf[n - 1] != '\n' && fgets(buf, sizeof buf, f)) n = strlen(buf);
-        if (is_poly && count++ == k) {
-            found = line;
-            break;
-        }
-    }
-    fclose(f);
-    return found;
-}
-
-static void where(char *out, size_t len, const char *path, size_t k)
-{
-    int line = polygon_line(path, k);
-    if (line > 0)
-        snprintf(out, len, "%s:%d", path ? path : "scene", line);
-    else
-        snprintf(out, len, "%s: polygon %zu", path ? path : "scene", k);
+    const char *name = path ? path : "scene";
+    int n = pg->line > 0 ? snprintf(out, len, "%s:%d", name, pg->line) : snprintf(out, len, "%s", name);
+    if (n < 0 || (size_t)n >= len) return;
+    if (k >= nfile)
+        snprintf(out + n, len - (size_t)n, ": object %d (a sphere or cone, as facets)",
+                 m->facet_object[pg->id - m->facet_base]);
+    else if (pg->line <= 0)
+        snprintf(out + n, len - (size_t)n, ": polygon %zu", k);
 }
 
 static int push_piece(rad_mesh *m, size_t *cap, const rad_piece *pc, int owner)
@@ -294,7 +271,8 @@ static vw_status mesh_polygon(rad_mesh *m, size_t *cap, const vw_decomp *d, cons
         for (int j = (int)floor(vmin / S); j <= (int)floor(vmax / S); j++) {
             rad_poly patch, piece;
             clip_rect(poly, origin, ua, va, i * S, (i + 1) * S, j * S, (j + 1) * S, &patch);
-            if (patch.n < 3 || rad_poly_area(&patch, NULL, NULL) <= tiny) continue;
+            double patch_area;
+            if (patch.n < 3 || (patch_area = rad_poly_area(&patch, NULL, NULL)) <= tiny) continue;
             vw_box pb = {{INFINITY, INFINITY, INFINITY}, {-INFINITY, -INFINITY, -INFINITY}};
             for (int k = 0; k < patch.n; k++)
                 for (int a = 0; a < 3; a++) {
@@ -318,6 +296,11 @@ static vw_status mesh_polygon(rad_mesh *m, size_t *cap, const vw_decomp *d, cons
                 memcpy(pc.normal, normal, sizeof pc.normal);
                 memcpy(pc.centroid, cen, sizeof cen);
                 pc.area = area;
+                /* An uncut patch is its one piece: clip_box leaves its vertices as they
+                   are, so both areas are the same number and a one-cell run shoots as it
+                   did before. fmax: a cut piece is never larger than its patch, rounding
+                   aside. */
+                pc.patch_area = fmax(patch_area, area);
                 memcpy(pc.origin, origin, sizeof pc.origin);
                 memcpy(pc.uax, ua, sizeof pc.uax);
                 memcpy(pc.vax, va, sizeof pc.vax);
@@ -491,10 +474,196 @@ static vw_status mesh_concave(rad_mesh *m, size_t *cap, const vw_decomp *d, cons
     return st;
 }
 
+/* ---- spheres and cones, as facets ---- */
+
+/* The fixed subdivision of spheres and cones: a sphere is RAD_SPHERE_LON x
+   RAD_SPHERE_LAT facets between meridians and parallels (triangles at the poles, planar
+   trapezoids between), a cone RAD_SPHERE_LON trapezoids around its axis (no caps, as
+   NFF's). Corners lie on the surface, so the facets are inscribed: a sphere's area is
+   96.8 % of the true one, a cylinder's 99.4 %. Fixed, so that a scene meshes the same
+   on every process and in every run, whatever --patch-size; a facet larger than a
+   patch is cut into patches as any polygon. */
+#define RAD_SPHERE_LON 16
+#define RAD_SPHERE_LAT 8
+
+typedef struct facet_sink {
+    vw_scene *t;        /* the scene being extended */
+    size_t capv, capi, capp;
+    rad_mesh *m;
+    size_t capf;
+    int line; /* of the sphere or cone being cut into facets */
+} facet_sink;
+
+/* Appends the polygon v[0..n) as a facet of object obj (material mat), its winding
+   turned so that its normal points along out (away from the surface's inside). */
+static int add_facet(facet_sink *k, const double (*v)[3], int n, const double out[3], int obj, int mat)
+{
+    vw_scene *t = k->t;
+    double nw[3];
+    vw_polygon_normal(v, n, nw);
+    int flip = rad_dot(nw, out) < 0;
+    if (t->nvertices + (size_t)n > k->capv) {
+        size_t c = 2 * (t->nvertices + (size_t)n) + 64;
+        double (*q)[3] = realloc(t->vertices, sizeof *q * c);
+        if (!q) return -1;
+        t->vertices = q, k->capv = c;
+    }
+    if (t->nindices + (size_t)n > k->capi) {
+        size_t c = 2 * (t->nindices + (size_t)n) + 64;
+        int *q = realloc(t->indices, sizeof *q * c);
+        if (!q) return -1;
+        t->indices = q, k->capi = c;
+    }
+    if (t->npolygons + 1 > k->capp) {
+        size_t c = 2 * t->npolygons + 64;
+        vw_polygon *q = realloc(t->polygons, sizeof *q * c);
+        if (!q) return -1;
+        t->polygons = q, k->capp = c;
+    }
+    if (k->m->nfacets + 1 > k->capf) {
+        size_t c = 2 * k->m->nfacets + 64;
+        int32_t *q = realloc(k->m->facet_object, sizeof *q * c);
+        if (!q) return -1;
+        k->m->facet_object = q, k->capf = c;
+    }
+    vw_polygon *pg = &t->polygons[t->npolygons++];
+    memset(pg, 0, sizeof *pg);
+    pg->id = k->m->facet_base + (int)k->m->nfacets;
+    pg->material = mat;
+    pg->line = k->line;
+    pg->first = (int)t->nindices;
+    pg->count = n;
+    for (int i = 0; i < n; i++) {
+        memcpy(t->vertices[t->nvertices], v[flip ? n - 1 - i : i], sizeof v[0]);
+        t->indices[t->nindices++] = (int)t->nvertices++;
+    }
+    k->m->facet_object[k->m->nfacets++] = obj;
+    return 0;
+}
+
+/* Two unit vectors perpendicular to w and to each other. */
+static void perp_frame(const double w[3], double u[3], double v[3])
+{
+    double a[3] = {fabs(w[0]) < 0.9 ? 1 : 0, fabs(w[0]) < 0.9 ? 0 : 1, 0};
+    rad_cross(w, a, u);
+    rad_normalize(u);
+    rad_cross(w, u, v);
+}
+
+/* The scene t: s's polygons followed by the facets of its spheres and cones, ids from
+   m->facet_base on (m->facet_object maps them back). t's arrays are its own (free them
+   with free_facets), its other fields s's. Degenerate facets (a cone's apex) are left
+   to the mesher, which skips zero areas. */
+static vw_status add_curved(const vw_scene *s, vw_scene *t, rad_mesh *m)
+{
+    *t = *s;
+    t->normals = NULL; /* the mesher reads none; the new corners have none */
+    t->polygons = NULL, t->vertices = NULL, t->indices = NULL;
+    facet_sink k = {t, 0, 0, 0, m, 0, 0};
+    size_t nv = s->nvertices, ni = s->nindices, np = s->npolygons;
+    t->vertices = malloc(sizeof *t->vertices * (nv + 1));
+    t->indices = malloc(sizeof *t->indices * (ni + 1));
+    t->polygons = malloc(sizeof *t->polygons * (np + 1));
+    if (!t->vertices || !t->indices || !t->polygons) return VW_E_NOMEM;
+    if (nv) memcpy(t->vertices, s->vertices, sizeof *t->vertices * nv);
+    if (ni) memcpy(t->indices, s->indices, sizeof *t->indices * ni);
+    if (np) memcpy(t->polygons, s->polygons, sizeof *t->polygons * np);
+    k.capv = nv + 1, k.capi = ni + 1, k.capp = np + 1;
+    int base = 0;
+    for (size_t i = 0; i < np; i++) base = s->polygons[i].id >= base ? s->polygons[i].id + 1 : base;
+    for (size_t i = 0; i < s->nspheres; i++) base = s->spheres[i].id >= base ? s->spheres[i].id + 1 : base;
+    for (size_t i = 0; i < s->ncones; i++) base = s->cones[i].id >= base ? s->cones[i].id + 1 : base;
+    m->facet_base = base;
+    const double pi = 3.14159265358979323846;
+    for (size_t i = 0; i < s->nspheres; i++) {
+        const vw_sphere *sp = &s->spheres[i];
+        k.line = sp->line;
+        double r = fabs(sp->radius), sign = sp->radius < 0 ? -1 : 1; /* negative: seen from inside */
+        for (int a = 0; a < RAD_SPHERE_LAT; a++)
+            for (int b = 0; b < RAD_SPHERE_LON; b++) {
+                double q[4][3], th[2] = {pi * a / RAD_SPHERE_LAT, pi * (a + 1) / RAD_SPHERE_LAT};
+                double ph[2] = {2 * pi * b / RAD_SPHERE_LON, 2 * pi * (b + 1) / RAD_SPHERE_LON};
+                static const int corner[4][2] = {{0, 0}, {0, 1}, {1, 1}, {1, 0}};
+                int n = 0;
+                for (int c = 0; c < 4; c++) {
+                    double t0 = th[corner[c][0]], p0 = ph[corner[c][1]];
+                    double x[3] = {sp->center[0] + r * sin(t0) * cos(p0), sp->center[1] + r * cos(t0),
+                                   sp->center[2] + r * sin(t0) * sin(p0)};
+                    /* A pole is one corner, not two. */
+                    if ((a == 0 && c == 1) || (a == RAD_SPHERE_LAT - 1 && c == 3)) continue;
+                    memcpy(q[n++], x, sizeof x);
+                }
+                double cen[3] = {0, 0, 0}, out[3];
+                for (int c = 0; c < n; c++)
+                    for (int j = 0; j < 3; j++) cen[j] += q[c][j] / n;
+                for (int j = 0; j < 3; j++) out[j] = sign * (cen[j] - sp->center[j]);
+                if (add_facet(&k, (const double (*)[3])q, n, out, sp->id, sp->material)) return VW_E_NOMEM;
+            }
+    }
+    for (size_t i = 0; i < s->ncones; i++) {
+        const vw_cone *cn = &s->cones[i];
+        k.line = cn->line;
+        double w[3], u[3], v[3];
+        rad_sub(cn->apex, cn->base, w);
+        if (!rad_normalize(w)) continue; /* no axis: nothing to mesh */
+        perp_frame(w, u, v);
+        double rb = fabs(cn->base_radius), ra = fabs(cn->apex_radius);
+        double sign = cn->base_radius < 0 || cn->apex_radius < 0 ? -1 : 1;
+        for (int b = 0; b < RAD_SPHERE_LON; b++) {
+            double q[4][3], ph[2] = {2 * pi * b / RAD_SPHERE_LON, 2 * pi * (b + 1) / RAD_SPHERE_LON};
+            int n = 0;
+            for (int c = 0; c < 4; c++) {
+                int top = c >= 2, side = c == 1 || c == 2;
+                double rr = top ? ra : rb, p0 = ph[side];
+                if (rr == 0 && (c == 1 || c == 2)) continue; /* a point end: a triangle */
+                for (int j = 0; j < 3; j++)
+                    q[n][j] = (top ? cn->apex[j] : cn->base[j]) + rr * (cos(p0) * u[j] + sin(p0) * v[j]);
+                n++;
+            }
+            double pm = 0.5 * (ph[0] + ph[1]), out[3];
+            for (int j = 0; j < 3; j++) out[j] = sign * (cos(pm) * u[j] + sin(pm) * v[j]);
+            if (n >= 3 && add_facet(&k, (const double (*)[3])q, n, out, cn->id, cn->material)) return VW_E_NOMEM;
+        }
+    }
+    return VW_OK;
+}
+
+static void free_facets(vw_scene *t)
+{
+    free(t->vertices), free(t->indices), free(t->polygons);
+}
+
+static int is_ply(const char *path)
+{
+    size_t n = path ? strlen(path) : 0;
+    return n >= 4 && !strcasecmp(path + n - 4, ".ply");
+}
+
 vw_status rad_mesh_build(const vw_scene *s, const char *path, const vw_decomp *d,
                          const rad_options *o, rad_mesh *m, char *err, size_t errlen)
 {
     memset(m, 0, sizeof *m);
+    /* From here on s is the scene with its spheres and cones as facets (after its own
+       polygons, so that polygon k < s0->npolygons is the file's k-th). */
+    const vw_scene *s0 = s;
+    /* Refused before the facets are made: 66430 spheres would be 8.5 million facets
+       (a gigabyte of corners) before the patch count below refused them. */
+    double nfacets = (double)s->nspheres * RAD_SPHERE_LON * RAD_SPHERE_LAT + (double)s->ncones * RAD_SPHERE_LON;
+    if (nfacets > RAD_MAX_SQUARES) {
+        snprintf(err, errlen,
+                 "%s: %zu spheres and %zu cones are %.0f facets (%d a sphere, %d a cone), more "
+                 "than the %d patches radiosity meshes", path ? path : "scene", s->nspheres,
+                 s->ncones, nfacets, RAD_SPHERE_LON * RAD_SPHERE_LAT, RAD_SPHERE_LON, RAD_MAX_SQUARES);
+        return VW_E_LIMIT;
+    }
+    vw_scene aug;
+    if (add_curved(s0, &aug, m) != VW_OK) {
+        free_facets(&aug);
+        rad_mesh_free(m);
+        snprintf(err, errlen, "%s: out of memory while meshing", path ? path : "scene");
+        return VW_E_NOMEM;
+    }
+    s = &aug;
     size_t cap = 0;
     double S = o->patch_size > 0 ? o->patch_size : rad_default_patch_size(s);
     double elem = S / (o->elem_split > 0 ? o->elem_split : 1);
@@ -505,7 +674,11 @@ vw_status rad_mesh_build(const vw_scene *s, const char *path, const vw_decomp *d
     double tiny = 1e-14 * diag * diag;
     int ncells = vw_decomp_cell_count(d);
     int *cells = malloc(sizeof(int) * (size_t)ncells);
-    if (!cells) return VW_E_NOMEM;
+    if (!cells) {
+        free_facets(&aug);
+        rad_mesh_free(m);
+        return VW_E_NOMEM;
+    }
     vw_status st = VW_OK;
     int max_id = -1;
     double squares = 0; /* of the patch grid over every polygon so far */
@@ -535,8 +708,8 @@ vw_status rad_mesh_build(const vw_scene *s, const char *path, const vw_decomp *d
         double area = 0.5 * rad_norm(nw), normal[3] = {nw[0], nw[1], nw[2]};
         char at[512];
         if (!(area > tiny) || !rad_normalize(normal)) {
-            if (!o->quiet) {
-                where(at, sizeof at, path, k);
+            if (!o->quiet && k < s0->npolygons) { /* a facet: a cone's point end */
+                where(at, sizeof at, path, pg, k, s0->npolygons, m);
                 fprintf(stderr, "%s: warning: zero-area polygon (id %d) skipped\n", at, pg->id);
             }
             free(flat);
@@ -553,12 +726,12 @@ vw_status rad_mesh_build(const vw_scene *s, const char *path, const vw_decomp *d
             if (fabs(rad_dot(q, normal)) > off) off = fabs(rad_dot(q, normal)), worst = i;
         }
         if (off > 0.05 * size) {
-            where(at, sizeof at, path, k);
+            where(at, sizeof at, path, pg, k, s0->npolygons, m);
             snprintf(err, errlen, "%s: polygon (id %d) is not planar (vertex %d is %.3g off its plane)", at,
                      pg->id, worst + 1, off);
             st = VW_E_INPUT;
         } else if (off > 1e-3 * size && !o->quiet) {
-            where(at, sizeof at, path, k);
+            where(at, sizeof at, path, pg, k, s0->npolygons, m);
             fprintf(stderr, "%s: warning: polygon (id %d) is not planar (%.3g off), flattened\n", at, pg->id, off);
         }
         if (st != VW_OK) {
@@ -603,7 +776,7 @@ vw_status rad_mesh_build(const vw_scene *s, const char *path, const vw_decomp *d
             break;
         }
         if (crossed) {
-            where(at, sizeof at, path, k);
+            where(at, sizeof at, path, pg, k, s0->npolygons, m);
             snprintf(err, errlen,
                      "%s: polygon (id %d) crosses itself (its edges from corners %d and %d): "
                      "radiosity takes simple polygons only; split it",
@@ -637,11 +810,13 @@ vw_status rad_mesh_build(const vw_scene *s, const char *path, const vw_decomp *d
         const vw_polygon *pg = &s->polygons[first_clamped];
         const vw_material *mat = &s->materials[pg->material];
         char at[512];
-        where(at, sizeof at, path, first_clamped);
+        where(at, sizeof at, path, pg, first_clamped, s0->npolygons, m);
+        int facet = first_clamped >= s0->npolygons;
         fprintf(stderr,
-                "%s: warning: reflectance %g %g %g of polygon (id %d) is outside [0, 1], clamped "
+                "%s: warning: reflectance %g %g %g of %s (id %d) is outside [0, 1], clamped "
                 "(%zu polygon%s in all); the solver and the CSV use the clamped values\n",
-                at, mat->diffuse[0], mat->diffuse[1], mat->diffuse[2], pg->id, nclamped,
+                at, mat->diffuse[0], mat->diffuse[1], mat->diffuse[2], facet ? "object" : "polygon",
+                facet ? (int)m->facet_object[pg->id - m->facet_base] : pg->id, nclamped,
                 nclamped == 1 ? "" : "s");
     }
     if (st == VW_E_NOMEM) snprintf(err, errlen, "%s: out of memory while meshing", path ? path : "scene");
@@ -650,14 +825,16 @@ vw_status rad_mesh_build(const vw_scene *s, const char *path, const vw_decomp *d
                  "%s: patch size %g is too small for this scene: more than %d patch squares "
                  "(the default is %g)", path ? path : "scene", S, RAD_MAX_SQUARES,
                  rad_default_patch_size(s));
+    free_facets(&aug);
     if (st == VW_OK && m->npieces == 0) {
-        snprintf(err, errlen, "%s: no polygon to mesh (radiosity needs polygons)", path ? path : "scene");
+        snprintf(err, errlen, "%s: no polygon to mesh (radiosity needs polygons, spheres or cones)",
+                 path ? path : "scene");
         st = VW_E_INPUT;
     }
     if (st == VW_OK && !(rad_sum3(m->emitted) > 0)) {
         snprintf(err, errlen,
-                 "%s: no emitter: give some material an emission (MTL 'Ke r g b', NFF '#vw Ke r g b')",
-                 path ? path : "scene");
+                 "%s: no emitter: give some material an emission (MTL 'Ke r g b', NFF '#vw Ke r g b'%s)",
+                 path ? path : "scene", is_ply(path) ? "; PLY has no emission: convert the scene to OBJ+MTL or NFF" : "");
         st = VW_E_INPUT;
     }
     if (st != VW_OK) rad_mesh_free(m);
@@ -669,5 +846,6 @@ void rad_mesh_free(rad_mesh *m)
     if (!m) return;
     free(m->pieces);
     free(m->owner);
+    free(m->facet_object);
     memset(m, 0, sizeof *m);
 }

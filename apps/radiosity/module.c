@@ -34,7 +34,23 @@ typedef struct rad_patch {
     rad_piece pc;
     double unshot[3];
     int64_t nshots;
+    double scale;        /* pc.patch_area / pc.area: 1 for a patch no wall cuts */
 } rad_patch;
+
+/* The unshot power (r+g+b) of the whole patch piece pt is part of, as far as this cell
+   can tell: the piece's unshot power per area times the patch's area. The stopping
+   rule and the choice of shooter use it, so that they are about patches, as the
+   design says, whatever the walls cut: compared piece by piece, a patch cut into k
+   pieces held 1/k of its power in each, fell below --sf sooner, and the Cornell box
+   stopped with 23 % of the emitted power unshot on one cell but 32 % on 6x6x6. Why it
+   is safe: the patch's unshot power is the sum over its pieces of density times area,
+   which is at most the largest piece density times the patch area, so when no piece's
+   estimate is above the threshold no patch is. It is exact for an uncut patch (scale
+   1), so a one-cell run is what it was. */
+static double patch_unshot(const rad_patch *pt)
+{
+    return rad_sum3(pt->unshot) * pt->scale;
+}
 
 typedef struct rad_elem {
     int patch;
@@ -414,6 +430,7 @@ static vw_status cell_build(vw_ctx *ctx, const void *objects, size_t n, void **s
         rad_patch *pt = &c->patches[c->npatches++];
         memset(pt, 0, sizeof *pt);
         pt->pc = pcs[i];
+        pt->scale = pcs[i].patch_area > pcs[i].area ? pcs[i].patch_area / pcs[i].area : 1;
         for (int k = 0; k < 3; k++) pt->unshot[k] = pcs[i].emit[k] * pcs[i].area;
     }
     for (int p = 0; p < c->npatches; p++) {
@@ -524,7 +541,7 @@ static void report(vw_ctx *ctx, rad_cell *c, int round)
     r.cell = c->cell;
     r.nshots = c->nshots;
     for (int p = 0; p < c->npatches; p++) {
-        double u = rad_sum3(c->patches[p].unshot);
+        double u = patch_unshot(&c->patches[p]);
         if (u > r.max_unshot) r.max_unshot = u;
         for (int k = 0; k < 3; k++) r.unshot[k] += c->patches[p].unshot[k];
     }
@@ -1067,7 +1084,7 @@ static int step(vw_ctx *ctx, void *state)
     int best = -1;
     double bu = c->thr;
     for (int p = 0; p < c->npatches; p++) {
-        double u = rad_sum3(c->patches[p].unshot);
+        double u = patch_unshot(&c->patches[p]);
         if (u > bu) bu = u, best = p;
     }
     if (best < 0) {

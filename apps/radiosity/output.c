@@ -328,6 +328,28 @@ vw_status rad_write_csv(const char *path, const rad_mesh *m, const vw_scene *sc,
                   B[pg->id][2]);
         area[pg->id] = 0; /* once per polygon */
     }
+    /* Spheres and cones, each summed over its facets (their ids are the mesh's own). */
+    size_t nobj = m->nfacets ? (size_t)m->facet_base : 0;
+    double *oa = calloc(nobj ? nobj : 1, sizeof *oa), (*oB)[3] = calloc(nobj ? nobj : 1, sizeof *oB);
+    if (!oa || !oB) b.oom = 1;
+    for (size_t j = 0; oa && oB && j < m->nfacets; j++) {
+        size_t id = (size_t)m->facet_base + j;
+        int32_t obj = m->facet_object[j];
+        if (id >= np || obj < 0 || (size_t)obj >= nobj) continue;
+        oa[obj] += area[id];
+        for (int k = 0; k < 3; k++) oB[obj][k] += B[id][k] * area[id];
+    }
+    for (size_t k = 0; oa && oB && k < sc->nspheres + sc->ncones; k++) {
+        int id = k < sc->nspheres ? sc->spheres[k].id : sc->cones[k - sc->nspheres].id;
+        int mi = k < sc->nspheres ? sc->spheres[k].material : sc->cones[k - sc->nspheres].material;
+        if (id < 0 || (size_t)id >= nobj || oa[id] <= 0) continue;
+        const vw_material *mt = mi >= 0 && (size_t)mi < sc->nmaterials ? &sc->materials[mi] : NULL;
+        double rho[3], emit[3];
+        rad_material(mt, rho, emit);
+        sb_printf(&b, "%d,%.9g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.9g,%.9g,%.9g\n", id, oa[id], rho[0], rho[1],
+                  rho[2], emit[0], emit[1], emit[2], oB[id][0] / oa[id], oB[id][1] / oa[id], oB[id][2] / oa[id]);
+    }
+    free(oa), free(oB);
     free(area), free(B), free(inc);
     vw_status st = b.oom ? VW_E_NOMEM : vw_outfile_write(path, b.s, b.n, err, errlen);
     free(b.s);

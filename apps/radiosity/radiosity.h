@@ -41,6 +41,10 @@ typedef struct rad_piece {
     int32_t pi, pj;         /* patch grid index in the polygon's (u,v) frame */
     double v[RAD_MAXV][3];
     double normal[3], centroid[3], area;
+    /* The area of the whole patch (the polygon clipped to square (pi, pj)) this piece is
+       part of: the stopping rule is about patches, whatever the walls cut (module.c,
+       patch_unshot). Equals area when no wall cuts the patch. */
+    double patch_area;
     double origin[3], uax[3], vax[3];  /* the polygon's frame: elements align to it */
     double elem;            /* level-0 receiver element size */
     double rho[3], emit[3]; /* reflectance; emitted radiosity (power per area) */
@@ -77,9 +81,16 @@ typedef struct rad_mesh {
     double emitted[3];      /* total emitted power */
     double area;            /* total area */
     double patch_size;      /* the patch side used (--patch-size or the scene's default) */
+    /* Spheres and cones are meshed as facets (mesh.c, RAD_SPHERE_LON): polygon ids from
+       facet_base on, facet_object[id - facet_base] the scene id of the sphere or cone
+       (the CSV reports that object, summed over its facets). */
+    int32_t facet_base;
+    size_t nfacets;
+    int32_t *facet_object;
 } rad_mesh;
 
-/* Splits every polygon into patches and clips them at the cells of d. Bad geometry is
+/* Splits every polygon, and the facets of every sphere and cone, into patches and clips
+   them at the cells of d. Bad geometry is
    reported as "file:line: message" in err (VW_E_INPUT); zero-area polygons are skipped
    with a warning on stderr (unless quiet). A scene without emitter is an error. */
 vw_status rad_mesh_build(const vw_scene *s, const char *path, const vw_decomp *d,

@@ -47,7 +47,7 @@ typedef struct rad_collect_msg {
 typedef struct rad_report_msg {
     int32_t round, cell;
     int64_t nshots;
-    double max_unshot;
+    double max_unshot;   /* the largest patch_unshot (module.c) of the cell's pieces */
     double unshot[3], absorbed[3], shot[3], won[3];
 } rad_report_msg;
 

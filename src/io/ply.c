@@ -11,7 +11,8 @@
  * camera and no lights: the commands' defaults apply, as for OBJ.
  * Errors are "file:line: message": the header's line, an ASCII value's line, and for
  * binary data the line of end_header with the element, the record and the byte offset
- * in the message.
+ * in the message. An ASCII record is one line (a value more or less is that line's
+ * error), and non-blank ASCII data after the last element is an error.
  */
 #include <float.h>
 #include <math.h>
@@ -50,6 +51,7 @@ typedef struct ply {
     const unsigned char *p, *end; /* what is left to read */
     int line;                     /* of the next header line or ASCII value */
     int last_line;                /* of the last ASCII value read */
+    int rec_line;                 /* ASCII: the line of the record being read, 0 between */
     int format;
     elem *elems;
     int nelems;
@@ -255,6 +257,18 @@ static vw_status value(ply *P, enum ptype t, const char *what, double *out)
             while (P->p < P->end && (*P->p == ' ' || *P->p == '\t'))
                 P->p++;
             if (P->p < P->end && (*P->p == '\n' || *P->p == '\r')) {
+                /* A record is one line: read on, its missing values were taken from
+                   the next record, which was blamed (or none was, and the vertices
+                   were wrong). At the end of the file the record is one the file
+                   ends inside, as before. */
+                const unsigned char *q = P->p;
+                while (P->rec_line && q < P->end && (*q == ' ' || *q == '\t' || *q == '\n' || *q == '\r'))
+                    q++;
+                if (P->rec_line && q < P->end) {
+                    P->line = P->rec_line;
+                    return fail(P, "%s: its line ends before its last value (an ASCII record "
+                                "is one line)", what);
+                }
                 if (*P->p == '\r' && P->p + 1 < P->end && P->p[1] == '\n')
                     P->p++;
                 P->p++;
@@ -269,6 +283,8 @@ static vw_status value(ply *P, enum ptype t, const char *what, double *out)
             return fail(P, "the file ends inside %s", what);
         }
         P->last_line = P->line;
+        if (!P->rec_line)
+            P->rec_line = P->line;
         const char *s = (const char *)P->p;
         while (P->p < P->end && *P->p != ' ' && *P->p != '\t' && *P->p != '\n' && *P->p != '\r')
             P->p++;
@@ -343,13 +359,24 @@ static vw_status list_length(ply *P, const prop *pr, const char *what, double *n
 /* A list item handed over by read_record. */
 typedef vw_status (*item_fn)(ply *P, void *arg, double x, const char *what);
 
+/* Spaces and tabs, then the end of the line or of the file? */
+static int rest_of_line_blank(ply *P)
+{
+    while (P->p < P->end && (*P->p == ' ' || *P->p == '\t'))
+        P->p++;
+    return P->p >= P->end || *P->p == '\n' || *P->p == '\r';
+}
+
 /* One record of element e: its scalars into vals (NULL: read past), the items of list
-   `keep` to fn, every other list read past. */
+   `keep` to fn, every other list read past. In ASCII a record is one line, as the format
+   has it and every writer writes it: a value more or less is that line's error, not one
+   found records later on another line. */
 static vw_status read_record(ply *P, const elem *e, const char *what, double *vals, int keep,
                              item_fn fn, void *arg)
 {
     vw_status st = VW_OK;
     double x;
+    P->rec_line = 0;
     for (int i = 0; i < e->nprops && st == VW_OK; i++) {
         const prop *pr = &e->props[i];
         if (pr->count == T_NONE) {
@@ -362,6 +389,12 @@ static vw_status read_record(ply *P, const elem *e, const char *what, double *va
             if ((st = value(P, pr->type, what, &x)) == VW_OK && i == keep)
                 st = fn(P, arg, x, what);
     }
+    if (st == VW_OK && P->format == F_ASCII && P->rec_line && !rest_of_line_blank(P)) {
+        P->line = P->rec_line;
+        st = fail(P, "%s: more values on its line than its properties (an ASCII record is one "
+                  "line)", what);
+    }
+    P->rec_line = 0;
     return st;
 }
 
@@ -515,6 +548,7 @@ static vw_status read_faces(ply *P, const elem *e, int seen_vertices)
         face_acc acc = {0, {0, 0, 0}};
         vw__sb_polygon_begin(&P->b);
         st = read_record(P, e, what, vals, list, face_corner, &acc);
+        P->b.line = P->format == F_ASCII ? P->last_line : 0; /* an ASCII record is a line */
         if (st == VW_OK && acc.corners < 3)
             st = fail(P, "%s: a polygon needs at least 3 vertices, it has %d", what, acc.corners);
         if (st != VW_OK)
@@ -575,6 +609,21 @@ static vw_status parse_ply(ply *P)
     }
     if (st == VW_OK && !seen_vertices)
         return fail(P, "no element vertex");
+    /* Data after the last element is a header that says less than the file holds (a
+       count too small, an element left out): the scene read would be part of it. */
+    while (st == VW_OK && P->format == F_ASCII && P->p < P->end) {
+        if (rest_of_line_blank(P)) {
+            if (P->p >= P->end)
+                break;
+            if (*P->p == '\r' && P->p + 1 < P->end && P->p[1] == '\n')
+                P->p++;
+            P->p++;
+            P->line++;
+            continue;
+        }
+        return fail(P, "data after the last element (the header's counts say less than the "
+                    "file holds)");
+    }
     return st;
 }
 

@@ -97,6 +97,10 @@ int main(void)
     CHECK(vw_scene_fingerprint(sa) == vw_scene_fingerprint(sle));
     CHECK(vw_scene_fingerprint(sa) == vw_scene_fingerprint(sbe));
     CHECK(vw_scene_fingerprint(sa) == vw_scene_fingerprint(scr));
+    /* A face keeps its record's line in ASCII (after 10 header lines and 5 vertices),
+       none in binary. */
+    CHECK(sa->polygons[0].line == 16 && sa->polygons[4].line == 20 && scr->polygons[4].line == 20);
+    CHECK(sle->polygons[0].line == 0 && sbe->polygons[4].line == 0);
     /* ... and the same as an OBJ of it (0.8 grey, as an OBJ face without a material) */
     const char *objt = "v -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\nv 0 0 1.5\n"
                        "f 1 2 3 4\nf 1 2 5\nf 2 3 5\nf 3 4 5\nf 4 1 5\n";

@@ -905,6 +905,46 @@ static int t_csvcmp(const char *a, const char *b, double tol)
     return 0;
 }
 
+/* The pixels of a .pfm picture (width x height x 3 floats, little endian, as
+   rad_write_image writes it); NULL when it is not one. */
+static float *read_pfm(const char *path, int *w, int *h)
+{
+    FILE *f = fopen(path, "rb");
+    float *px = NULL;
+    double scale;
+    if (f && fscanf(f, "PF %d %d %lf", w, h, &scale) == 3 && fgetc(f) == '\n' && *w > 0 && *h > 0 &&
+        (px = malloc(sizeof *px * 3 * (size_t)*w * (size_t)*h)) &&
+        fread(px, sizeof *px, 3 * (size_t)*w * (size_t)*h, f) != 3 * (size_t)*w * (size_t)*h) {
+        free(px);
+        px = NULL;
+    }
+    if (f) fclose(f);
+    return px;
+}
+
+/* pfmcmp A B MINLIT TOL: A has at least MINLIT of its pixels lit (some channel above 0),
+   and B differs from it by at most TOL (mean absolute difference over mean value). */
+static int t_pfmcmp(const char *a, const char *b, double minlit, double tol)
+{
+    int wa, ha, wb, hb;
+    float *x = read_pfm(a, &wa, &ha), *y = read_pfm(b, &wb, &hb);
+    CHECK(x && y);
+    CHECK_EQ_INT(wa, wb);
+    CHECK_EQ_INT(ha, hb);
+    size_t n = (size_t)wa * (size_t)ha, lit = 0;
+    double diff = 0, sum = 0;
+    for (size_t i = 0; i < n; i++) {
+        lit += x[3 * i] > 0 || x[3 * i + 1] > 0 || x[3 * i + 2] > 0;
+        for (int k = 0; k < 3; k++) diff += fabs(x[3 * i + k] - y[3 * i + k]), sum += fabs(x[3 * i + k]);
+    }
+    double rel = sum > 0 ? diff / sum : 0;
+    printf("%s: %.3f of the pixels lit; %s differs by %.4f (relative)\n", a, (double)lit / n, b, rel);
+    free(x), free(y);
+    CHECK((double)lit / n >= minlit);
+    CHECK(rel <= tol);
+    return 0;
+}
+
 int main(int argc, char **argv)
 {
     if (argc < 2) {
@@ -927,6 +967,7 @@ int main(int argc, char **argv)
         return t_reference_file(argv[2], argv[3], atof(argv[4]), atoi(argv[5]), atoi(argv[6]));
     if (!strcmp(t, "gen") && argc == 4) return t_gen(argv[2], argv[3]);
     if (!strcmp(t, "csvcmp") && argc == 5) return t_csvcmp(argv[2], argv[3], atof(argv[4]));
+    if (!strcmp(t, "pfmcmp") && argc == 6) return t_pfmcmp(argv[2], argv[3], atof(argv[4]), atof(argv[5]));
     fprintf(stderr, "unknown test '%s'\n", t);
     return 2;
 }

@@ -43,7 +43,7 @@ add_test(NAME io_triangulate COMMAND test_io_triangulate)
 
 # The command's output files and its help texts (each script says what it checks; a
 # few seconds).
-foreach(t outputs help)
+foreach(t outputs help args)
   add_test(NAME io_cli_${t}
            COMMAND sh ${PROJECT_SOURCE_DIR}/tests/io/cli_${t}.sh $<TARGET_FILE:vwalls_tool>
                    ${CMAKE_CURRENT_BINARY_DIR}/io_cli_${t})

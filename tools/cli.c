@@ -54,11 +54,21 @@ int vw_cli_int(const char *cmd, const char *opt, const char *s, long lo, long hi
     return 0;
 }
 
+/* strtod, with errno 0 for a number too small to hold, which it rounds to a
+   denormal or to zero ("1e-320"): that is a fine value, not an error. An overflow
+   keeps its ERANGE. */
+static double cli_strtod(const char *s, char **end)
+{
+    errno = 0;
+    double v = strtod(s, end);
+    if (errno == ERANGE && fabs(v) <= DBL_MIN) errno = 0;
+    return v;
+}
+
 int vw_cli_double(const char *cmd, const char *opt, const char *s, double lo, double hi, double *out)
 {
     char *end;
-    errno = 0;
-    double v = strtod(s ? s : "", &end);
+    double v = cli_strtod(s ? s : "", &end);
     if (!s || !*s || *end || errno || !isfinite(v) || v < lo || v > hi) {
         vw_cli_error(cmd, "%s: bad value '%s' (expected a number from %g to %g)", opt, s ? s : "",
                      lo, hi);
@@ -76,8 +86,7 @@ int vw_cli_fov_ok(double deg)
 int vw_cli_angle(const char *cmd, const char *opt, const char *s, double *out)
 {
     char *end;
-    errno = 0;
-    double v = strtod(s ? s : "", &end);
+    double v = cli_strtod(s ? s : "", &end);
     if (!s || !*s || *end || errno || !vw_cli_fov_ok(v)) {
         vw_cli_error(cmd, "%s: bad value '%s' (expected degrees above 0 and below 180)", opt,
                      s ? s : "");
@@ -94,8 +103,7 @@ int vw_cli_numbers(const char *cmd, const char *opt, const char *s, const char *
     const char *p = s ? s : "";
     for (;;) {
         char *end;
-        errno = 0;
-        double v = strtod(p, &end);
+        double v = cli_strtod(p, &end);
         if (end == p || errno || !(fabs(v) <= FLT_MAX) || k == max) break;
         out[k++] = v;
         if (!*end) {
@@ -179,10 +187,12 @@ const char *vw_cli_value(const char *cmd, int argc, char **argv, int *i)
         vw_cli_error(cmd, "%s needs a value", argv[*i]);
         return NULL;
     }
-    /* "--stats --quiet" forgot the value: writing a file named --quiet would hide it.
-       (A value may start with one '-': a negative number, or "-" for stdout.) */
+    /* "--stats --quiet" or "--stats -q" forgot the value: writing a file named --quiet
+       would hide it. (A value may start with one '-': a negative number.) -o, -q and
+       -h are every short option of every command. */
     const char *v = argv[*i + 1];
-    if (v[0] == '-' && v[1] == '-' && v[2]) {
+    if ((v[0] == '-' && v[1] == '-' && v[2]) || !strcmp(v, "-o") || !strcmp(v, "-q") ||
+        !strcmp(v, "-h")) {
         vw_cli_error(cmd, "%s needs a value, not the option '%s'", argv[*i], v);
         return NULL;
     }
@@ -196,7 +206,23 @@ const char *vw_cli_output(const char *cmd, int argc, char **argv, int *i)
         vw_cli_error(cmd, "%s: empty file name", argv[*i - 1]);
         return NULL;
     }
+    /* Not standard output: the outputs are written whole, then renamed into place, and
+       "-" made a file of that name. /dev/stdout writes there. */
+    if (v && !strcmp(v, "-")) {
+        vw_cli_error(cmd, "%s -: standard output is not an output here (name a file, or "
+                          "/dev/stdout)", argv[*i - 1]);
+        return NULL;
+    }
     return v;
+}
+
+int vw_cli_named(const char *cmd, const char *opt, const char *path)
+{
+    const char *slash = strrchr(path, '/'), *base = slash ? slash + 1 : path;
+    if (base[0] != '.' || !base[1] || strchr(base + 1, '.')) return 0;
+    vw_cli_error(cmd, "%s %s: no file name before the ending '%s' (the file would be hidden "
+                      "and nameless, like x%s without the x)", opt, path, base, base);
+    return -1;
 }
 
 int vw_cli_scene_output(const char *cmd, const char *opt, const char *path, const char *ext,
@@ -204,10 +230,23 @@ int vw_cli_scene_output(const char *cmd, const char *opt, const char *path, cons
 {
     size_t n = strlen(path), m = strlen(ext);
     struct stat sb;
+    if (vw_cli_named(cmd, opt, path)) return -1;
     if ((n > m && !strcasecmp(path + n - m, ext)) || (stat(path, &sb) == 0 && !S_ISREG(sb.st_mode)))
         return 0;
     vw_cli_error(cmd, "%s %s: written as %s, which vwalls reads only from a name ending in %s",
                  opt, path, format, ext);
+    return -1;
+}
+
+int vw_cli_scene_size(const char *path, const vw_camera *cam, int width)
+{
+    if (width > 0 || (cam->width <= 16384 && cam->height <= 16384)) return 0;
+    char where[64] = "";
+    if (cam->resolution_line > 0) snprintf(where, sizeof where, ":%d", cam->resolution_line);
+    if (vw_cli_is_output())
+        fprintf(stderr, "%s%s: resolution %dx%d too large for the ray tracer (at most 16384 on "
+                        "a side): give --size WxH to draw another size\n", path, where,
+                cam->width, cam->height);
     return -1;
 }
 
@@ -342,15 +381,102 @@ static int check_writable(const char *opt, const char *path, char *err, size_t e
     return -1;
 }
 
-int vw_cli_check_outputs(const char *cmd, const char *const *opts, const char *const *paths, int n)
+/* Which file a name stands for: an existing file by its device and inode (a hard
+   link, a symbolic link, "./x" and "x" are one file), a new one by its directory's
+   resolved path and its own name. A device or a FIFO (/dev/null, /dev/stdout) is
+   nobody's data: exempt (0). 1 when *id is filled in, 0 also when out of memory. */
+typedef struct file_id {
+    dev_t dev;
+    ino_t ino;
+    char *path; /* a new file's resolved name, malloc'ed; NULL for an existing one */
+} file_id;
+
+static int file_identify(const char *name, file_id *id)
+{
+    struct stat st;
+    id->path = NULL;
+    /* /dev/stdout leads to whatever standard output is, a file too: named twice, it is
+       the user's choice of one stream. (/dev/shm holds plain files.) */
+    if (!strncmp(name, "/dev/", 5) && strncmp(name, "/dev/shm/", 9)) return 0;
+    if (stat(name, &st) == 0) {
+        if (!S_ISREG(st.st_mode)) return 0;
+        id->dev = st.st_dev, id->ino = st.st_ino;
+        return 1;
+    }
+    const char *slash = strrchr(name, '/');
+    char *dir = slash ? strndup(name, slash == name ? 1 : (size_t)(slash - name)) : strdup(".");
+    char *real = dir ? realpath(dir, NULL) : NULL;
+    size_t len = (real ? strlen(real) : strlen(name)) + strlen(name) + 2;
+    id->path = malloc(len);
+    if (id->path && real)
+        snprintf(id->path, len, "%s/%s", real, slash ? slash + 1 : name);
+    else if (id->path) /* (its directory is missing: the name as given) */
+        snprintf(id->path, len, "%s", name);
+    free(dir), free(real);
+    return id->path != NULL;
+}
+
+static int file_same(const file_id *a, const file_id *b)
+{
+    if (a->path || b->path) return a->path && b->path && !strcmp(a->path, b->path);
+    return a->dev == b->dev && a->ino == b->ino;
+}
+
+/* Does an output name an input, or the same file as another output? 0, or -1 with
+   the message in err (-2: out of memory). Either destroyed data without a word: the
+   image replaced by the stats, the scene by the CSV. */
+static int check_distinct(const char *const *inputs, const char *const *opts,
+                          const char *const *paths, int n, char *err, size_t errlen)
+{
+    int ni = 0, bad = 0;
+    while (inputs && inputs[ni]) ni++;
+    file_id *in = calloc((size_t)ni + 1, sizeof *in), *out = calloc((size_t)n + 1, sizeof *out);
+    int *in_ok = calloc((size_t)ni + 1, sizeof *in_ok);
+    int *out_ok = calloc((size_t)n + 1, sizeof *out_ok);
+    if (!in || !out || !in_ok || !out_ok) {
+        snprintf(err, errlen, "out of memory");
+        bad = -2;
+    }
+    for (int k = 0; !bad && k < ni; k++) in_ok[k] = file_identify(inputs[k], &in[k]);
+    for (int k = 0; !bad && k < n; k++) {
+        if (!paths[k] || !(out_ok[k] = file_identify(paths[k], &out[k]))) continue;
+        for (int j = 0; !bad && j < ni; j++)
+            if (in_ok[j] && file_same(&out[k], &in[j])) {
+                snprintf(err, errlen, "%s %s: is the input file %s: it would be overwritten",
+                         opts[k], paths[k], inputs[j]);
+                bad = -1;
+            }
+        for (int j = 0; !bad && j < k; j++)
+            if (out_ok[j] && file_same(&out[k], &out[j])) {
+                snprintf(err, errlen, "%s %s: the same file as %s %s: one would overwrite the "
+                         "other", opts[k], paths[k], opts[j], paths[j]);
+                bad = -1;
+            }
+    }
+    for (int k = 0; in && k < ni; k++) free(in[k].path);
+    for (int k = 0; out && k < n; k++) free(out[k].path);
+    free(in), free(out), free(in_ok), free(out_ok);
+    return bad;
+}
+
+int vw_cli_check_files(const char *cmd, const char *const *inputs, const char *const *opts,
+                       const char *const *paths, int n)
 {
     char err[1024] = "";
     vw_status st = VW_OK;
+    int distinct = vw_cli_is_output() ? check_distinct(inputs, opts, paths, n, err, sizeof err) : 0;
+    if (distinct) st = distinct == -2 ? VW_E_NOMEM : VW_E_INPUT;
     for (int k = 0; k < n && st == VW_OK && vw_cli_is_output(); k++)
         if (paths[k] && check_writable(opts[k], paths[k], err, sizeof err)) st = VW_E_IO;
-    if (vw_engine_agree(st, err, sizeof err) == VW_OK) return VW_EXIT_OK;
+    st = vw_engine_agree(st, err, sizeof err);
+    if (st == VW_OK) return VW_EXIT_OK;
     if (vw_cli_is_output()) vw_cli_error(cmd, "%s", err);
-    return VW_EXIT_FAIL;
+    return st == VW_E_INPUT ? VW_EXIT_USAGE : VW_EXIT_FAIL;
+}
+
+int vw_cli_check_outputs(const char *cmd, const char *const *opts, const char *const *paths, int n)
+{
+    return vw_cli_check_files(cmd, NULL, opts, paths, n);
 }
 
 /* Rank 0's n values (collective; a copy to free). */

@@ -45,12 +45,24 @@ const char *vw_cli_value(const char *cmd, int argc, char **argv, int *i);
    when the file is written. */
 const char *vw_cli_output(const char *cmd, int argc, char **argv, int *i);
 
+/* An output whose kind its name's ending chooses (-o x.png) must have a name before
+   the ending: 0, or for ".png" or "dir/.png" "vwalls CMD: OPT PATH: no file name before
+   the ending '.png' ..." and -1. */
+int vw_cli_named(const char *cmd, const char *opt, const char *path);
+
 /* An output that vwalls reads back as a scene (gen -o: NFF, radiosity -o: PLY), which
    it recognises by the name's ending: 0 when path ends in ext (".nff", any case) or is
    a device or a FIFO (not read back by name), else "vwalls CMD: OPT PATH: written as
-   FORMAT, which vwalls reads only from a name ending in EXT" and -1. */
+   FORMAT, which vwalls reads only from a name ending in EXT" and -1 (and -1 from
+   vw_cli_named for a name that is nothing but the ending). */
 int vw_cli_scene_output(const char *cmd, const char *opt, const char *path, const char *ext,
                         const char *format);
+
+/* The image size the ray tracer would take from the scene file's camera (path, as
+   read into cam) when no --size was given (width 0): 0 when it is at most 16384 on a
+   side, else -1 and "FILE:LINE: resolution WxH too large for the ray tracer (...): give
+   --size WxH ..." (the line of the file's 'resolution', as the reader recorded it). */
+int vw_cli_scene_size(const char *path, const vw_camera *cam, int width);
 
 /* Fault injection for tests: is name one of the comma-separated words of the
    environment variable VW_FAULT (e.g. VW_FAULT=ledger: vwalls radiosity takes its
@@ -64,8 +76,18 @@ int vw_cli_fault(const char *name);
    computed and then lost, or half of the outputs written; the writes at the end still
    report their own errors (a full disk, a directory removed meanwhile). VW_EXIT_OK, or
    VW_EXIT_FAIL on every process with "vwalls CMD: OPT PATH: cannot write: DIR: why"
-   printed once. Collective under MPI. */
+   printed once; VW_EXIT_USAGE when two of them are one file (vw_cli_check_files).
+   Collective under MPI. */
 int vw_cli_check_outputs(const char *cmd, const char *const *opts, const char *const *paths, int n);
+/* vw_cli_check_outputs, which calls it with no inputs, and first: no output is one of
+   the inputs (the files the command reads, a NULL-terminated list; NULL: none) and no
+   two outputs are the same file (compared by device and inode when the file exists, by
+   the resolved name when it does not; devices and FIFOs, /dev/null or /dev/stdout, are
+   exempt). Such a pair is VW_EXIT_USAGE, with "vwalls CMD: OPT PATH: is the input file
+   IN: it would be overwritten" or "OPT PATH: the same file as OPT2 PATH2: one would
+   overwrite the other"; nothing has been written. Collective under MPI. */
+int vw_cli_check_files(const char *cmd, const char *const *inputs, const char *const *opts,
+                       const char *const *paths, int n);
 
 /* Is this process the one that prints (rank 0, or no MPI)? Valid after vw_cli_engine_init. */
 int vw_cli_is_output(void);

@@ -320,12 +320,14 @@ static void help(const char *cmd)
                "for collisions at their destination (and along their path with 'sweep on') by\n"
                "cells of the decomposition; every 'frame' renders a PNG. Under MPI the first\n"
                "process reads EDITS and hands it to the others.\n");
-    printf("  -o PATTERN       frame file names: a .png name with one %%d (like %%04d) for the\n"
-           "                   frame number (from 0), %%%% for a percent sign\n"
-           "  --cells L        layout of cells, like 4, 2x4, 2x2x2 (default 1)\n"
-           "  --workers W      worker threads per process (default: the cores it may run on)\n"
+    printf("  -o, --output PATTERN  frame file names: a .png name with one %%d (like %%04d)\n"
+           "                   for the frame number (from 0), %%%% for a percent sign\n"
+           "  --cells L        layout of cells, like 4, 2x4, 2x2x2 (default 1; at most\n"
+           "                   32768 cells)\n"
+           "  --workers W      worker threads per process, 1 to 1024 (default: the cores it\n"
+           "                   may run on)\n"
            "  --size WxH       image size (default: the scene's, else 512x512)\n"
-           "  --depth D        maximum ray depth (default 5)\n"
+           "  --depth D        maximum ray depth, 1 to 64 (default 5)\n"
            "  --balance S      none|tensor|rotate|staggered|divide: rebalance between frames\n"
            "                   when lambda exceeds 1 + --threshold (default 0.1)\n"
            "  --threshold X    rebalance when lambda exceeds 1 + X (default 0.1)\n"
@@ -342,9 +344,11 @@ static void help(const char *cmd)
            "  --stats FILE     the stats JSON, with an \"animation\" member (per frame)\n"
            "  --full-rebuild   rebuild every cell at every frame (the benchmark's baseline)\n"
            "  --brute-force    decide with the O(n^2) reference instead of the cells\n"
-           "  --quiet          no banner, frame lines or summary (animate: no rejections\n"
+           "  -q, --quiet      no banner, frame lines or summary (animate: no rejections\n"
            "                   either; edit always answers every edit)\n"
            "  --help           this text\n"
+           "The outputs (the frames, --log, --stats) must be files other than each other and\n"
+           "the inputs (devices like /dev/null excepted); \"-\" is not standard output.\n"
            "Exit status: 0 success, 2 bad input (any bad line; it stops animate unless\n"
            "--keep-going: lines that do not parse before the first frame, others where\n"
            "they are reached), 1 other.\n");
@@ -599,12 +603,15 @@ int vw_anim_main(const char *cmd, int argc, char **argv)
     p.farm = (rt_farm)vw_cli_farm_resolve(farm, s->strategy != NULL); /* as render's */
     s->farm = p.farm;
     {
-        /* The frames' directory and the stats' (the log is opened below), before any
-           frame: a --stats into a missing directory failed after the last frame. */
-        const char *opts[] = {"-o", "--stats"};
-        const char *paths[] = {s->pattern, stats};
-        if (vw_cli_check_outputs(cmd, opts, paths, 2) != VW_EXIT_OK) {
-            rc = VW_EXIT_FAIL;
+        /* The frames' directory, the stats' and the log's (opened below, once the world
+           is built), before any work: a --stats into a missing directory failed after
+           the last frame; a --log naming the edits replaced them. */
+        const char *opts[] = {"-o", "--stats", "--log"};
+        const char *paths[] = {s->pattern, stats, log_path};
+        const char *inputs[] = {scene_path, edits_path, NULL};
+        int crc = vw_cli_check_files(cmd, inputs, opts, paths, 3);
+        if (crc != VW_EXIT_OK) {
+            rc = crc;
             goto done;
         }
     }
@@ -628,6 +635,10 @@ int vw_anim_main(const char *cmd, int argc, char **argv)
     }
     if (vw_cli_same_view(cmd, p.width, p.height, depth, &scene->camera, scene) ||
         vw_cli_same_scene(cmd, scene)) {
+        vw_scene_free(scene);
+        goto done;
+    }
+    if (vw_cli_scene_size(scene_path, &scene->camera, p.width)) { /* as render's */
         vw_scene_free(scene);
         goto done;
     }

@@ -24,8 +24,10 @@ static void gen_usage(FILE *f)
             "  cornell  the Cornell box as polygons, with an emitting light (for radiosity)\n"
             "  room     a furnished room (table, chairs, shelf) with one ceiling light\n"
             "\noptions:\n"
-            "  --size N          size factor or depth of balls, rings, tree (default per scene)\n"
-            "  --count N         number of spheres for 'spheres' (default 1000)\n"
+            "  --size N          size or depth of balls, rings, tree (default per scene;\n"
+            "                    at most 7 for balls, 120 for rings, 13 for tree)\n"
+            "  --count N         number of spheres for 'spheres', at most 20000000\n"
+            "                    (default 1000)\n"
             "  --seed S          random seed of spheres and tree, 0 to 2^64-1 in decimal\n"
             "                    (default 1); the same seed gives the same scene\n"
             "  --cluster F       fraction of spheres in the cluster region, 0..1 (default 0)\n"
@@ -40,7 +42,7 @@ static void gen_usage(FILE *f)
 int vw_cmd_gen(int argc, char **argv)
 {
     const char *cmd = "gen", *name = NULL, *out = NULL, *v;
-    int seed_given = 0;
+    int seed_given = 0, cluster_given = 0;
     vw_gen_params p;
     vw_gen_params_init(&p);
     for (int i = 1; i < argc; i++) {
@@ -77,6 +79,7 @@ int vw_cmd_gen(int argc, char **argv)
             if (!(v = vw_cli_value(cmd, argc, argv, &i)) ||
                 vw_cli_double(cmd, a, v, 0.0, 1.0, &p.cluster))
                 return VW_EXIT_USAGE;
+            cluster_given = 1;
         } else if (!strcmp(a, "--resolution")) {
             if (!(v = vw_cli_value(cmd, argc, argv, &i)) ||
                 vw_cli_size(cmd, a, v, &p.width, &p.height))
@@ -107,12 +110,17 @@ int vw_cmd_gen(int argc, char **argv)
     int random = !strcmp(name, "spheres");
     int seeded = random || !strcmp(name, "tree");
     const char *unused = p.size && !sized ? "--size" : p.count && !random ? "--count"
-                       : p.cluster != 0 && !random ? "--cluster"
+                       : cluster_given && !random ? "--cluster"
                        : seed_given && !seeded ? "--seed" : NULL;
     if (unused) {
         vw_cli_error(cmd, "%s: '%s' takes no such option (--size: balls, rings, tree; "
                           "--count, --cluster: spheres; --seed: spheres, tree)", unused, name);
         return VW_EXIT_USAGE;
+    }
+    if (out) { /* before generating: a big scene was made, then not written */
+        const char *opts[] = {"-o"}, *paths[] = {out};
+        int rc = vw_cli_check_outputs(cmd, opts, paths, 1);
+        if (rc != VW_EXIT_OK) return rc;
     }
     char err[512] = "";
     vw_scene *s;

@@ -385,7 +385,9 @@ int vw_cmd_radiosity(int argc, char **argv)
     {
         const char *opts[] = {"-o", "--csv", "--image", "--stats", "--trace", "--checkpoint"};
         const char *paths[] = {r.out, r.csv, r.image, r.stats, trace, o.checkpoint};
-        if (vw_cli_check_outputs(CMD, opts, paths, 6) != VW_EXIT_OK) return VW_EXIT_FAIL;
+        const char *const inputs[] = {scene_path, NULL};
+        int crc = vw_cli_check_files(CMD, inputs, opts, paths, 6);
+        if (crc != VW_EXIT_OK) return crc;
     }
 
     /* A radiosity cell cannot be shared by workers (a shot's bitmaps depend on the order

@@ -28,13 +28,15 @@ static void help(void)
            "Ray traces the scene (Whitted: Phong lights with shadow rays, mirror reflection,\n"
            "refraction) with rays travelling as messages between the cells of a grid of\n"
            "virtual walls. The image is bit-identical for every layout and worker count.\n"
-           "  -o FILE          output image, .png (8-bit) or .pfm (float, unclamped)\n"
-           "  --cells L        layout of cells, like 4, 2x4, 2x2x2 (default 1)\n"
-           "  --workers W      worker threads per process (default: the cores it may run on,\n"
-           "                   as nproc counts, or a cgroup CPU quota's rounded up; under\n"
-           "                   MPI, its share of its host's, the fewest of any process)\n"
+           "  -o, --output FILE  output image, .png (8-bit) or .pfm (float, unclamped)\n"
+           "  --cells L        layout of cells, like 4, 2x4, 2x2x2 (default 1; at most\n"
+           "                   32768 cells)\n"
+           "  --workers W      worker threads per process, 1 to 1024 (default: the cores\n"
+           "                   it may run on, as nproc counts, or a cgroup CPU quota's\n"
+           "                   rounded up; under MPI, its share of its host's, the fewest\n"
+           "                   of any process)\n"
            "  --size WxH       image size (default: the scene's, else 512x512)\n"
-           "  --depth D        maximum ray depth, eye rays being depth 1 (default 5)\n"
+           "  --depth D        maximum ray depth, 1 to 64; eye rays are depth 1 (default 5)\n"
            "  --from X,Y,Z --at X,Y,Z --up X,Y,Z --angle DEG\n"
            "                   override the camera (angle: full vertical field of view,\n"
            "                   above 0 and below 180 degrees, as in an NFF file)\n"
@@ -51,10 +53,11 @@ static void help(void)
            "                   their rays), then the full render (the image does not change)\n"
            "  --balance-load M busy (measured time, default) | segments (counted ray-cell\n"
            "                   visits: deterministic) | model (objects + pixels + messages)\n"
-           "  --balance-iters N  pre-pass / balance rounds (default 2; divide and rotate\n"
-           "                     take up to 3 more, stopping when no gain is predicted)\n"
-           "  --prepass N      pre-pass traces every N-th row and column (default: about 256\n"
-           "                   eye rays per cell, N between 1 and 8)\n"
+           "  --balance-iters N  pre-pass / balance rounds, 1 to 20 (default 2; divide and\n"
+           "                     rotate take up to 3 more, stopping when no gain is\n"
+           "                     predicted)\n"
+           "  --prepass N      pre-pass traces every N-th row and column, N from 1 to 256\n"
+           "                   (default: about 256 eye rays per cell, N between 1 and 8)\n"
            "  --farm F         auto (default) | all | idle | none: the workers of a process\n"
            "                   share its cells by holding copies; all: every worker gets one\n"
            "                   of every cell (rays cross only to other processes; the copies\n"
@@ -71,7 +74,7 @@ static void help(void)
            "                   one per worker of the job: processes x --workers (default:\n"
            "                   the fewest cores of any process, see --workers)\n"
            "  --slow W:K[,..]  worker W does its work K times slower, K from 1 to 1000\n"
-           "                   (emulates a slow machine)\n"
+           "                   (emulates a slow machine); each worker at most once\n"
            "  --steal S        auto (default) | on | off: a copy that is done takes the\n"
            "                   turns other copies of its cell (on any process) have not\n"
            "                   taken; off: every copy makes exactly its share; auto: on\n"
@@ -80,8 +83,10 @@ static void help(void)
            "                   pixel by the worker that made its eye ray (farmed cells show\n"
            "                   their copies' turns)\n"
            "  --progress       the progress bar even when stderr is no terminal (mpirun)\n"
-           "  --quiet          no progress bar and no summary\n"
+           "  -q, --quiet      no progress bar and no summary\n"
            "  --help           this text\n"
+           "The outputs (-o, --stats, --overlay) must be files other than each other and the\n"
+           "scene (devices like /dev/null excepted); \"-\" is not standard output.\n"
            "Runs under mpirun too; only the first process writes files.\n"
            "\nexit status: 0 success, 2 bad input or usage, 1 any other failure\n");
 }
@@ -221,7 +226,7 @@ int vw_cmd_render(int argc, char **argv)
     int farm = -1, farm_copies = 0; /* -1: auto, resolved once the options are read */
     int steal = -1;                 /* vw_config.steal: -1 auto, 1 on, 0 off */
     vw_map_kind map = VW_MAP_BLOCK;
-    int map_given = 0, balance_given = 0, by_worker = 0;
+    int map_given = 0, balance_given = 0, by_worker = 0, by_given = 0;
     const char *tuning = NULL; /* a pre-pass option given: it needs --balance or --map */
     long iters = 2, prepass = 0; /* 0: rt_prepass_stride() */
     vw_load_spec lspec;
@@ -313,6 +318,7 @@ int vw_cmd_render(int argc, char **argv)
                 return VW_EXIT_USAGE;
             }
             by_worker = !strcmp(v, "worker");
+            by_given = 1;
         } else if (!strcmp(a, "--from")) {
             if (vw_cli_numbers(CMD, a, vw_cli_value(CMD, argc, argv, &i), "X,Y,Z", from, 3, 3,
                                NULL))
@@ -370,6 +376,8 @@ int vw_cmd_render(int argc, char **argv)
         vw_cli_error(CMD, "need a scene and -o OUT.png (try --help)");
         return VW_EXIT_USAGE;
     }
+    if (vw_cli_named(CMD, "-o", out) || (overlay && vw_cli_named(CMD, "--overlay", overlay)))
+        return VW_EXIT_USAGE;
     vw_image_format format = vw_image_format_of(out);
     int pfm = format == VW_IMAGE_PFM;
     if (format == VW_IMAGE_NONE) {
@@ -382,10 +390,13 @@ int vw_cmd_render(int argc, char **argv)
     }
 
     {
-        /* A --stats into a missing directory failed after the image was written. */
+        /* A --stats into a missing directory failed after the image was written; a
+           --stats naming the image or the scene replaced it. */
         const char *opts[] = {"-o", "--overlay", "--stats"};
         const char *paths[] = {out, overlay, stats};
-        if (vw_cli_check_outputs(CMD, opts, paths, 3) != VW_EXIT_OK) return VW_EXIT_FAIL;
+        const char *inputs[] = {scene_path, NULL};
+        int crc = vw_cli_check_files(CMD, inputs, opts, paths, 3);
+        if (crc != VW_EXIT_OK) return crc;
     }
 
     /* Workers of the whole job, for --speeds and --slow (the world's own default when
@@ -416,20 +427,31 @@ int vw_cmd_render(int argc, char **argv)
     if (rc == VW_EXIT_OK && slow_s) {
         slowdown = malloc(sizeof(double) * (size_t)gw);
         if (!slowdown) rc = vw_cli_fail(CMD, VW_EXIT_FAIL, err, sizeof err, "out of memory for --slow");
-        for (int g = 0; slowdown && g < gw; g++) slowdown[g] = 1.0;
+        /* 0 until a worker is given: one given twice ("1:3,1:4") is a mistake, not
+           the last one winning. */
+        for (int g = 0; slowdown && g < gw; g++) slowdown[g] = 0;
         for (const char *q = slow_s; slowdown && *q;) {
             char *end;
             long wk = strtol(q, &end, 10);
             double k = 0;
             if (end != q && *end == ':') k = strtod(end + 1, &end);
-            if (wk < 0 || wk >= gw || !(k >= 1) || k > 1000 || (*end && *end != ',')) {
+            if (wk < 0 || wk >= gw || !(k >= 1) || k > 1000 || (*end && *end != ',') ||
+                (*end == ',' && !end[1])) {
                 rc = vw_cli_fail(CMD, VW_EXIT_USAGE, err, sizeof err, "--slow: bad value '%s' "
-                                 "(expected W:K with worker W < %d and K from 1 to 1000)", slow_s, gw);
+                                 "(expected W:K,... with worker W < %d and K from 1 to 1000)",
+                                 slow_s, gw);
+                break;
+            }
+            if (slowdown[wk] != 0) {
+                rc = vw_cli_fail(CMD, VW_EXIT_USAGE, err, sizeof err, "--slow: bad value '%s' "
+                                 "(worker %ld given twice)", slow_s, wk);
                 break;
             }
             slowdown[wk] = k;
             q = *end ? end + 1 : end;
         }
+        for (int g = 0; slowdown && g < gw; g++)
+            if (slowdown[g] == 0) slowdown[g] = 1.0;
         /* A known slow-down is the calibration: its speed is 1/K. */
         if (rc == VW_EXIT_OK && !speeds) {
             speeds = malloc(sizeof(double) * (size_t)gw);
@@ -487,6 +509,13 @@ int vw_cmd_render(int argc, char **argv)
         free(speeds), free(slowdown);
         return rc != VW_EXIT_OK ? rc : VW_EXIT_USAGE;
     }
+    /* The file's resolution, too large, was refused by the ray tracer without its line;
+       the same on every process (vw_cli_same_view compared it). */
+    if (vw_cli_scene_size(scene_path, &cam, width)) {
+        vw_scene_free(scene);
+        free(speeds), free(slowdown);
+        return VW_EXIT_USAGE;
+    }
 
     rt_params p;
     memset(&p, 0, sizeof p);
@@ -518,6 +547,8 @@ int vw_cmd_render(int argc, char **argv)
     if (tuning && !balancing && vw_cli_is_output())
         fprintf(stderr, "vwalls render: warning: %s has no effect without a pre-pass (--balance "
                         "other than none, or --map greedy or weighted)\n", tuning);
+    if (by_given && !overlay && vw_cli_is_output())
+        fprintf(stderr, "vwalls render: warning: --overlay-by has no effect without --overlay\n");
     farm = vw_cli_farm_resolve(farm, balance_given || map_given);
     rt_balance_result bi;
     memset(&bi, 0, sizeof bi);

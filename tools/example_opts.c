@@ -73,5 +73,9 @@ int vw_example_opts_parse(const char *cmd, int argc, char **argv, vw_example_opt
             return VW_EXIT_USAGE;
         }
     }
-    return -1;
+    /* Before the work: a --stats into a missing directory failed after the result was
+       printed. */
+    const char *opts[] = {"--stats"}, *paths[] = {o->stats};
+    int rc = vw_cli_check_outputs(cmd, opts, paths, 1);
+    return rc == VW_EXIT_OK ? -1 : rc;
 }

@@ -15,7 +15,8 @@ typedef struct vw_example_opts {
 } vw_example_opts;
 
 /* Parses argv[1..argc) into o, whose fields hold the defaults on entry. Returns -1 to
-   go on, or the exit status to return at once (after --help, or a bad option). */
+   go on, or the exit status to return at once (after --help, a bad option, or a
+   --stats that cannot be written: vw_cli_check_outputs, collective under MPI). */
 int vw_example_opts_parse(const char *cmd, int argc, char **argv, vw_example_opts *o,
                           void (*help)(void));
 

@@ -258,10 +258,16 @@ static uint64_t env_count(const char *name, uint64_t max)
    is read every time: a program may change it between two worlds. */
 static _Atomic double probed_quota = -1;
 
+/* Set once the bad VW_CORES was reported: a program makes many worlds. */
+static atomic_flag cores_warned = ATOMIC_FLAG_INIT;
+
 int vw_host_cores(void)
 {
     uint64_t c = env_count("VW_CORES", 1024);
     if (c) return (int)c;
+    /* A value out of range (0, 5000) or not a number ("abc", "-1") is a mistake the
+       user should hear of: it used to be ignored without a word. */
+    const char *bad = getenv("VW_CORES");
     int n = 0;
     cpu_set_t set;
     if (sched_getaffinity(0, sizeof set, &set) == 0) n = CPU_COUNT(&set);
@@ -276,7 +282,14 @@ int vw_host_cores(void)
     }
     /* A quota of 1.5 cores runs two workers: the half core is there to take. */
     if (quota > 0 && ceil(quota) < n) n = (int)ceil(quota);
-    return n < 1 ? 1 : n;
+    if (n < 1) n = 1;
+    /* Under MPI the first process alone says it, as it says everything (every process
+       reads the same environment from the launcher). */
+    if (bad && *bad && vw_engine_rank() == 0 && !atomic_flag_test_and_set(&cores_warned))
+        fprintf(stderr, "vwalls: warning: VW_CORES='%s' is not a whole number from 1 to 1024: "
+                        "ignored, counting the %d core%s this process may use\n", bad, n,
+                n == 1 ? "" : "s");
+    return n;
 }
 
 int vw__host_cores_given(void) { return env_count("VW_CORES", 1024) != 0; }

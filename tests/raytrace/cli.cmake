@@ -121,11 +121,12 @@ execute_process(COMMAND ${VWALLS} render ${SCENE} -o ${WORK}/big.png --size 1638
 if(NOT rc EQUAL 0 OR NOT EXISTS ${WORK}/big.png)
   message(FATAL_ERROR "--size 16384x1: exit ${rc}: ${err}")
 endif()
-# A scene file's own resolution beyond it: the same status, the ray tracer's message.
+# A scene file's own resolution beyond it: the same status, the file's line and --size.
 file(WRITE ${WORK}/wide.nff "v\nfrom 0 0 5\nat 0 0 0\nup 0 1 0\nangle 30\nhither 1\nresolution 20000 10\ns 0 0 0 1\n")
 execute_process(COMMAND ${VWALLS} render ${WORK}/wide.nff -o ${WORK}/wide.png --quiet
                 RESULT_VARIABLE rc ERROR_VARIABLE err)
-if(NOT rc EQUAL 2 OR NOT err MATCHES "image size 20000x10 too large" OR EXISTS ${WORK}/wide.png)
+if(NOT rc EQUAL 2 OR NOT err MATCHES "wide.nff:7: resolution 20000x10 too large.*--size"
+   OR EXISTS ${WORK}/wide.png)
   message(FATAL_ERROR "resolution 20000 10: exit ${rc} (expected 2 and the limit): ${err}")
 endif()
 # A scene refused after --speeds or --slow was read: exit 2 (under ASan, a leak of their

@@ -250,10 +250,19 @@ static vw_status job_prepare(rt_job *j, const vw_scene *s, const rt_params *p, i
 
     vw_status st;
     /* The world box: the scene bounds padded so no primitive touches the outer walls,
-       and so a flat scene still gives cells of positive volume. */
+       and so a flat scene still gives cells of positive volume. A scene a trillion times
+       its size or more from the origin on an axis keeps nothing of a pad relative to its
+       size there, nor perhaps its own extent (a sphere 1e-20 across at x = 1 has lo = hi
+       = 1), and its box came out flat: no cell could be made. So the pad is also at
+       least 8 units in the last place of the axis's coordinates per cell across it,
+       which leaves the grid's walls several representable values apart; where the
+       relative pad is larger (every scene nearer than that) the box is as before. */
     vw_box world;
     for (int a = 0; a < 3; a++) {
         double pad = fmax(1e-3 * diag, 1e-3 * (hi[a] - lo[a]));
+        double mag = fmax(fabs(lo[a]), fabs(hi[a]));
+        double ulp = nextafter(mag, INFINITY) - mag; /* (NaN for an infinite bound: refused below) */
+        pad = fmax(pad, 8.0 * (p->dims[a] > 1 ? p->dims[a] : 1) * ulp);
         world.lo[a] = lo[a] - pad;
         world.hi[a] = hi[a] + pad;
     }

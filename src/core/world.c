@@ -93,29 +93,46 @@ void vw_config_init(vw_config *c)
 
 int vw__worker_process(const vw_world *w, int global_worker) { return global_worker / w->nworkers; }
 
+/* The worker of this process hosting unit r of cell c (0: the master, r: copy r), or
+   NULL when another process hosts it. */
+static vw__worker *unit_worker(vw_world *w, int c, int r)
+{
+    int g = r ? w->cells[c].reps[r - 1].worker : w->cell_worker[c];
+    return vw__worker_process(w, g) == w->rank ? &w->workers[g - w->rank * w->nworkers] : NULL;
+}
+
 /* The per-worker lists of what each worker of this process hosts: the cells it is the
-   master of, then the copies of duplicated cells (cell_rep says which). */
+   master of, then the copies of duplicated cells (cell_rep says which). Two passes over
+   the units, counting then filling, so each list is the size of its worker's share:
+   O(cells + units) time and memory, whatever the number of workers. */
 static vw_status assign_units(vw_world *w)
 {
-    size_t cap = (size_t)w->ncells + (size_t)vw__replica_total(w);
+    w->units_stale = 1; /* until every list is whole */
+    for (int i = 0; i < w->nworkers; i++) w->workers[i].ncells = 0;
+    for (int c = 0; c < w->ncells; c++)
+        for (int r = 0; r <= w->cells[c].nreps; r++) {
+            vw__worker *wk = unit_worker(w, c, r);
+            if (wk) wk->ncells++;
+        }
     for (int i = 0; i < w->nworkers; i++) {
         vw__worker *wk = &w->workers[i];
+        size_t n = (size_t)wk->ncells;
         wk->ncells = 0;
+        wk->step_cursor = 0;
         free(wk->cells);
         free(wk->cell_rep);
-        wk->cells = malloc(sizeof(int) * (cap ? cap : 1));
-        wk->cell_rep = malloc(sizeof(int) * (cap ? cap : 1));
+        wk->cells = malloc(sizeof(int) * (n ? n : 1));
+        wk->cell_rep = malloc(sizeof(int) * (n ? n : 1));
         if (!wk->cells || !wk->cell_rep) return VW_E_NOMEM;
-        wk->step_cursor = 0;
     }
     for (int c = 0; c < w->ncells; c++)
         for (int r = 0; r <= w->cells[c].nreps; r++) {
-            int g = r ? w->cells[c].reps[r - 1].worker : w->cell_worker[c];
-            if (vw__worker_process(w, g) != w->rank) continue;
-            vw__worker *wk = &w->workers[g - w->rank * w->nworkers];
+            vw__worker *wk = unit_worker(w, c, r);
+            if (!wk) continue;
             wk->cells[wk->ncells] = c;
             wk->cell_rep[wk->ncells++] = r;
         }
+    w->units_stale = 0;
     return VW_OK;
 }
 
@@ -617,9 +634,13 @@ vw_status vw_world_commit(vw_world *w)
                                    "input", r);
     }
     int cell = -1, rep = 0;
-    vw_status st = vw__runtime_build(w, &cell, &rep);
     char msg[512] = "";
-    if (st != VW_OK && rep)
+    /* The copies set since the last commit, listed per worker once for all of them. */
+    vw_status st = w->units_stale ? assign_units(w) : VW_OK;
+    if (st != VW_OK)
+        snprintf(msg, sizeof msg, "listing each worker's cells and copies: %s",
+                 vw_status_message(st));
+    else if ((st = vw__runtime_build(w, &cell, &rep)) != VW_OK && rep)
         snprintf(msg, sizeof msg, "building copy %d of cell %d failed: %s", rep, cell,
                  vw_status_message(st));
     else if (st != VW_OK)
@@ -804,8 +825,18 @@ static int *make_shares(const vw_world *w, int master, const int *workers, int k
             n[big]--;
             n[u] = 1;
         }
+    int even = 1;
+    for (int u = 1; u < k; u++) even &= n[u] == n[0];
     for (int u = 0; u < k; u++) cur[u] = 0;
     for (int j = 0; j < L; j++) {
+        /* Equal counts (equal speeds, every farmed cell): the round-robin the loop below
+           would find, as the unit with the fewest turns so far and the lowest number
+           is the one ahead; without the loop's k steps per slot, which made farming
+           every cell to every worker cost cells x workers^2. */
+        if (even) {
+            seq[j] = j % k;
+            continue;
+        }
         int best = 0;
         for (int u = 0; u < k; u++) {
             cur[u] += n[u];
@@ -814,16 +845,16 @@ static int *make_shares(const vw_world *w, int master, const int *workers, int k
         seq[j] = best;
         cur[best] -= L;
     }
-    /* Counts to offsets (in place), then each unit's slots in ascending order. */
+    /* Counts to offsets (in place), then each unit's slots in ascending order (one pass
+       over the slots, cur[u] counting those of unit u placed so far). */
     int off = 0;
     for (int u = 0; u <= k; u++) {
         int cnt = u < k ? n[u] : 0;
         first[u] = off;
         off += cnt;
     }
-    for (int u = 0, p = 0; u < k; u++)
-        for (int j = 0; j < L; j++)
-            if (seq[j] == u) pos[p++] = j;
+    for (int u = 0; u < k; u++) cur[u] = 0;
+    for (int j = 0; j < L; j++) pos[first[seq[j]] + cur[seq[j]]++] = j;
     free(want);
     free(cur);
     return blk;
@@ -894,7 +925,8 @@ static vw_status set_replicas(vw_world *w, int cell, const int *workers, int n)
     c->share_pos = shares ? shares + c->share_len : NULL;
     c->share_first = shares ? shares + 2 * c->share_len : NULL;
     w->committed = 0;
-    return assign_units(w);
+    w->units_stale = 1; /* listed by the next commit (vw_world.units_stale) */
+    return VW_OK;
 }
 
 vw_status vw_world_set_replicas(vw_world *w, int cell, const int *workers, int n)

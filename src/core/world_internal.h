@@ -225,6 +225,11 @@ struct vw_world {
     size_t nobjects, capobjects;
     double pad;                /* placement padding (world units) */
     int committed;
+    /* The workers' unit lists (vw__worker.cells) lag the copies of duplicated cells:
+       vw_world_set_replicas only marks them, and the commit lists them once, so setting
+       copies on every cell costs cells + units, not cells x units. Never set while
+       committed (set_replicas uncommits), so a run always finds them current. */
+    int units_stale;
     vw__packet *posted;        /* messages posted before run */
     atomic_long active;
     atomic_int finished;

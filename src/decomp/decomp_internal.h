@@ -6,6 +6,9 @@
 
 #include "vwalls/decomp.h"
 
+#include <stdatomic.h>
+#include <stdint.h>
+
 /* A face a carried walk crosses in one step: it has one neighbour, flush with the cell on
    the other two axes (so the ray's exits along them stay the same); wall is that
    neighbour's far wall on the face's axis, in the face's direction, inner unless it is
@@ -31,6 +34,14 @@ struct vw_decomp {
     int *nb;
     int max_nb;
     vw_face_step *face_step; /* per (cell, face): the step of a carried walk (vw_walk_next) */
+    /* Who this decomposition is known to equal: the number its constructor drew, or that
+       of another decomposition that vw_decomp_equal found equal to it (a clone, first).
+       Two decompositions with the same number are equal, so vw_decomp_equal answers
+       them at once, where comparing the trees costs a pass over every node (once per
+       cell built, in the ray tracer). Numbers are never reused (64 bits), and only ever
+       copied between equal decompositions, so the answer is sound even if the one that
+       drew the number is freed. Atomic: vw_decomp_equal writes it from worker threads. */
+    _Atomic uint64_t same_as;
 };
 
 /* Divides cell `cell` of a kd-tree node array of n nodes (with room for two more) by a

@@ -65,6 +65,8 @@ static vw_status kd_create(const vw_box *world, const vw_kd_node *nodes, int nno
 
     vw_decomp *d = calloc(1, sizeof *d);
     if (!d) return VW_E_NOMEM;
+    static _Atomic uint64_t drawn; /* (the last number drawn: see vw_decomp.same_as) */
+    atomic_init(&d->same_as, atomic_fetch_add_explicit(&drawn, 1, memory_order_relaxed) + 1);
     d->kind = kind;
     d->world = *world;
     d->nnodes = nnodes;
@@ -236,12 +238,18 @@ vw_status vw_decomp_clone(const vw_decomp *d, vw_decomp **out)
         st = vw_decomp_create_kd(&d->world, d->nodes, d->nnodes, d->has_frame ? d->frame : NULL,
                                  d->kind, out);
     }
+    /* Compared once here (which gives the clone d's number), so every later comparison
+       of the two, or of their clones, is immediate. */
+    if (st == VW_OK) (void)vw_decomp_equal(d, *out);
     return st;
 }
 
 int vw_decomp_equal(const vw_decomp *a, const vw_decomp *b)
 {
     if (!a || !b) return a == b;
+    uint64_t na = atomic_load_explicit(&a->same_as, memory_order_relaxed);
+    uint64_t nb = atomic_load_explicit(&b->same_as, memory_order_relaxed);
+    if (a == b || na == nb) return 1;
     /* Doubles compared as bits: -0.0 and 0.0 could round a walk differently. */
     if (a->nnodes != b->nnodes || a->has_frame != b->has_frame) return 0;
     if (memcmp(&a->world, &b->world, sizeof a->world) != 0) return 0;
@@ -253,6 +261,12 @@ int vw_decomp_equal(const vw_decomp *a, const vw_decomp *b)
             (p->axis >= 0 && memcmp(&p->split, &q->split, sizeof p->split) != 0))
             return 0;
     }
+    /* Equal: both take the lower number, so the next comparison is immediate. The
+       decompositions are the caller's const, but only this field changes, and it does
+       not change what any query answers. */
+    uint64_t n = na < nb ? na : nb;
+    atomic_store_explicit(&((vw_decomp *)a)->same_as, n, memory_order_relaxed);
+    atomic_store_explicit(&((vw_decomp *)b)->same_as, n, memory_order_relaxed);
     return 1;
 }
 

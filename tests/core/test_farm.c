@@ -29,7 +29,7 @@ enum { CNT_MADE, CNT_HASH, NCOUNTERS };
 
 typedef struct farm {
     uint64_t nbatches;
-    atomic_int *made; /* per batch: times made in this run */
+    atomic_int *made; /* per cell and batch (cell * nbatches + batch): times made this run */
     int work;         /* iterations of busy work a batch */
 } farm;
 
@@ -60,7 +60,7 @@ static int step(vw_ctx *ctx, void *state)
     farm *f = vw_ctx_user(ctx);
     uint64_t b = vw_ctx_next_batch(ctx, f->nbatches);
     if (b >= f->nbatches) return 0;
-    atomic_fetch_add(&f->made[b], 1);
+    atomic_fetch_add(&f->made[(size_t)vw_ctx_cell(ctx) * f->nbatches + b], 1);
     vw_count(ctx, CNT_MADE, 1);
     vw_count(ctx, CNT_HASH, batch_hash(b));
     volatile double x = 1;
@@ -144,6 +144,97 @@ static int64_t farm_runs(int workers, int steal, const double *slowdown, const d
                          uint64_t nbatches, int runs, uint64_t stress)
 {
     return farm_runs_work(workers, steal, slowdown, speeds, nbatches, runs, stress, 2000);
+}
+
+/* Cell c's copies in pattern p: on the k = (c + p) % gw workers after its master m
+   (some cells have none, some a copy on every other worker). */
+static int pattern_copies(int c, int m, int gw, int p, int *on)
+{
+    int k = (c + p) % gw;
+    for (int i = 0; i < k; i++) on[i] = (m + 1 + i) % gw;
+    return k;
+}
+
+/* Runs the world once and checks every cell's batches were each made once; with steal
+   off and equal speeds, also that every worker made exactly the turns of the units it
+   hosts (unit u of a cell with k units: batches u, u + k, ...), so each unit was on its
+   worker's list exactly once. */
+static void check_cells_run(vw_world *w, farm *f, int ncells, int gw, int steal, const char *when)
+{
+    size_t nb = f->nbatches;
+    for (size_t i = 0; i < (size_t)ncells * nb; i++) atomic_store(&f->made[i], 0);
+    vw_world_reset_stats(w);
+    CHECK_EQ_INT(vw_world_run(w), VW_OK);
+    uint64_t wrong = 0;
+    for (size_t i = 0; i < (size_t)ncells * nb; i++) wrong += atomic_load(&f->made[i]) != 1;
+    EXPECT(wrong == 0, "%d cells, steal %d, %s: %llu of %zu batches not made once", ncells,
+           steal, when, (unsigned long long)wrong, (size_t)ncells * nb);
+    if (steal) return;
+    int64_t want[64] = {0};
+    int on[64];
+    for (int c = 0; c < ncells; c++) {
+        int n = vw_world_replicas(w, c, on, 64), k = n + 1;
+        for (int u = 0; u < k; u++) {
+            int g = u ? on[u - 1] : vw_world_cell_worker(w, c);
+            if ((size_t)u < nb) want[g] += (int64_t)((nb - (size_t)u + (size_t)k - 1) / (size_t)k);
+        }
+    }
+    for (int g = 0; g < gw; g++) {
+        int64_t made = vw_world_worker_counter(w, g, CNT_MADE);
+        EXPECT(made == want[g], "%d cells, %s: worker %d made %lld batches, its units' turns "
+               "are %lld", ncells, when, g, (long long)made, (long long)want[g]);
+    }
+}
+
+/* Copies set on many cells, some set twice or dropped before the commit, then run:
+   the workers' lists of units are made once at the commit (vw_world.units_stale), and
+   must come out as if remade at every vw_world_set_replicas. Then copies changed after
+   a run, and after a remap (which lists the units itself). */
+static void farm_many_cells(int workers, int steal, uint64_t stress)
+{
+    vw_box box = {{0, 0, 0}, {1, 1, 1}};
+    int dims[3] = {4, 3, 2};
+    vw_decomp *d;
+    CHECK_EQ_INT(vw_decomp_create_grid(&box, dims, &d), VW_OK);
+    int nc = vw_decomp_cell_count(d);
+    farm f = {37, calloc((size_t)nc * 37, sizeof(atomic_int)), 200};
+    CHECK(f.made != NULL);
+    vw_config cfg;
+    vw_config_init(&cfg);
+    cfg.workers = workers;
+    cfg.steal = steal;
+    if (stress && !cfg.stress_seed) cfg.stress_seed = stress;
+    vw_world *w;
+    CHECK_EQ_INT(vw_world_create(&farm_module, &f, d, &cfg, &w), VW_OK);
+    int gw = workers, on[64];
+    for (int c = 0; c < nc; c++) {
+        int n = pattern_copies(c, vw_world_cell_worker(w, c), gw, 0, on);
+        CHECK_EQ_INT(vw_world_set_replicas(w, c, on, n), VW_OK);
+    }
+    for (int c = 1; c < nc; c += 2) { /* again, otherwise, before any commit */
+        int n = pattern_copies(c, vw_world_cell_worker(w, c), gw, 1, on);
+        CHECK_EQ_INT(vw_world_set_replicas(w, c, on, n), VW_OK);
+    }
+    check_cells_run(w, &f, nc, gw, steal, "copies set before the first run");
+    check_cells_run(w, &f, nc, gw, steal, "run again");
+    for (int c = 0; c < nc; c += 3) {
+        int n = pattern_copies(c, vw_world_cell_worker(w, c), gw, 2, on);
+        CHECK_EQ_INT(vw_world_set_replicas(w, c, on, n), VW_OK);
+    }
+    CHECK_EQ_INT(vw_world_commit(w), VW_OK);
+    check_cells_run(w, &f, nc, gw, steal, "copies changed after a run, then committed");
+    int cw[64];
+    for (int c = 0; c < nc; c++) cw[c] = (c * 7 + 1) % gw;
+    CHECK_EQ_INT(vw_world_remap(w, cw), VW_OK); /* (drops the copies) */
+    check_cells_run(w, &f, nc, gw, steal, "remapped");
+    for (int c = 0; c < nc; c++) {
+        int n = pattern_copies(c, cw[c], gw, 3, on);
+        CHECK_EQ_INT(vw_world_set_replicas(w, c, on, n), VW_OK);
+    }
+    check_cells_run(w, &f, nc, gw, steal, "remapped, copies set again");
+    vw_world_free(w);
+    vw_decomp_free(d);
+    free(f.made);
 }
 
 /* Under mpirun: one worker per process, the copies spread over the processes. */
@@ -232,6 +323,8 @@ int main(int argc, char **argv)
     /* Fewer batches than copies: most copies get none. */
     farm_runs(6, 1, NULL, NULL, 3, 2, stress);
     farm_runs(6, 0, NULL, mixed, 3, 2, stress);
+    /* Copies on many cells, set in bulk before a commit. */
+    for (int steal = 0; steal <= 1; steal++) farm_many_cells(5, steal, stress);
     printf("farm: %d failures\n", vw_test_failures);
     return vw_test_failures ? 1 : 0;
 }

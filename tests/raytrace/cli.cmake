@@ -304,6 +304,35 @@ foreach(name mixed wall_hit)
     message(FATAL_ERROR "far_${name}.nff: not the PNG of ${name}.nff")
   endif()
 endforeach()
+# Within the limits, but far from the origin for their size on one axis: the scene's
+# extent there, and a pad relative to its size, were lost to rounding and the world box
+# came out flat ("cannot create the 1x1x1 decomposition", exit 2). The box is now padded
+# by units in the last place of the coordinates (job.c): they render, the same PNG on
+# one cell and on 4x4x4 (a few cells a few ulps wide on that axis).
+foreach(case "1 0 5;1 0 0;s 1 0 0 1e-20" "1e16 0 5;1e16 0 0;s 1e16 0 0 1"
+             "0 0 0;1e35 0 0;s 1e35 0 0 1" "1e16 0 5;1e16 0 0;s 1e16 0.5 0 1")
+  list(GET case 0 eye)
+  list(GET case 1 at)
+  list(GET case 2 sphere)
+  string(REPLACE " " "_" tag "${sphere}")
+  file(WRITE ${WORK}/thin_${tag}.nff "v\nfrom ${eye}\nat ${at}\nup 0 1 0\nangle 40\n"
+                                     "hither 0.01\nresolution 16 16\nl 5 5 5\n"
+                                     "f 1 0 0 1 0 0 0 0\n${sphere}\n")
+  foreach(c 1 4x4x4)
+    file(REMOVE ${WORK}/thin_${c}.png)
+    execute_process(COMMAND ${VWALLS} render ${WORK}/thin_${tag}.nff -o ${WORK}/thin_${c}.png
+                            --quiet --cells ${c} --workers 2
+                    RESULT_VARIABLE rc ERROR_VARIABLE err)
+    if(NOT rc EQUAL 0 OR NOT EXISTS ${WORK}/thin_${c}.png)
+      message(FATAL_ERROR "'${sphere}' seen from ${eye} on ${c} cells: exit ${rc} (${err})")
+    endif()
+  endforeach()
+  execute_process(COMMAND ${CMAKE_COMMAND} -E compare_files ${WORK}/thin_1.png
+                          ${WORK}/thin_4x4x4.png RESULT_VARIABLE same)
+  if(NOT same EQUAL 0)
+    message(FATAL_ERROR "'${sphere}' seen from ${eye}: the PNG on 4x4x4 cells is not that on one")
+  endif()
+endforeach()
 # A pre-pass option without a pre-pass is said to do nothing (and renders); with one, not.
 foreach(case "--balance-iters;3;warn" "--prepass;2;warn" "--balance-load;segments;warn"
              "--prepass;2;--balance;tensor;quiet")

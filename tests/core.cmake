@@ -37,8 +37,14 @@ add_test(NAME core_misuse_limits COMMAND test_misuse limits)
 add_test(NAME core_misuse_stats COMMAND test_misuse stats)
 add_test(NAME core_misuse_slowdown COMMAND test_misuse slowdown)
 add_test(NAME core_misuse_signal COMMAND test_misuse signal)
+# Failed calls say why, queries take a NULL world, bad workers are refused,
+# vw_world_done asks every cell.
+foreach(m errmsg null workers done)
+  add_test(NAME core_misuse_${m} COMMAND test_misuse ${m})
+endforeach()
 set_tests_properties(core_misuse_create core_misuse_post core_misuse_redecompose
   core_misuse_limits core_misuse_stats core_misuse_slowdown core_misuse_signal
+  core_misuse_errmsg core_misuse_null core_misuse_workers core_misuse_done
   PROPERTIES LABELS "core")
 # An overflowed size loops; a slow-down read from the caller's array spins: both hang.
 set_tests_properties(core_misuse_limits core_misuse_slowdown PROPERTIES TIMEOUT 30)
@@ -46,11 +52,19 @@ foreach(case "send;sent message kind 1 to cell 0, but the kind has no handle"
              "output;sent message kind 0 to the output, but the kind has no output handler"
              "count;counted into counter 5 of 1"
              "face;sent message kind 0 to face 6 (faces are 0..5)"
-             "build-send;sent message kind 0 from cell 0 outside a run")
+             "build-send;sent message kind 0 from cell 0 outside a run"
+             "send-null;sent message kind 0 of 4 bytes with no message (NULL)"
+             "point-null;sent message kind 0 of 4 bytes with no message (NULL)"
+             "reenter-run;called vw_world_run from a callback during a run"
+             "reenter-post;called vw_world_post from a callback during a run"
+             "reenter-add;called vw_world_add_objects from a callback during a run"
+             "reenter-free;called vw_world_free from a callback during a run"
+             "reenter-commit;called vw_world_commit from a callback during the cells")
   list(GET case 0 m)
   list(GET case 1 want)
   add_test(NAME core_misuse_${m} COMMAND test_misuse ${m} ${want})
-  set_tests_properties(core_misuse_${m} PROPERTIES LABELS "core")
+  # A call back into the world used to wait for its own run for ever.
+  set_tests_properties(core_misuse_${m} PROPERTIES LABELS "core" TIMEOUT 30)
 endforeach()
 
 # The example module equals the O(n^2) count for every layout and worker count.

@@ -76,6 +76,8 @@ VW_API void vw_decomp_layout_string(const vw_decomp *d, char *buf, size_t len);
 /* Interior wall positions of a grid along axis (dims[axis]-1 values); NULL otherwise. */
 VW_API const double *vw_decomp_grid_walls(const vw_decomp *d, int axis);
 VW_API vw_box vw_decomp_world(const vw_decomp *d);
+/* A cell's box; for an id outside 0 .. vw_decomp_cell_count() - 1 the empty box at the
+   origin (lo = hi = 0), which is no error: check ids against the count first. */
 VW_API vw_box vw_decomp_cell_box(const vw_decomp *d, int cell);
 /* The kd-tree nodes (for balancers that edit a decomposition). */
 VW_API const vw_kd_node *vw_decomp_nodes(const vw_decomp *d, int *nnodes);
@@ -157,7 +159,8 @@ VW_API int vw_walk_next(const vw_decomp *d, vw_walk *w);
 #define VW_FACE_AXIS(f) ((f) >> 1)
 #define VW_FACE_SIGN(f) (((f) & 1) ? 1 : -1)
 /* The cells sharing a piece of face `face` of `cell` (positive area). Writes at most max
-   ids; returns the total number (a face may have several neighbours, or none). */
+   ids; returns the total number (a face may have several neighbours, or none). An
+   unknown cell or a face outside 0..5 has none: 0, as a face on the world's wall. */
 VW_API int vw_decomp_neighbours(const vw_decomp *d, int cell, int face, int *out, int max);
 /* The largest number of neighbours any cell has over all faces. */
 VW_API int vw_decomp_max_neighbours(const vw_decomp *d);

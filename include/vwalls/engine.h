@@ -28,7 +28,10 @@ VW_API int vw_engine_launched(void);
    collective calls below makes MPI calls). Fails with VW_E_MPI and a message when MPI
    offers less. Without a launcher it does nothing and returns VW_OK. */
 VW_API vw_status vw_engine_init(int *argc, char ***argv, char *msg, size_t len);
-/* Finalises MPI if vw_engine_init initialised it. */
+/* Finalises MPI if vw_engine_init initialised it (a second call does nothing). Call it
+   last, after vw_world_free of every world: any call on a world after it (a run, an
+   agreement) makes MPI calls after MPI_Finalize, which MPI forbids (the job aborts or
+   hangs), and a world freed after it cannot free its communicator. */
 VW_API void vw_engine_finish(void);
 /* Ends the whole job at once with this status (MPI_Abort when launched, exit otherwise),
    after printing msg; for failures the other ranks cannot learn about otherwise. */

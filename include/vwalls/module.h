@@ -55,7 +55,11 @@ typedef struct vw_module {
     const char *name;
 
     /* Objects are plain records of object_size bytes, copied into every cell their
-       bounds overlap (so they must not hold pointers that differ between processes). */
+       bounds overlap (so they must not hold pointers that differ between processes).
+       Each cell's box is widened for this by a margin of 1e-9 of the world's largest
+       extent (docs/runtime.md), so an object on a wall, or near one within the margin,
+       goes to the cells on both sides: cell_build may get objects just outside
+       vw_ctx_cell_box. To count something once, give it one owner (vw_decomp_locate). */
     size_t object_size;
     void (*object_bounds)(const void *object, vw_box *out, void *user);
 
@@ -80,14 +84,21 @@ typedef struct vw_module {
     vw_status (*cell_build)(vw_ctx *ctx, const void *objects, size_t nobjects, void **state);
     void (*cell_free)(void *state, void *user);
     /* Optional: local work that needs no message (generate primary rays, shoot a patch).
-       Return nonzero when it did some work; it is called again until it returns 0, and
-       again after the cell receives messages. A worker goes idle only after a pass in
+       Every run calls it on every cell (and copy) at its start, also a run with nothing
+       posted, so a cell that has nothing to do must return 0 at once (keep a flag in
+       the state). Return nonzero when it did some work; it is called again until it
+       returns 0, and again after the cell receives messages (not in a run that a
+       callback failed: vw_ctx_fail). A worker goes idle only after a pass in
        which step() of every cell (and copy) it hosts returned 0, so a cell may keep
        tallies or partial buffers between calls and hand them over here. */
     int (*step)(vw_ctx *ctx, void *state);
     /* Optional load estimate of a cell; otherwise measured busy time is used. */
     double (*load)(vw_ctx *ctx, void *state);
-    /* Optional local convergence test (used by the application's outer loop). */
+    /* Optional local convergence test: nonzero when the cell has converged. The runtime
+       never calls it by itself; vw_world_done (world.h) asks every cell between runs,
+       on the process that hosts it (the master of a duplicated cell), and agrees on the
+       answer, for an outer loop of runs ("run until done"). Like load() it may not send
+       or fail the run. */
     int (*done)(vw_ctx *ctx, void *state);
 } vw_module;
 
@@ -123,7 +134,9 @@ VW_API uint64_t vw_ctx_next_batch(vw_ctx *ctx, uint64_t nbatches);
    for a kind of size 0, a signal that carries nothing). A send that cannot be meant is
    a bug in the module and stops the process with a message on stderr: an unknown cell,
    face or kind, a kind without handle sent to a cell, a kind without
-   output handler sent to the output; so is an unknown counter given to vw_count.
+   output handler sent to the output, msg NULL for a kind of size > 0 (also when the
+   send reaches no cell: a point outside, a face on the world's wall); so is an
+   unknown counter given to vw_count.
    Messages are batched per destination into packets, flushed when full or when the
    worker has nothing else to do. To a duplicated cell, a message of an independent kind
    goes to the master or one of its copies in turn (round-robin per sending worker),
@@ -168,7 +181,9 @@ VW_API void vw_count(vw_ctx *ctx, int idx, int64_t n);
    The caller returns as usual after it. Only in handlers and step(): cell_build returns
    its status, and a call from it or from load() stops the process as a misuse.
    Output handlers, which get no context, keep their own failure flag for the caller
-   to check after the run. The runtime fails a run the same way when it cannot
+   to check after the run. No callback may change its world (vw_world_run, _post,
+   _add_objects, _commit, vw_world_free, ...: world.h, Misuse): that too stops the
+   process, naming the call. The runtime fails a run the same way when it cannot
    allocate a packet for a message being sent. */
 VW_API void vw_ctx_fail(vw_ctx *ctx, vw_status status, const char *fmt, ...)
 #if defined(__GNUC__) || defined(__clang__)

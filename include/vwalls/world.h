@@ -25,6 +25,19 @@
  * process 0's in name, record size, message kinds or counters (another build: packets
  * cross as raw bytes), and vw_world_commit one given another world (walls, mapping,
  * copies, objects' bounds).
+ *
+ * Misuse. A call given a NULL world returns VW_E_INVAL (a status), 0, -1 or NULL (the
+ * queries, each as said below), or does nothing (the void ones). Every other call of
+ * this header that returns a status other than VW_OK sets the message vw_world_errmsg(w)
+ * returns, queries (vw_world_cell_stats) included. A world changes only between runs, from the thread
+ * that runs it: a module's callback (cell_build, step, a handler, an output handler,
+ * load, done) that calls vw_world_add_objects, _update_object, _set_replicas,
+ * _redecompose, _remap, _commit, _post, _run, _done, _write_stats, _reset_stats,
+ * vw_balance_world or vw_world_free on its own world stops the process with a message
+ * on stderr naming the call, as a send that cannot be meant does (module.h): returning
+ * a status there would leave the run hung or the cells changed under the workers. The
+ * other queries may be called from callbacks; figures they read are those of the last
+ * run.
  */
 #ifndef VWALLS_WORLD_H
 #define VWALLS_WORLD_H
@@ -42,7 +55,8 @@ typedef struct vw_world vw_world;
 
 typedef struct vw_config {
     int workers;             /* worker threads per process; 0 = number of cores (under
-                                MPI its share of the host's: vw_engine_workers) */
+                                MPI its share of the host's: vw_engine_workers);
+                                negative: VW_E_INVAL at create, above 1024 VW_E_LIMIT */
     size_t packet_bytes;     /* flush a packet when it holds this much (default 32 KiB;
                                 at most 1 GiB, VW_E_LIMIT above) */
     size_t cap_bytes;        /* a worker whose unconsumed sent bytes exceed this drains its
@@ -104,7 +118,8 @@ VW_API vw_status vw_world_commit(vw_world *w);
 /* A message delivered to `cell` at the start of the next run, on the worker that hosts
    the cell then (after any vw_world_remap or vw_world_redecompose in between; one that
    leaves no cell `cell` is refused with VW_E_STATE while the message waits). msg may be
-   NULL for a kind of size 0. */
+   NULL for a kind of size 0. An unknown cell or kind, a kind without handle, or a NULL
+   msg for a kind of size > 0 is VW_E_INVAL with a message. */
 VW_API vw_status vw_world_post(vw_world *w, int cell, int kind, const void *msg);
 /* Runs every cell to quiescence (no message in flight, every step() idle); commits
    first when objects or the decomposition changed since the last commit. A run that a
@@ -112,6 +127,14 @@ VW_API vw_status vw_world_post(vw_world *w, int cell, int kind, const void *msg)
    the rest of the module's work, still ends, and returns that status (on every
    process, agreed). */
 VW_API vw_status vw_world_run(vw_world *w);
+
+/* The module's done() (its local convergence test, module.h) asked of every cell, on the
+   process hosting the cell (its master; copies are not asked), between runs: *done is 1
+   when every cell said nonzero, else 0. Every cell is asked each time. Collective under
+   MPI: every process gets the same answer. VW_E_INVAL (and *done 0) when the module has
+   no done() or done is NULL, VW_E_STATE when a cell is not built (commit or run first).
+   An iterative solver's outer loop: run, then stop when vw_world_done says so. */
+VW_API vw_status vw_world_done(vw_world *w, int *done);
 
 /* Replace the decomposition (and optionally the mapping) between runs: objects are
    re-placed, moved between workers/processes, and the cells rebuilt. A mapping to a
@@ -140,7 +163,8 @@ VW_API vw_status vw_world_set_replicas(vw_world *w, int cell, const int *workers
    NULL with max 0) and returns how many there are. */
 VW_API int vw_world_replicas(const vw_world *w, int cell, int *out, int max);
 
-/* Engine facts. */
+/* Engine facts. A NULL world has rank -1, 0 processes and workers, is not the output,
+   has decomposition NULL; an unknown cell (or a NULL world) has worker -1. */
 VW_API int vw_world_process(const vw_world *w);       /* this process's rank */
 VW_API int vw_world_processes(const vw_world *w);
 VW_API int vw_world_workers(const vw_world *w);       /* per process */
@@ -148,7 +172,10 @@ VW_API int vw_world_is_output(const vw_world *w);     /* rank 0 */
 VW_API const vw_decomp *vw_world_decomp(const vw_world *w);
 VW_API int vw_world_cell_worker(const vw_world *w, int cell);
 
-/* Measurements of the last run(s), valid on every process after run(). */
+/* Measurements of the last run(s), valid on every process after run(). With a NULL
+   world, an unknown cell, worker or counter: VW_E_INVAL from vw_world_cell_stats (with a
+   message, but for a NULL world), 0 from the others; vw_world_imbalance(NULL) is 0 (a
+   lambda is at least 1); vw_world_reset_stats(NULL) does nothing. */
 typedef struct vw_cell_stats {
     int worker;
     size_t objects;
@@ -188,8 +215,8 @@ VW_API uint64_t vw_world_migrated(const vw_world *w);
 
 /* The stats JSON (docs/runtime.md, Statistics), written by the output process only,
    through vw_outfile (vwalls/outfile.h: complete or absent). extra_json: more
-   top-level members ("\"rays\": {...}") or NULL. On failure vw_world_errmsg() says
-   "path: reason". */
+   top-level members ("\"rays\": {...}") or NULL, copied as they are: writing them as
+   JSON is the caller's part. On failure vw_world_errmsg() says "path: reason". */
 VW_API vw_status vw_world_write_stats(vw_world *w, const char *path, const char *command,
                                       const char *extra_json);
 

@@ -44,6 +44,24 @@ struct vw_ctx {
     int in_run;
 };
 
+/* The module's callbacks may run from now until callbacks_end (w->in_callbacks): a
+   world-changing call meanwhile is refused (vw__world_guard). Returns what was running
+   them before (a load() called from a query made in a handler), to restore. */
+static const char *callbacks_begin(vw_world *w, const char *what)
+{
+    return atomic_exchange(&w->in_callbacks, what);
+}
+
+static void callbacks_end(vw_world *w, const char *before) { atomic_store(&w->in_callbacks, before); }
+
+void vw__world_reentered(const vw_world *w, const char *call)
+{
+    fprintf(stderr, "vwalls: module '%s' called %s from a callback during %s: the world "
+                    "changes only between runs (a callback sends messages instead)\n",
+            w->m->name ? w->m->name : "?", call, atomic_load(&w->in_callbacks));
+    abort();
+}
+
 /* The figures and state of copy rep of a cell (0: the master itself). */
 static void **unit_state(vw_world *w, int cell, int rep)
 {
@@ -252,6 +270,17 @@ misuse(const vw_ctx *ctx, const char *fmt, int a, int b)
     abort();
 }
 
+/* Only a signal (a kind of size 0) may be sent without a buffer: memcpy read address 0.
+   Checked also where the send may reach nobody (a point outside, a face on the world's
+   wall), so the mistake shows on the first send, wherever the cell lies. */
+static inline void check_msg(const vw_ctx *ctx, int kind, const void *msg)
+{
+    const vw_module *m = ctx->w->m;
+    if (!msg && kind >= 0 && kind < m->nkinds && m->kinds[kind].size)
+        misuse(ctx, "sent message kind %d of %d bytes with no message (NULL)", kind,
+               (int)m->kinds[kind].size);
+}
+
 static void enqueue(vw_ctx *ctx, int slot, int dest, int cell, int kind, const void *msg)
 {
     vw_world *w = ctx->w;
@@ -267,6 +296,7 @@ static void enqueue(vw_ctx *ctx, int slot, int dest, int cell, int kind, const v
         misuse(ctx, "sent message kind %d from cell %d outside a run (cell_build or load)", kind,
                ctx->cell);
     size_t size = w->m->kinds[kind].size;
+    check_msg(ctx, kind, msg);
     size_t stride = msg_stride(size);
     vw__packet *p = wk->out[slot];
     if (p && p->used + stride > p->cap) {
@@ -623,6 +653,7 @@ void vw_send_cell(vw_ctx *ctx, int cell, int kind, const void *msg)
 
 int vw_send_point(vw_ctx *ctx, const double p[3], const double dir[3], int kind, const void *msg)
 {
+    check_msg(ctx, kind, msg);
     int cell = vw_decomp_locate(ctx->w->decomp, p, dir);
     if (cell >= 0) vw_send_cell(ctx, cell, kind, msg);
     return cell;
@@ -633,6 +664,7 @@ int vw_send_face(vw_ctx *ctx, int face, int kind, const void *msg)
     /* A face that does not exist is a bug like an unknown cell: it used to send to no
        one and return 0, as a face on the world's wall does. */
     if (face < 0 || face > 5) misuse(ctx, "sent message kind %d to face %d (faces are 0..5)", kind, face);
+    check_msg(ctx, kind, msg);
     int nb[64];
     int n = vw_decomp_neighbours(ctx->w->decomp, ctx->cell, face, nb, 64);
     if (n > 64) {
@@ -901,7 +933,17 @@ static void pool_wait(vw_world *w)
     pthread_mutex_unlock(&w->pool_mu);
 }
 
+static vw_status runtime_run(vw_world *w);
+
 vw_status vw__runtime_run(vw_world *w)
+{
+    const char *before = callbacks_begin(w, "a run (vw_world_run)");
+    vw_status st = runtime_run(w);
+    callbacks_end(w, before);
+    return st;
+}
+
+static vw_status runtime_run(vw_world *w)
 {
     /* The threads first: a run that cannot start them fails before it counts anything
        or takes the posted messages, so the next run starts as this one would have (a
@@ -1000,12 +1042,14 @@ vw_status vw__runtime_build(vw_world *w, int *cell, int *rep)
 {
     /* Each worker builds its own cells, on its own thread (or all here if threads
        cannot be started). */
+    const char *before = callbacks_begin(w, "the cells' build (vw_world_commit)");
     if (pool_start(w) < 0) {
         pool_dispatch(w, build_job);
         pool_wait(w);
     } else {
         for (int i = 0; i < w->nworkers; i++) build_job(&w->workers[i]);
     }
+    callbacks_end(w, before);
     /* Units are listed by cell, then copy (assign_units), so each worker's failure is
        its lowest failing unit, and the lowest of those is the lowest of all: the same
        unit is named whichever worker got there first. */
@@ -1086,12 +1130,28 @@ double vw__cell_load(vw_world *w, int cell)
 {
     vw__cell *c = &w->cells[cell];
     vw_ctx ctx = {w, &w->workers[c->worker - w->rank * w->nworkers], cell, 0, cell, 0};
-    return w->m->load(&ctx, c->state);
+    const char *before = callbacks_begin(w, "load()");
+    double load = w->m->load(&ctx, c->state);
+    callbacks_end(w, before);
+    return load;
+}
+
+int vw__cell_done(vw_world *w, int cell)
+{
+    vw__cell *c = &w->cells[cell];
+    vw_ctx ctx = {w, &w->workers[c->worker - w->rank * w->nworkers], cell, 0, cell, 0};
+    const char *before = callbacks_begin(w, "done() (vw_world_done)");
+    int done = w->m->done(&ctx, c->state);
+    callbacks_end(w, before);
+    return done;
 }
 
 double vw__replica_load(vw_world *w, int cell, int rep)
 {
     vw__replica *rp = &w->cells[cell].reps[rep - 1];
     vw_ctx ctx = {w, &w->workers[rp->worker - w->rank * w->nworkers], cell, rep, cell, rep};
-    return w->m->load(&ctx, rp->state);
+    const char *before = callbacks_begin(w, "load()");
+    double load = w->m->load(&ctx, rp->state);
+    callbacks_end(w, before);
+    return load;
 }

@@ -188,8 +188,9 @@ static void write_body(vw_world *w, FILE *f, const char *command, const char *ex
 vw_status vw_world_write_stats(vw_world *w, const char *path, const char *command,
                                const char *extra_json)
 {
-    if (!w || !path) return VW_E_INVAL;
+    if (!w) return VW_E_INVAL;
     vw__world_begin_step(w);
+    if (!path) return vw__world_error(w, VW_E_INVAL, "vw_world_write_stats: path is NULL");
     if (w->rank != 0) return VW_OK;
     char err[512];
     vw_outfile *of;

@@ -332,6 +332,11 @@ vw_status vw_world_create(const vw_module *m, void *user, const vw_decomp *d, co
     /* The cores this process may run on: the default worker count, and whether the
        workers leave a core to spare (steal, share_core below). */
     int cores = vw_host_cores();
+    if (w->cfg.workers < 0) {
+        create_failed(VW_E_INVAL, "vw_world_create: %d workers (0 = one per core)", w->cfg.workers);
+        free(w);
+        return VW_E_INVAL;
+    }
     w->nworkers = w->cfg.workers > 0 ? w->cfg.workers : cores;
     if (w->nworkers > 1024) {
         create_failed(VW_E_LIMIT, "vw_world_create: %d workers (at most 1024)", w->nworkers);
@@ -423,6 +428,7 @@ vw_status vw_world_create(const vw_module *m, void *user, const vw_decomp *d, co
 void vw_world_free(vw_world *w)
 {
     if (!w) return;
+    vw__world_guard(w, "vw_world_free"); /* it would join the thread it runs on */
     vw__runtime_stop(w);
     if (w->transport) w->transport->free(w);
     free(w->wstats);
@@ -507,9 +513,13 @@ static vw_status place_object(vw_world *w, size_t id)
 
 static vw_status add_objects(vw_world *w, const void *objects, size_t n)
 {
-    if (n && !objects) return VW_E_INVAL;
+    if (n && !objects)
+        return vw__world_error(w, VW_E_INVAL, "vw_world_add_objects: %zu objects at NULL", n);
     size_t osz = w->m->object_size;
-    if (!osz) return n ? VW_E_INVAL : VW_OK;
+    if (!osz && n)
+        return vw__world_error(w, VW_E_INVAL, "vw_world_add_objects: module '%s' has no objects "
+                               "(object_size 0)", w->m->name);
+    if (!osz) return VW_OK;
     if (n == 0) return VW_OK; /* also keeps memcpy away from a NULL buffer */
     /* The records' bytes must fit a size_t: a count near SIZE_MAX wrapped the capacity
        to a small allocation and the copy ran past it. */
@@ -656,10 +666,16 @@ vw_status vw_world_commit(vw_world *w)
 
 vw_status vw_world_post(vw_world *w, int cell, int kind, const void *msg)
 {
-    if (!w || cell < 0 || cell >= w->ncells || kind < 0 || kind >= w->m->nkinds ||
-        (!msg && w->m->kinds[kind].size)) /* a kind of size 0 has nothing to point to */
-        return VW_E_INVAL;
+    if (!w) return VW_E_INVAL;
     vw__world_begin_step(w);
+    if (cell < 0 || cell >= w->ncells)
+        return vw__world_error(w, VW_E_INVAL, "posted to cell %d of %d", cell, w->ncells);
+    if (kind < 0 || kind >= w->m->nkinds)
+        return vw__world_error(w, VW_E_INVAL, "posted message kind %d, but module '%s' has %d kinds",
+                               kind, w->m->name, w->m->nkinds);
+    if (!msg && w->m->kinds[kind].size) /* a kind of size 0 has nothing to point to */
+        return vw__world_error(w, VW_E_INVAL, "posted message kind %d of %zu bytes with no "
+                               "message (NULL)", kind, w->m->kinds[kind].size);
     if (!w->m->kinds[kind].handle)
         return vw__world_error(w, VW_E_INVAL, "posted message kind %d to cell %d, but the kind "
                                "has no handle", kind, cell);
@@ -693,6 +709,41 @@ vw_status vw_world_run(vw_world *w)
         if (st != VW_OK) return st;
     }
     return vw__runtime_run(w);
+}
+
+/* The module's done() on every cell's master, on the process hosting it, between runs;
+   then agreed, so every process returns the same answer (the outer loop of an iterative
+   solver stops on all processes alike). Every cell is asked, also after one said no: a
+   module may keep per-cell tallies there. */
+vw_status vw_world_done(vw_world *w, int *done)
+{
+    if (!w) return VW_E_INVAL;
+    vw__world_begin_step(w);
+    if (!done) return vw__world_error(w, VW_E_INVAL, "vw_world_done: done is NULL");
+    *done = 0;
+    if (!w->m->done)
+        return vw__world_error(w, VW_E_INVAL, "vw_world_done: module '%s' has no done()", w->m->name);
+    vw_status st = VW_OK;
+    int all = 1;
+    for (int c = 0; c < w->ncells; c++) {
+        const vw__cell *cl = &w->cells[c];
+        if (vw__worker_process(w, cl->worker) != w->rank) continue;
+        if (!cl->built) {
+            st = vw__world_error(w, VW_E_STATE, "vw_world_done: cell %d is not built (commit or "
+                                 "run first)", c);
+            break;
+        }
+        if (!vw__cell_done(w, c)) all = 0;
+    }
+    st = vw__world_step_agreed(w, st, "vw_world_done");
+    if (st != VW_OK) return st;
+    /* Not done anywhere is not done: one more agreement, its "failure" the answer. */
+    if (w->transport) {
+        char msg[8] = "";
+        all = vw_world_agree(w, all ? VW_OK : VW_E_STATE, msg, sizeof msg) == VW_OK;
+    }
+    *done = all;
+    return VW_OK;
 }
 
 /* ---- re-decomposition --------------------------------------------------------------- */
@@ -947,20 +998,42 @@ int vw_world_replicas(const vw_world *w, int cell, int *out, int max)
 
 /* ---- facts and measurements --------------------------------------------------------- */
 
-int vw_world_process(const vw_world *w) { return w->rank; }
-int vw_world_processes(const vw_world *w) { return w->nprocs; }
-int vw_world_workers(const vw_world *w) { return w->nworkers; }
-int vw_world_is_output(const vw_world *w) { return w->rank == 0; }
-const vw_decomp *vw_world_decomp(const vw_world *w) { return w->decomp; }
+/* A NULL world answers as world.h says (no rank, no workers, no decomposition), so a
+   program that failed to create one can still print its figures. */
+int vw_world_process(const vw_world *w) { return w ? w->rank : -1; }
+int vw_world_processes(const vw_world *w) { return w ? w->nprocs : 0; }
+int vw_world_workers(const vw_world *w) { return w ? w->nworkers : 0; }
+int vw_world_is_output(const vw_world *w) { return w && w->rank == 0; }
+const vw_decomp *vw_world_decomp(const vw_world *w) { return w ? w->decomp : NULL; }
 
 int vw_world_cell_worker(const vw_world *w, int cell)
 {
-    return cell >= 0 && cell < w->ncells ? w->cell_worker[cell] : -1;
+    return w && cell >= 0 && cell < w->ncells ? w->cell_worker[cell] : -1;
+}
+
+/* A failed query says why like a failed step. The message is not part of what the world
+   computes (sqlite3_errmsg's is on a const handle too), hence the cast; from a callback,
+   where workers share the world, the query leaves it alone. */
+static vw_status query_error(const vw_world *w, vw_status st, const char *fmt, ...)
+    __attribute__((format(printf, 3, 4)));
+static vw_status query_error(const vw_world *w, vw_status st, const char *fmt, ...)
+{
+    if (atomic_load_explicit(&w->in_callbacks, memory_order_relaxed)) return st;
+    vw_world *mw = (vw_world *)w;
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(mw->errmsg, sizeof mw->errmsg, fmt, ap);
+    va_end(ap);
+    mw->err = st;
+    return st;
 }
 
 vw_status vw_world_cell_stats(const vw_world *w, int cell, vw_cell_stats *out)
 {
-    if (!w || !out || cell < 0 || cell >= w->ncells) return VW_E_INVAL;
+    if (!w) return VW_E_INVAL;
+    if (!out) return query_error(w, VW_E_INVAL, "vw_world_cell_stats: out is NULL");
+    if (cell < 0 || cell >= w->ncells)
+        return query_error(w, VW_E_INVAL, "vw_world_cell_stats: cell %d of %d", cell, w->ncells);
     const vw__cell *c = &w->cells[cell];
     out->worker = c->worker;
     out->objects = c->nobjs;
@@ -989,7 +1062,7 @@ vw_status vw_world_cell_stats(const vw_world *w, int cell, vw_cell_stats *out)
 
 double vw_world_worker_busy(const vw_world *w, int g)
 {
-    if (g < 0 || g >= w->gworkers) return 0;
+    if (!w || g < 0 || g >= w->gworkers) return 0;
     double s = 0;
     for (int c = 0; c < w->ncells; c++) {
         if (w->cells[c].worker == g) s += w->cells[c].busy.s;
@@ -1001,7 +1074,7 @@ double vw_world_worker_busy(const vw_world *w, int g)
 
 int64_t vw_world_cell_counter(const vw_world *w, int cell, int idx)
 {
-    if (cell < 0 || cell >= w->ncells || idx < 0 || idx >= w->m->ncounters) return 0;
+    if (!w || cell < 0 || cell >= w->ncells || idx < 0 || idx >= w->m->ncounters) return 0;
     int64_t s = w->cells[cell].counters[idx];
     for (int r = 0; r < w->cells[cell].nreps; r++) s += w->cells[cell].reps[r].counters[idx];
     return s;
@@ -1023,7 +1096,7 @@ int64_t vw_world_worker_counter(const vw_world *w, int g, int idx)
 int64_t vw_world_counter(const vw_world *w, int idx)
 {
     int64_t s = 0;
-    for (int c = 0; c < w->ncells; c++) s += vw_world_cell_counter(w, c, idx);
+    for (int c = 0; w && c < w->ncells; c++) s += vw_world_cell_counter(w, c, idx);
     return s;
 }
 
@@ -1050,6 +1123,7 @@ double vw__lambda(const double *t, const double *speeds, int n)
    so a worker's work is its busy time times its speed. */
 double vw_world_imbalance(const vw_world *w)
 {
+    if (!w) return 0; /* never a lambda, which is at least 1 */
     if (w->gworkers < 1) return 1.0;
     double *t = malloc(sizeof *t * (size_t)w->gworkers);
     if (!t) return 0;
@@ -1064,6 +1138,8 @@ double vw_world_imbalance(const vw_world *w)
 
 void vw_world_reset_stats(vw_world *w)
 {
+    if (!w) return;
+    vw__world_guard(w, "vw_world_reset_stats"); /* the workers write these figures */
     for (int c = 0; c < w->ncells; c++) {
         w->cells[c].busy.s = 0;
         w->cells[c].messages_in = 0;
@@ -1119,6 +1195,7 @@ double vw_world_time(const vw_world *w, const char *phase)
 void vw_world_set_balance_info(vw_world *w, const char *strategy, double before, double after,
                                uint64_t migrated)
 {
+    if (!w) return;
     snprintf(w->balance_strategy, sizeof w->balance_strategy, "%s", strategy ? strategy : "none");
     w->imbalance_before = before;
     w->imbalance_after = after;

@@ -253,6 +253,11 @@ struct vw_world {
     int pool_started, pool_left, pool_quit;
     void (*pool_job)(struct vw__worker *); /* the current job: a run or a build */
     pthread_mutex_t output_mu; /* output handlers run one at a time */
+    /* Non-NULL while the module's callbacks may run (a run, a build, load() or done()
+       called between runs): what runs them, for the message. A call that changes the
+       world then comes from a callback (or from another thread) and would hang in
+       pool_wait or change cells under the workers: vw__world_guard stops the process. */
+    _Atomic(const char *) in_callbacks;
     vw__transport *transport;
     vw__worker_stats *wstats;  /* gworkers entries, valid after a run */
     char errmsg[512];
@@ -279,9 +284,22 @@ double vw__unit_share(const vw__cell *c, int u);
    keep it. */
 vw_status vw__world_error(vw_world *w, vw_status st, const char *fmt, ...)
     __attribute__((format(printf, 3, 4)));
+/* Stops the process (world.h: "Between runs only"): `call` was made while the world's
+   callbacks run (w->in_callbacks). */
+void vw__world_reentered(const vw_world *w, const char *call) __attribute__((noreturn, cold));
+static inline void vw__world_guard(const vw_world *w, const char *call)
+{
+    if (atomic_load_explicit(&w->in_callbacks, memory_order_relaxed)) vw__world_reentered(w, call);
+}
 /* A public step begins: the last step's error is no longer the world's (vw_world_errmsg
-   tells the last failed step's, not the world's first). */
-static inline void vw__world_begin_step(vw_world *w) { w->err = VW_OK; }
+   tells the last failed step's, not the world's first). Every call that changes the
+   world begins so, which refuses it from inside a callback, naming the caller. */
+static inline void vw__world_begin_step_(vw_world *w, const char *call)
+{
+    vw__world_guard(w, call);
+    w->err = VW_OK;
+}
+#define vw__world_begin_step(w) vw__world_begin_step_((w), __func__)
 int vw__worker_process(const vw_world *w, int global_worker);
 /* Ends a collective step in agreement (see world.c): st is this process's outcome, step
    its name for a failure without a message. */
@@ -340,6 +358,8 @@ uint64_t vw__take_turns(vw_world *w, int cell, int unit, int thief, uint64_t nba
                         uint64_t *first);
 uint64_t vw__rng_next(uint64_t *s);
 double vw__cell_load(vw_world *w, int cell);
+/* done() of a cell this process hosts (its master), between runs. */
+int vw__cell_done(vw_world *w, int cell);
 /* load() of copy rep (>= 1) of cell, hosted by this process. */
 double vw__replica_load(vw_world *w, int cell, int rep);
 /* Fills w->wstats from this process's workers (the other processes' entries zero). */

@@ -7,9 +7,19 @@
  *   stats    phase names of any length and number, escaped in the stats JSON
  *   slowdown vw_config.worker_slowdown is copied at create, like the speeds
  *   signal   kinds of size 0 are sent and posted with no buffer
- *   send | output | count | build-send   a module's bad send (also one from
- *            cell_build) or count stops the process (abort)
- *            with a message on stderr: run in a child, whose end and stderr are checked
+ *   errmsg   every failed post, query or stats write says its own why (it said "no
+ *            error" or an older call's message)
+ *   null     the queries answer a NULL world as world.h says (they read address 0)
+ *   workers  a negative worker count is refused at create (it meant one per core)
+ *   done     vw_world_done asks every cell's done(), and refuses what it cannot answer
+ *   send | output | count | build-send | send-null | point-null   a module's bad send
+ *            (also one from cell_build, one without its message) or count stops the
+ *            process (abort) with a message on stderr: run in a child, whose end and
+ *            stderr are checked
+ *   reenter-run | reenter-post | reenter-add | reenter-free | reenter-commit   a call
+ *            that changes the world made from a callback (step; cell_build for commit)
+ *            stops the process naming it, the same way (run hung in pool_wait, post
+ *            changed the world mid-run)
  * Usage: test_misuse MODE [EXPECTED-MESSAGE]
  */
 #include <signal.h>
@@ -42,6 +52,7 @@ static void output(void *user, const void *msg)
 }
 
 static const char *mode;
+static vw_world *the_world; /* for the callbacks that call back into it */
 
 /* The mistake of the mode, once, from cell 0. */
 static int step(vw_ctx *ctx, void *state)
@@ -50,6 +61,13 @@ static int step(vw_ctx *ctx, void *state)
     if (*done || vw_ctx_cell(ctx) != 0) return 0;
     *done = 1;
     int x = 0;
+    obj o = {{0.5, 0.5, 0.5}};
+    if (!strcmp(mode, "send-null")) vw_send_cell(ctx, 1, 0, NULL);   /* kind 0: an int */
+    if (!strcmp(mode, "point-null")) vw_send_point(ctx, (double[3]){2, 2, 2}, NULL, 0, NULL);
+    if (!strcmp(mode, "reenter-run")) vw_world_run(the_world);
+    if (!strcmp(mode, "reenter-post")) vw_world_post(the_world, 1, 0, &x);
+    if (!strcmp(mode, "reenter-add")) vw_world_add_objects(the_world, &o, 1);
+    if (!strcmp(mode, "reenter-free")) vw_world_free(the_world);
     if (!strcmp(mode, "send")) vw_send_cell(ctx, 0, 1, &x);   /* kind 1: output only */
     if (!strcmp(mode, "output")) vw_send_output(ctx, 0, &x);  /* kind 0: no output */
     if (!strcmp(mode, "count")) vw_count(ctx, 5, 1);          /* one counter */
@@ -64,6 +82,7 @@ static vw_status build(vw_ctx *ctx, const void *objects, size_t n, void **state)
     *state = &done[vw_ctx_cell(ctx)];
     int x = 0;
     if (!strcmp(mode, "build-send") && vw_ctx_cell(ctx) == 0) vw_send_cell(ctx, 0, 0, &x);
+    if (!strcmp(mode, "reenter-commit") && vw_ctx_cell(ctx) == 0) vw_world_commit(the_world);
     return VW_OK;
 }
 
@@ -99,6 +118,15 @@ static const vw_msg_kind signal_kinds[] = {
     {.name = "signal", .size = 0, .handle = on_signal},
     {.name = "signal_out", .size = 0, .output = on_signal_out},
 };
+
+/* done(): what each cell says, and how often it was asked. */
+static int done_says[2], done_asked[2];
+static int cell_done(vw_ctx *ctx, void *state)
+{
+    (void)state;
+    done_asked[vw_ctx_cell(ctx)]++;
+    return done_says[vw_ctx_cell(ctx)];
+}
 
 static vw_module module(void)
 {
@@ -149,8 +177,32 @@ int main(int argc, char **argv)
         CHECK(strstr(vw_world_errmsg(NULL), "counter 0 has no name") != NULL);
         CHECK(vw_world_create(&m, NULL, d, &cfg, &w) == VW_OK);
         CHECK(!strcmp(vw_world_errmsg(NULL), "no world")); /* a success clears it */
+    } else if (!strcmp(mode, "null")) {
+        CHECK_EQ_INT(vw_world_counter(NULL, 0), 0);
+        CHECK_EQ_INT(vw_world_cell_counter(NULL, 0, 0), 0);
+        CHECK_EQ_INT(vw_world_worker_counter(NULL, 0, 0), 0);
+        CHECK_EQ_INT(vw_world_is_output(NULL), 0);
+        CHECK_EQ_INT(vw_world_workers(NULL), 0);
+        CHECK_EQ_INT(vw_world_processes(NULL), 0);
+        CHECK_EQ_INT(vw_world_process(NULL), -1);
+        CHECK_EQ_INT(vw_world_cell_worker(NULL, 0), -1);
+        CHECK(vw_world_decomp(NULL) == NULL);
+        CHECK(vw_world_imbalance(NULL) == 0);
+        CHECK(vw_world_worker_busy(NULL, 0) == 0);
+        vw_cell_stats cs;
+        CHECK_EQ_INT(vw_world_cell_stats(NULL, 0, &cs), VW_E_INVAL);
+        int yes = 1;
+        CHECK_EQ_INT(vw_world_done(NULL, &yes), VW_E_INVAL);
+        vw_world_reset_stats(NULL);
+        vw_world_set_balance_info(NULL, "none", 1, 1, 0);
+    } else if (!strcmp(mode, "workers")) {
+        cfg.workers = -3;
+        CHECK(vw_world_create(&m, NULL, d, &cfg, &w) == VW_E_INVAL && !w);
+        printf("workers: %s\n", vw_world_errmsg(NULL));
+        CHECK(strstr(vw_world_errmsg(NULL), "-3 workers") != NULL);
     } else {
         CHECK(vw_world_create(&m, NULL, d, &cfg, &w) == VW_OK);
+        the_world = w;
         obj o[2] = {{{0.25, 0.5, 0.5}}, {{0.75, 0.5, 0.5}}};
         CHECK(vw_world_add_objects(w, o, 2) == VW_OK);
         if (!strcmp(mode, "redecompose")) {
@@ -264,6 +316,46 @@ int main(int argc, char **argv)
             CHECK(strstr(json, "\"p19\": 19.0") != NULL);
             CHECK(strstr(json, "\"say \\\"hi\\\"\\\\\": 3.0") != NULL);
             CHECK(strstr(json, "\"strategy\": \"my \\\"own\\\"\"") != NULL);
+        } else if (!strcmp(mode, "errmsg")) {
+            /* Each failure after the first must replace its message with its own. */
+            int x = 0;
+            CHECK(vw_world_post(w, 1, 1, &x) == VW_E_INVAL);
+            CHECK(strstr(vw_world_errmsg(w), "has no handle") != NULL);
+            CHECK(vw_world_post(w, 5, 0, &x) == VW_E_INVAL);
+            printf("post to cell 5: %s\n", vw_world_errmsg(w));
+            CHECK(strstr(vw_world_errmsg(w), "cell 5 of 2") != NULL);
+            CHECK(vw_world_post(w, 0, 9, &x) == VW_E_INVAL);
+            CHECK(strstr(vw_world_errmsg(w), "kind 9") != NULL);
+            CHECK(vw_world_post(w, 0, 0, NULL) == VW_E_INVAL);
+            CHECK(strstr(vw_world_errmsg(w), "no message (NULL)") != NULL);
+            vw_cell_stats cs;
+            CHECK(vw_world_cell_stats(w, 9, &cs) == VW_E_INVAL);
+            CHECK(strstr(vw_world_errmsg(w), "cell 9 of 2") != NULL);
+            CHECK(vw_world_write_stats(w, NULL, "misuse", NULL) == VW_E_INVAL);
+            CHECK(strstr(vw_world_errmsg(w), "path is NULL") != NULL);
+            CHECK(vw_world_post(w, 0, 0, &x) == VW_OK);
+            CHECK(!strcmp(vw_world_errmsg(w), "no error"));
+        } else if (!strcmp(mode, "done")) {
+            int yes = 7;
+            CHECK_EQ_INT(vw_world_done(w, &yes), VW_E_INVAL); /* the module has no done() */
+            CHECK(yes == 0 && strstr(vw_world_errmsg(w), "has no done()") != NULL);
+            vw_module dm = m;
+            dm.done = cell_done;
+            vw_world *w2 = NULL;
+            CHECK(vw_world_create(&dm, NULL, d, &cfg, &w2) == VW_OK);
+            CHECK_EQ_INT(vw_world_done(w2, &yes), VW_E_STATE); /* nothing built yet */
+            printf("done: %s\n", vw_world_errmsg(w2));
+            CHECK(vw_world_add_objects(w2, o, 2) == VW_OK);
+            CHECK(vw_world_run(w2) == VW_OK);
+            done_says[0] = 1;
+            CHECK_EQ_INT(vw_world_done(w2, &yes), VW_OK);
+            CHECK_EQ_INT(yes, 0);
+            done_says[1] = 1;
+            CHECK_EQ_INT(vw_world_done(w2, &yes), VW_OK);
+            CHECK_EQ_INT(yes, 1);
+            CHECK(done_asked[0] == 2 && done_asked[1] == 2); /* every cell, every time */
+            CHECK_EQ_INT(vw_world_done(w2, NULL), VW_E_INVAL);
+            vw_world_free(w2);
         } else if (!strcmp(mode, "post")) {
             int x = 0;
             CHECK(vw_world_post(w, 1, 1, &x) == VW_E_INVAL);

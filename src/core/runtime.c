@@ -1125,33 +1125,33 @@ vw_status vw__world_build_replica(vw_world *w, int cell, int rep, vw__worker *wk
     return build_unit(w, cell, rep, wk);
 }
 
-/* The module's load estimate of a cell, called between runs. */
-double vw__cell_load(vw_world *w, int cell)
+/* The context of unit (cell, rep) of this process for a callback between runs: its
+   worker's, outside any run. */
+static vw_ctx between_runs(vw_world *w, int cell, int rep)
 {
-    vw__cell *c = &w->cells[cell];
-    vw_ctx ctx = {w, &w->workers[c->worker - w->rank * w->nworkers], cell, 0, cell, 0};
+    int g = rep ? w->cells[cell].reps[rep - 1].worker : w->cells[cell].worker;
+    return (vw_ctx){w, &w->workers[g - w->rank * w->nworkers], cell, rep, cell, rep};
+}
+
+/* The module's load estimate of unit (cell, rep), called between runs. */
+static double unit_load(vw_world *w, int cell, int rep)
+{
+    vw_ctx ctx = between_runs(w, cell, rep);
     const char *before = callbacks_begin(w, "load()");
-    double load = w->m->load(&ctx, c->state);
+    double load = w->m->load(&ctx, *unit_state(w, cell, rep));
     callbacks_end(w, before);
     return load;
 }
+
+double vw__cell_load(vw_world *w, int cell) { return unit_load(w, cell, 0); }
+
+double vw__replica_load(vw_world *w, int cell, int rep) { return unit_load(w, cell, rep); }
 
 int vw__cell_done(vw_world *w, int cell)
 {
-    vw__cell *c = &w->cells[cell];
-    vw_ctx ctx = {w, &w->workers[c->worker - w->rank * w->nworkers], cell, 0, cell, 0};
+    vw_ctx ctx = between_runs(w, cell, 0);
     const char *before = callbacks_begin(w, "done() (vw_world_done)");
-    int done = w->m->done(&ctx, c->state);
+    int done = w->m->done(&ctx, w->cells[cell].state);
     callbacks_end(w, before);
     return done;
-}
-
-double vw__replica_load(vw_world *w, int cell, int rep)
-{
-    vw__replica *rp = &w->cells[cell].reps[rep - 1];
-    vw_ctx ctx = {w, &w->workers[rp->worker - w->rank * w->nworkers], cell, rep, cell, rep};
-    const char *before = callbacks_begin(w, "load()");
-    double load = w->m->load(&ctx, rp->state);
-    callbacks_end(w, before);
-    return load;
 }

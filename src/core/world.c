@@ -18,14 +18,19 @@
 #include <string.h>
 #include <unistd.h>
 
+static void set_error(vw_world *w, vw_status st, const char *fmt, va_list ap)
+{
+    vsnprintf(w->errmsg, sizeof w->errmsg, fmt, ap);
+    w->err = st;
+}
+
 vw_status vw__world_error(vw_world *w, vw_status st, const char *fmt, ...)
 {
     if (w->err == VW_OK) {
         va_list ap;
         va_start(ap, fmt);
-        vsnprintf(w->errmsg, sizeof w->errmsg, fmt, ap);
+        set_error(w, st, fmt, ap);
         va_end(ap);
-        w->err = st;
     }
     return st;
 }
@@ -1019,12 +1024,10 @@ static vw_status query_error(const vw_world *w, vw_status st, const char *fmt, .
 static vw_status query_error(const vw_world *w, vw_status st, const char *fmt, ...)
 {
     if (atomic_load_explicit(&w->in_callbacks, memory_order_relaxed)) return st;
-    vw_world *mw = (vw_world *)w;
     va_list ap;
     va_start(ap, fmt);
-    vsnprintf(mw->errmsg, sizeof mw->errmsg, fmt, ap);
+    set_error((vw_world *)w, st, fmt, ap);
     va_end(ap);
-    mw->err = st;
     return st;
 }
 

@@ -86,7 +86,8 @@ VW_API int vw_engine_workers(int workers);
    least room left under a memory limit of those groups (v2 memory.max, v1
    memory.limit_in_bytes), if lower; 0 when nothing says. VW_CORES=N (1 to 1024) and
    VW_MEM_AVAILABLE=BYTES replace the readings, so one machine can play hosts of other
-   sizes. */
+   sizes; another VW_CORES is ignored with a warning on stderr (once a process, from
+   the first MPI process only). */
 VW_API int vw_host_cores(void);
 VW_API uint64_t vw_host_memory(void);
 

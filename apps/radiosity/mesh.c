@@ -486,6 +486,11 @@ static vw_status mesh_concave(rad_mesh *m, size_t *cap, const vw_decomp *d, cons
 #define RAD_SPHERE_LON 16
 #define RAD_SPHERE_LAT 8
 
+double rad_mesh_facets(const vw_scene *s)
+{
+    return (double)s->nspheres * RAD_SPHERE_LON * RAD_SPHERE_LAT + (double)s->ncones * RAD_SPHERE_LON;
+}
+
 typedef struct facet_sink {
     vw_scene *t;        /* the scene being extended */
     size_t capv, capi, capp;
@@ -648,7 +653,7 @@ vw_status rad_mesh_build(const vw_scene *s, const char *path, const vw_decomp *d
     const vw_scene *s0 = s;
     /* Refused before the facets are made: 66430 spheres would be 8.5 million facets
        (a gigabyte of corners) before the patch count below refused them. */
-    double nfacets = (double)s->nspheres * RAD_SPHERE_LON * RAD_SPHERE_LAT + (double)s->ncones * RAD_SPHERE_LON;
+    double nfacets = rad_mesh_facets(s);
     if (nfacets > RAD_MAX_SQUARES) {
         snprintf(err, errlen,
                  "%s: %zu spheres and %zu cones are %.0f facets (%d a sphere, %d a cone), more "

@@ -89,6 +89,10 @@ typedef struct rad_mesh {
     int32_t *facet_object;
 } rad_mesh;
 
+/* How many facets the scene's spheres and cones become (a fixed number each): with its
+   polygons, the fewest pieces rad_mesh_build can make of it. */
+double rad_mesh_facets(const vw_scene *s);
+
 /* Splits every polygon, and the facets of every sphere and cone, into patches and clips
    them at the cells of d. Bad geometry is
    reported as "file:line: message" in err (VW_E_INPUT); zero-area polygons are skipped

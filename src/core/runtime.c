@@ -271,8 +271,9 @@ misuse(const vw_ctx *ctx, const char *fmt, int a, int b)
 }
 
 /* Only a signal (a kind of size 0) may be sent without a buffer: memcpy read address 0.
-   Checked also where the send may reach nobody (a point outside, a face on the world's
-   wall), so the mistake shows on the first send, wherever the cell lies. */
+   Every send that reaches a cell is checked in enqueue; one that reaches nobody (a point
+   outside, a face on the world's wall) is checked where it ends, so the mistake shows on
+   the first send, wherever the cell lies. */
 static inline void check_msg(const vw_ctx *ctx, int kind, const void *msg)
 {
     const vw_module *m = ctx->w->m;
@@ -653,9 +654,11 @@ void vw_send_cell(vw_ctx *ctx, int cell, int kind, const void *msg)
 
 int vw_send_point(vw_ctx *ctx, const double p[3], const double dir[3], int kind, const void *msg)
 {
-    check_msg(ctx, kind, msg);
     int cell = vw_decomp_locate(ctx->w->decomp, p, dir);
-    if (cell >= 0) vw_send_cell(ctx, cell, kind, msg);
+    if (cell >= 0)
+        vw_send_cell(ctx, cell, kind, msg);
+    else
+        check_msg(ctx, kind, msg);
     return cell;
 }
 
@@ -664,9 +667,9 @@ int vw_send_face(vw_ctx *ctx, int face, int kind, const void *msg)
     /* A face that does not exist is a bug like an unknown cell: it used to send to no
        one and return 0, as a face on the world's wall does. */
     if (face < 0 || face > 5) misuse(ctx, "sent message kind %d to face %d (faces are 0..5)", kind, face);
-    check_msg(ctx, kind, msg);
     int nb[64];
     int n = vw_decomp_neighbours(ctx->w->decomp, ctx->cell, face, nb, 64);
+    if (n == 0) check_msg(ctx, kind, msg);
     if (n > 64) {
         int *all = malloc(sizeof(int) * (size_t)n);
         if (!all) {

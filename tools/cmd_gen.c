@@ -105,6 +105,14 @@ int vw_cmd_gen(int argc, char **argv)
                           "(try vwalls gen --help)");
         return VW_EXIT_USAGE;
     }
+    /* An unknown name first: "gen random --count 5" is not a misplaced --count. */
+    size_t k = 0;
+    while (vw_gen_name(k) && strcmp(vw_gen_name(k), name)) k++;
+    if (!vw_gen_name(k)) {
+        vw_cli_error(cmd, "unknown generator '%s' (balls, rings, tree, spheres, cornell, "
+                          "room)", name);
+        return VW_EXIT_USAGE;
+    }
     /* An option the scene has no use for is a mistake, not a no-op. */
     int sized = !strcmp(name, "balls") || !strcmp(name, "rings") || !strcmp(name, "tree");
     int random = !strcmp(name, "spheres");

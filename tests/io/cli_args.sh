@@ -2,10 +2,11 @@
 # cli_args.sh VWALLS TMPDIR - options and outputs refused before any work, the review's
 # cases: an output naming an input or another output (status 2, nothing written, the
 # input intact; devices exempt); an output into a missing directory found before the
-# work (gen -o, --log, the examples' --stats); gen --cluster for balls; --slow with a
-# worker twice or a trailing comma; --overlay-by without --overlay (a warning); a number
-# that underflows to a denormal; a name that is only an ending (-o .png); --stats - and
-# --stats -q; a bad VW_CORES (a warning); a scene's resolution too large (file:line).
+# work (gen -o, --log, the examples' --stats); gen --cluster for balls, and an unknown
+# gen scene given with options; --slow with a worker twice or a trailing comma;
+# --overlay-by without --overlay (a warning); a number that underflows to a denormal; a
+# name that is only an ending (-o .png); --stats - and --stats -q; a bad VW_CORES (a
+# warning); a scene's resolution too large (file:line).
 set -u
 V=$1 T=$2
 rm -rf "$T" && mkdir -p "$T" && cd "$T" || exit 1
@@ -74,6 +75,8 @@ done
 
 # 4. An option the scene has no use for, given at its default value too.
 refused 2 "^vwalls gen: --cluster: 'balls' takes no such option" gen balls --cluster 0
+# ... and an unknown scene is named as such, whatever options come with it.
+refused 2 "^vwalls gen: unknown generator 'random'" gen random --count 5
 
 # 5. --slow: a worker twice, a trailing comma; --overlay-by alone is a warning.
 # shellcheck disable=SC2086

@@ -15,6 +15,11 @@ target_include_directories(test_host PRIVATE ${PROJECT_SOURCE_DIR}/src)
 add_test(NAME core_host COMMAND test_host)
 add_test(NAME core_decomp COMMAND test_decomp)
 set_tests_properties(core_decomp PROPERTIES LABELS "core")
+# Face neighbour lists against brute force, on random kd-trees (staggered, divided, grids;
+# 1 to 3 dimensions) and their clones: the same cells, in the same order.
+vw_core_test(test_neighbours)
+add_test(NAME core_neighbours COMMAND test_neighbours)
+set_tests_properties(core_neighbours PROPERTIES LABELS "core")
 
 vw_core_test(test_storm)
 add_test(NAME core_storm COMMAND test_storm 20)
@@ -37,15 +42,15 @@ add_test(NAME core_misuse_limits COMMAND test_misuse limits)
 add_test(NAME core_misuse_stats COMMAND test_misuse stats)
 add_test(NAME core_misuse_slowdown COMMAND test_misuse slowdown)
 add_test(NAME core_misuse_signal COMMAND test_misuse signal)
-# Failed calls say why, queries take a NULL world, bad workers are refused,
-# vw_world_done asks every cell.
-foreach(m errmsg null workers done)
+# Failed calls say why (map.h's too), queries take a NULL world, bad workers are
+# refused (by vw_engine_workers too), vw_world_done asks every cell.
+foreach(m errmsg null workers done maperr)
   add_test(NAME core_misuse_${m} COMMAND test_misuse ${m})
 endforeach()
 set_tests_properties(core_misuse_create core_misuse_post core_misuse_redecompose
   core_misuse_limits core_misuse_stats core_misuse_slowdown core_misuse_signal
   core_misuse_errmsg core_misuse_null core_misuse_workers core_misuse_done
-  PROPERTIES LABELS "core")
+  core_misuse_maperr PROPERTIES LABELS "core")
 # An overflowed size loops; a slow-down read from the caller's array spins: both hang.
 set_tests_properties(core_misuse_limits core_misuse_slowdown PROPERTIES TIMEOUT 30)
 foreach(case "send;sent message kind 1 to cell 0, but the kind has no handle"
@@ -59,7 +64,10 @@ foreach(case "send;sent message kind 1 to cell 0, but the kind has no handle"
              "reenter-post;called vw_world_post from a callback during a run"
              "reenter-add;called vw_world_add_objects from a callback during a run"
              "reenter-free;called vw_world_free from a callback during a run"
-             "reenter-commit;called vw_world_commit from a callback during the cells")
+             "reenter-commit;called vw_world_commit from a callback during the cells"
+             "reenter-agree;called vw_world_agree from a callback during a run"
+             "build-agree;called vw_world_agree from a callback during the cells"
+             "reenter-traffic;called vw_world_traffic from a callback during a run")
   list(GET case 0 m)
   list(GET case 1 want)
   add_test(NAME core_misuse_${m} COMMAND test_misuse ${m} ${want})

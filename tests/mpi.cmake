@@ -147,3 +147,8 @@ vw_mpi_test(mpi_build_mixed 2 ENV "VW_FAULT=build-id;VW_MIXED_BUILDS=1"
 vw_mpi_script_test(mpi_wire_check 2 must_say.sh 60 wire
                    "rank 0: packet from rank 1 .*malformed: message 0 is of kind 2"
                    $<TARGET_FILE:test_mpi_storm> --wire)
+# A step() that calls vw_world_agree (a collective, from a worker thread mid-run) stops
+# the job naming the call, as the calls that change the world from a callback do.
+vw_mpi_script_test(mpi_agree_in_step 2 must_say.sh 60 agree-in-step
+                   "called vw_world_agree from a callback during a run"
+                   $<TARGET_FILE:test_mpi_storm> --agree-in-step)

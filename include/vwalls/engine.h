@@ -55,7 +55,11 @@ VW_API int vw_engine_size(void);
    vw_world_agree does the same before the next collective step. Like vw_world_create
    it initialises MPI when the process was started by a launcher and nobody did; where
    the world would run on the threads engine alone (or on one process) it returns
-   local and leaves msg as it is. */
+   local and leaves msg as it is. The agreed message is in msg only: vw_world_agree
+   leaves vw_world_errmsg as it was. vw_world_agree is made between runs, from the
+   thread that runs the world: called from a module's callback (with either engine) it
+   stops the process with a message naming it, as the calls that change the world do
+   (world.h, Misuse). */
 VW_API vw_status vw_engine_agree(vw_status local, char *msg, size_t len);
 VW_API vw_status vw_world_agree(vw_world *w, vw_status local, char *msg, size_t len);
 VW_API vw_status vw_config_agree(const vw_config *c, vw_status local, char *msg, size_t len);
@@ -72,11 +76,13 @@ VW_API void vw_errmsg_wrap(char *dst, size_t len, const char *what, const char *
 VW_API void vw_engine_broadcast(void *buf, size_t n);
 
 /* Workers per process of a world created on MPI_COMM_WORLD with vw_config.workers =
-   workers: workers when positive; otherwise one per core (vw_host_cores), and under MPI
-   each process's share of its host's cores (processes on one host that may run on the
-   same cores split them), the fewest of any process, which every process of the world
-   then runs (global worker = rank * W + local). So a tool can size per-worker options
-   (speeds) before the world exists, the same on every host. Collective under MPI: every rank must call it. */
+   workers: workers when positive; 0: one per core (vw_host_cores), and under MPI each
+   process's share of its host's cores (processes on one host that may run on the same
+   cores split them), the fewest of any process, which every process of the world then
+   runs (global worker = rank * W + local); -1 for a count vw_world_create refuses
+   (negative: VW_E_INVAL, above 1024: VW_E_LIMIT), which makes no world. So a tool can
+   size per-worker options (speeds) before the world exists, the same on every host.
+   Collective under MPI: every rank must call it, whatever its count. */
 VW_API int vw_engine_workers(int workers);
 /* What this host gives the process (not collective). vw_host_cores: the cores it may
    run on, the default worker count: its CPU affinity (taskset, a container's cpuset, an

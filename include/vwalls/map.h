@@ -4,6 +4,14 @@
  * A mapping is a table cell -> global worker (process * workers_per_process + local
  * worker), the form vw_config.cell_worker and vw_world_redecompose take. Invariant of
  * every mapper: each cell is mapped exactly once, to a worker in [0, gworkers).
+ *
+ * Errors. The mappers and parsers (vw_map_*) take no world and have no message to set:
+ * their status (VW_E_INVAL for a bad argument, VW_E_NOMEM) is all they say. The calls
+ * on a world (vw_world_remap, vw_world_traffic, vw_world_machines) follow world.h:
+ * VW_E_INVAL without a message for a NULL world, otherwise every failure sets the
+ * message vw_world_errmsg(w) returns. All three are collective under MPI, and like the
+ * calls that change the world, they stop the process with a message naming the call
+ * when a module's callback makes them (world.h, Misuse).
  */
 #ifndef VWALLS_MAP_H
 #define VWALLS_MAP_H
@@ -58,7 +66,9 @@ VW_API vw_status vw_map_parse_speeds(const char *s, double *speeds, int n);
 
 /* Re-maps the world's cells onto workers between runs (cells move with their objects
    and are rebuilt on their new worker). Before the first commit nothing has been built,
-   so nothing counts as migrated. */
+   so nothing counts as migrated. A step of the world's life (world.h): VW_E_INVAL for
+   no mapping (cell_worker NULL) or a worker that does not exist, and the world stays
+   as it was. */
 VW_API vw_status vw_world_remap(vw_world *w, const int *cell_worker);
 
 /* Share of neighbour traffic that stayed inside the sending worker, inside its process
@@ -66,7 +76,8 @@ VW_API vw_status vw_world_remap(vw_world *w, const int *cell_worker);
    destination class) since the last vw_world_reset_stats. Collective under MPI.
    Only messages sent count: work a module does in a cell of its own worker through
    vw_ctx_enter is no message (the ray tracer hands every ray on that way, so its
-   msgs_worker stays 0 unless VW_STRESS refuses hand-offs). */
+   msgs_worker stays 0 unless VW_STRESS refuses hand-offs). VW_E_INVAL when out is NULL,
+   VW_E_NOMEM, or vw_world_machines's failure. */
 typedef struct vw_traffic {
     uint64_t msgs, bytes;                 /* cell-to-cell messages */
     uint64_t msgs_worker, bytes_worker;   /* ... whose destination is the same worker */
@@ -76,7 +87,8 @@ typedef struct vw_traffic {
 VW_API vw_status vw_world_traffic(vw_world *w, vw_traffic *out);
 /* The machine of every process (machine_of[vw_world_processes()]): the lowest rank that
    shares memory with it (MPI_Comm_split_type(MPI_COMM_TYPE_SHARED)); without MPI, 0.
-   Collective under MPI. */
+   Collective under MPI. VW_E_INVAL when machine_of is NULL, VW_E_MPI when MPI cannot
+   group the processes. */
 VW_API vw_status vw_world_machines(vw_world *w, int *machine_of);
 
 #ifdef __cplusplus

@@ -28,16 +28,23 @@
  *
  * Misuse. A call given a NULL world returns VW_E_INVAL (a status), 0, -1 or NULL (the
  * queries, each as said below), or does nothing (the void ones). Every other call of
- * this header that returns a status other than VW_OK sets the message vw_world_errmsg(w)
- * returns, queries (vw_world_cell_stats) included. A world changes only between runs, from the thread
- * that runs it: a module's callback (cell_build, step, a handler, an output handler,
- * load, done) that calls vw_world_add_objects, _update_object, _set_replicas,
- * _redecompose, _remap, _commit, _post, _run, _done, _write_stats, _reset_stats,
- * vw_balance_world or vw_world_free on its own world stops the process with a message
- * on stderr naming the call, as a send that cannot be meant does (module.h): returning
- * a status there would leave the run hung or the cells changed under the workers. The
- * other queries may be called from callbacks; figures they read are those of the last
- * run.
+ * this header, and of map.h on a world (vw_world_remap, vw_world_traffic,
+ * vw_world_machines), that returns a status other than VW_OK sets the message
+ * vw_world_errmsg(w) returns, queries (vw_world_cell_stats) included; a query made
+ * from a callback leaves the message as it was (the workers share the world) and only
+ * returns its status. vw_world_agree (engine.h) is the exception: it writes the agreed
+ * message into the caller's buffer and leaves vw_world_errmsg's alone. A world changes
+ * only between runs, from the thread that runs it: a module's callback (cell_build,
+ * step, a handler, an output handler, load, done) that calls vw_world_add_objects,
+ * _update_object, _set_replicas, _redecompose, _remap, _commit, _post, _run, _done,
+ * _write_stats, _reset_stats, vw_balance_world or vw_world_free on its own world stops
+ * the process with a message on stderr naming the call, as a send that cannot be meant
+ * does (module.h): returning a status there would leave the run hung or the cells
+ * changed under the workers. So do vw_world_agree, vw_world_traffic and
+ * vw_world_machines, which change nothing but are collective under MPI: made from a
+ * worker thread in the middle of a run, they would meet the run's own collectives (a
+ * hang, or agreements mixed up). The other queries may be called from callbacks;
+ * figures they read are those of the last run.
  */
 #ifndef VWALLS_WORLD_H
 #define VWALLS_WORLD_H
@@ -56,7 +63,8 @@ typedef struct vw_world vw_world;
 typedef struct vw_config {
     int workers;             /* worker threads per process; 0 = number of cores (under
                                 MPI its share of the host's: vw_engine_workers);
-                                negative: VW_E_INVAL at create, above 1024 VW_E_LIMIT */
+                                negative: VW_E_INVAL at create, above 1024 VW_E_LIMIT
+                                (vw_engine_workers answers -1 for both) */
     size_t packet_bytes;     /* flush a packet when it holds this much (default 32 KiB;
                                 at most 1 GiB, VW_E_LIMIT above) */
     size_t cap_bytes;        /* a worker whose unconsumed sent bytes exceed this drains its

@@ -57,7 +57,8 @@ static void callbacks_end(vw_world *w, const char *before) { atomic_store(&w->in
 void vw__world_reentered(const vw_world *w, const char *call)
 {
     fprintf(stderr, "vwalls: module '%s' called %s from a callback during %s: the world "
-                    "changes only between runs (a callback sends messages instead)\n",
+                    "changes, and its processes agree, only between runs (a callback sends "
+                    "messages instead)\n",
             w->m->name ? w->m->name : "?", call, atomic_load(&w->in_callbacks));
     abort();
 }
@@ -1014,7 +1015,8 @@ static vw_status runtime_run(vw_world *w)
     st = atomic_load(&w->run_failed) ? w->run_err : VW_OK;
     char msg[512];
     snprintf(msg, sizeof msg, "%s", w->run_msg);
-    if (w->transport) st = vw_world_agree(w, st, msg, sizeof msg);
+    /* (Still inside the run's callbacks window, which would refuse vw_world_agree.) */
+    if (w->transport) st = vw__world_agree(w, st, msg, sizeof msg);
     if (st != VW_OK) return vw__world_error(w, st, "%s", msg);
     return VW_OK;
 }

@@ -70,7 +70,7 @@ vw_status vw__world_step_agreed(vw_world *w, vw_status st, const char *step)
     if (st != VW_OK && w->err == VW_OK) vw__world_error(w, st, "%s: %s", step, vw_status_message(st));
     if (st != VW_OK) snprintf(msg, sizeof msg, "%s", w->errmsg);
     if (!w->transport) return st;
-    vw_status all = vw_world_agree(w, st, msg, sizeof msg);
+    vw_status all = vw__world_agree(w, st, msg, sizeof msg);
     if (all != VW_OK) {
         w->err = VW_OK; /* this step's own message gives way to the agreed one */
         vw__world_error(w, all, "%s", msg);
@@ -343,8 +343,9 @@ vw_status vw_world_create(const vw_module *m, void *user, const vw_decomp *d, co
         return VW_E_INVAL;
     }
     w->nworkers = w->cfg.workers > 0 ? w->cfg.workers : cores;
-    if (w->nworkers > 1024) {
-        create_failed(VW_E_LIMIT, "vw_world_create: %d workers (at most 1024)", w->nworkers);
+    if (w->nworkers > VW__MAX_WORKERS) {
+        create_failed(VW_E_LIMIT, "vw_world_create: %d workers (at most %d)", w->nworkers,
+                      VW__MAX_WORKERS);
         free(w);
         return VW_E_LIMIT;
     }
@@ -663,7 +664,7 @@ vw_status vw_world_commit(vw_world *w)
     /* Under MPI every process builds only its own cells; they agree before anyone runs,
        so a cell that fails on one process fails the commit everywhere, naming the cell
        and (vw_world_agree's "rank R: ") the lowest failing process. */
-    if (w->transport) st = vw_world_agree(w, st, msg, sizeof msg);
+    if (w->transport) st = vw__world_agree(w, st, msg, sizeof msg);
     if (st != VW_OK) return vw__world_error(w, st, "%s", msg);
     w->committed = 1;
     return VW_OK;
@@ -745,7 +746,7 @@ vw_status vw_world_done(vw_world *w, int *done)
     /* Not done anywhere is not done: one more agreement, its "failure" the answer. */
     if (w->transport) {
         char msg[8] = "";
-        all = vw_world_agree(w, all ? VW_OK : VW_E_STATE, msg, sizeof msg) == VW_OK;
+        all = vw__world_agree(w, all ? VW_OK : VW_E_STATE, msg, sizeof msg) == VW_OK;
     }
     *done = all;
     return VW_OK;
@@ -1019,9 +1020,7 @@ int vw_world_cell_worker(const vw_world *w, int cell)
 /* A failed query says why like a failed step. The message is not part of what the world
    computes (sqlite3_errmsg's is on a const handle too), hence the cast; from a callback,
    where workers share the world, the query leaves it alone. */
-static vw_status query_error(const vw_world *w, vw_status st, const char *fmt, ...)
-    __attribute__((format(printf, 3, 4)));
-static vw_status query_error(const vw_world *w, vw_status st, const char *fmt, ...)
+vw_status vw__world_query_error(const vw_world *w, vw_status st, const char *fmt, ...)
 {
     if (atomic_load_explicit(&w->in_callbacks, memory_order_relaxed)) return st;
     va_list ap;
@@ -1034,9 +1033,10 @@ static vw_status query_error(const vw_world *w, vw_status st, const char *fmt, .
 vw_status vw_world_cell_stats(const vw_world *w, int cell, vw_cell_stats *out)
 {
     if (!w) return VW_E_INVAL;
-    if (!out) return query_error(w, VW_E_INVAL, "vw_world_cell_stats: out is NULL");
+    if (!out) return vw__world_query_error(w, VW_E_INVAL, "vw_world_cell_stats: out is NULL");
     if (cell < 0 || cell >= w->ncells)
-        return query_error(w, VW_E_INVAL, "vw_world_cell_stats: cell %d of %d", cell, w->ncells);
+        return vw__world_query_error(w, VW_E_INVAL, "vw_world_cell_stats: cell %d of %d", cell,
+                                     w->ncells);
     const vw__cell *c = &w->cells[cell];
     out->worker = c->worker;
     out->objects = c->nobjs;
@@ -1207,6 +1207,18 @@ void vw_world_set_balance_info(vw_world *w, const char *strategy, double before,
 
 uint64_t vw_world_migrated(const vw_world *w) { return w ? w->migrated : 0; }
 
+/* The program's own agreement (engine.h), in both engines. From a callback it would be
+   a collective made by a worker thread in the middle of a run or a build, beside the
+   runtime's own collectives (under MPI a hang, or agreements mixed up with each other;
+   MPI_THREAD_FUNNELED forbids it outright): refused as the calls that change the world
+   are, though it changes nothing. */
+vw_status vw_world_agree(vw_world *w, vw_status local, char *msg, size_t len)
+{
+    if (!w) return VW_E_INVAL;
+    vw__world_guard(w, "vw_world_agree");
+    return vw__world_agree(w, local, msg, len);
+}
+
 /* ---- without MPI: the engine is this one process ------------------------------------ */
 
 #if !VW_HAVE_MPI
@@ -1244,10 +1256,10 @@ vw_status vw_engine_agree(vw_status local, char *msg, size_t len)
     (void)msg, (void)len;
     return local;
 }
-vw_status vw_world_agree(vw_world *w, vw_status local, char *msg, size_t len)
+vw_status vw__world_agree(vw_world *w, vw_status local, char *msg, size_t len)
 {
-    (void)msg, (void)len;
-    return w ? local : VW_E_INVAL; /* as the MPI build answers */
+    (void)w, (void)msg, (void)len;
+    return local;
 }
 vw_status vw_config_agree(const vw_config *c, vw_status local, char *msg, size_t len)
 {
@@ -1255,5 +1267,9 @@ vw_status vw_config_agree(const vw_config *c, vw_status local, char *msg, size_t
     return local;
 }
 void vw_engine_broadcast(void *buf, size_t n) { (void)buf, (void)n; }
-int vw_engine_workers(int workers) { return workers > 0 ? workers : vw_host_cores(); }
+int vw_engine_workers(int workers)
+{
+    if (workers < 0 || workers > VW__MAX_WORKERS) return -1; /* vw_world_create refuses it */
+    return workers > 0 ? workers : vw_host_cores();
+}
 #endif

@@ -284,6 +284,14 @@ double vw__unit_share(const vw__cell *c, int u);
    keep it. */
 vw_status vw__world_error(vw_world *w, vw_status st, const char *fmt, ...)
     __attribute__((format(printf, 3, 4)));
+/* A failed query (a call that reads the world and changes nothing of what it computes:
+   vw_world_cell_stats, vw_world_traffic, vw_world_machines) says why like a failed step,
+   replacing any older message; called from a callback, where the workers share the
+   world, it leaves the message alone and only returns st. */
+vw_status vw__world_query_error(const vw_world *w, vw_status st, const char *fmt, ...)
+    __attribute__((format(printf, 3, 4)));
+/* The most worker threads a process may run (vw_config.workers): VW_E_LIMIT above. */
+#define VW__MAX_WORKERS 1024
 /* Stops the process (world.h: "Between runs only"): `call` was made while the world's
    callbacks run (w->in_callbacks). */
 void vw__world_reentered(const vw_world *w, const char *call) __attribute__((noreturn, cold));
@@ -376,6 +384,11 @@ vw_status vw__mpi_attach(vw_world *w);
 /* Collective over the world's processes: the lowest rank whose v differs from rank 0's,
    or -1 when all agree (always -1 without MPI). */
 int vw__mpi_first_differing(vw_world *w, uint64_t v);
+/* vw_world_agree without its guard (engine.h): the runtime's own agreements, one of
+   which (the end of a run) is made while w->in_callbacks still says a run. The public
+   vw_world_agree (world.c) refuses a call from a callback, then calls this: the MPI
+   engine's (transport/mpi_engine.c), or world.c's, which returns local. w not NULL. */
+vw_status vw__world_agree(vw_world *w, vw_status local, char *msg, size_t len);
 
 double vw__now(void);
 

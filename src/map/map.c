@@ -243,8 +243,14 @@ vw_status vw_map_compute(vw_map_kind kind, const vw_decomp *d, const double *cel
 
 vw_status vw_world_remap(vw_world *w, const int *cell_worker)
 {
-    if (!w || !cell_worker) return VW_E_INVAL;
+    if (!w) return VW_E_INVAL;
     vw__world_begin_step(w);
+    /* Agreed like any step: a process given no mapping alone would otherwise leave the
+       others waiting in their redecomposition's agreement. */
+    if (!cell_worker)
+        return vw__world_step_agreed(w, vw__world_error(w, VW_E_INVAL, "vw_world_remap: no "
+                                                         "mapping (cell_worker is NULL)"),
+                                     "vw_world_remap");
     int built = 0;
     for (int c = 0; c < w->ncells; c++) built |= w->cells[c].built;
     uint64_t before = w->migrated;

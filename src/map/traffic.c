@@ -14,9 +14,15 @@
 #include "transport/mpi_internal.h"
 #endif
 
+/* Both calls are collective under MPI: from a module's callback (a worker thread, in
+   the middle of a run) they would meet the run's own collectives, so they are refused
+   there as vw_world_agree is (world.h). */
 vw_status vw_world_machines(vw_world *w, int *machine_of)
 {
-    if (!w || !machine_of) return VW_E_INVAL;
+    if (!w) return VW_E_INVAL;
+    vw__world_guard(w, "vw_world_machines");
+    if (!machine_of)
+        return vw__world_query_error(w, VW_E_INVAL, "vw_world_machines: machine_of is NULL");
     for (int p = 0; p < w->nprocs; p++) machine_of[p] = p;
 #if VW_HAVE_MPI
     if (w->transport) {
@@ -24,7 +30,8 @@ vw_status vw_world_machines(vw_world *w, int *machine_of)
         MPI_Comm comm = vw__mpi_world_comm(w), shm;
         if (MPI_Comm_split_type(comm, MPI_COMM_TYPE_SHARED, w->rank, MPI_INFO_NULL, &shm) !=
             MPI_SUCCESS)
-            return VW_E_MPI;
+            return vw__world_query_error(w, VW_E_MPI, "vw_world_machines: "
+                                         "MPI_Comm_split_type(MPI_COMM_TYPE_SHARED) failed");
         int leader = w->rank;
         MPI_Allreduce(MPI_IN_PLACE, &leader, 1, MPI_INT, MPI_MIN, shm);
         MPI_Comm_free(&shm);
@@ -36,11 +43,15 @@ vw_status vw_world_machines(vw_world *w, int *machine_of)
 
 vw_status vw_world_traffic(vw_world *w, vw_traffic *out)
 {
-    if (!w || !out) return VW_E_INVAL;
+    if (!w) return VW_E_INVAL;
+    vw__world_guard(w, "vw_world_traffic");
+    if (!out) return vw__world_query_error(w, VW_E_INVAL, "vw_world_traffic: out is NULL");
     memset(out, 0, sizeof *out);
     int *mach = malloc(sizeof(int) * (size_t)w->nprocs);
-    if (!mach) return VW_E_NOMEM;
-    vw_status st = vw_world_machines(w, mach);
+    if (!mach)
+        return vw__world_query_error(w, VW_E_NOMEM, "vw_world_traffic: out of memory for %d "
+                                     "processes' machines", w->nprocs);
+    vw_status st = vw_world_machines(w, mach); /* (which says why it failed) */
     if (st != VW_OK) {
         free(mach);
         return st;

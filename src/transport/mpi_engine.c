@@ -205,6 +205,9 @@ int vw_engine_workers(int workers)
         cores = vw__mpi_core_share(MPI_COMM_WORLD, cores);
         MPI_Allreduce(&cores, &fewest, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
     }
+    /* A count vw_world_create refuses has no answer (it took a negative one as one per
+       core); the reductions above were still made, as the other ranks make them. */
+    if (workers < 0 || workers > VW__MAX_WORKERS) return -1;
     return workers > 0 ? workers : fewest;
 }
 
@@ -229,9 +232,9 @@ vw_status vw_config_agree(const vw_config *c, vw_status local, char *msg, size_t
     return vw__mpi_agree(base, local, msg, len);
 }
 
-vw_status vw_world_agree(vw_world *w, vw_status local, char *msg, size_t len)
+/* The public vw_world_agree (world.c) refuses a call from a callback, then comes here. */
+vw_status vw__world_agree(vw_world *w, vw_status local, char *msg, size_t len)
 {
-    if (!w) return VW_E_INVAL;
     MPI_Comm c = vw__mpi_world_comm(w);
     if (c == MPI_COMM_NULL) return local;
     return vw__mpi_agree(c, local, msg, len);

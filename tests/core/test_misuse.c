@@ -10,7 +10,12 @@
  *   errmsg   every failed post, query or stats write says its own why (it said "no
  *            error" or an older call's message)
  *   null     the queries answer a NULL world as world.h says (they read address 0)
- *   workers  a negative worker count is refused at create (it meant one per core)
+ *   workers  a negative worker count is refused at create (it meant one per core), and
+ *            vw_engine_workers answers -1 for the counts create refuses (it took a
+ *            negative one as one per core)
+ *   maperr   the calls of map.h that take a world say why they failed (vw_world_remap
+ *            without a mapping, vw_world_traffic and vw_world_machines without room for
+ *            their answer returned VW_E_INVAL and left "no error" or an older message)
  *   done     vw_world_done asks every cell's done(), and refuses what it cannot answer
  *   send | output | count | build-send | send-null | point-null   a module's bad send
  *            (also one from cell_build, one without its message) or count stops the
@@ -20,6 +25,10 @@
  *            that changes the world made from a callback (step; cell_build for commit)
  *            stops the process naming it, the same way (run hung in pool_wait, post
  *            changed the world mid-run)
+ *   reenter-agree | build-agree | reenter-traffic   so do vw_world_agree from step() or
+ *            cell_build, and vw_world_traffic from step(): collectives under MPI, made
+ *            from a worker thread in the middle of a run or a commit (they were let
+ *            through: a hang or a mixed-up agreement under MPI)
  * Usage: test_misuse MODE [EXPECTED-MESSAGE]
  */
 #include <signal.h>
@@ -68,6 +77,9 @@ static int step(vw_ctx *ctx, void *state)
     if (!strcmp(mode, "reenter-post")) vw_world_post(the_world, 1, 0, &x);
     if (!strcmp(mode, "reenter-add")) vw_world_add_objects(the_world, &o, 1);
     if (!strcmp(mode, "reenter-free")) vw_world_free(the_world);
+    if (!strcmp(mode, "reenter-agree")) vw_world_agree(the_world, VW_OK, NULL, 0);
+    vw_traffic t;
+    if (!strcmp(mode, "reenter-traffic")) vw_world_traffic(the_world, &t);
     if (!strcmp(mode, "send")) vw_send_cell(ctx, 0, 1, &x);   /* kind 1: output only */
     if (!strcmp(mode, "output")) vw_send_output(ctx, 0, &x);  /* kind 0: no output */
     if (!strcmp(mode, "count")) vw_count(ctx, 5, 1);          /* one counter */
@@ -83,6 +95,7 @@ static vw_status build(vw_ctx *ctx, const void *objects, size_t n, void **state)
     int x = 0;
     if (!strcmp(mode, "build-send") && vw_ctx_cell(ctx) == 0) vw_send_cell(ctx, 0, 0, &x);
     if (!strcmp(mode, "reenter-commit") && vw_ctx_cell(ctx) == 0) vw_world_commit(the_world);
+    if (!strcmp(mode, "build-agree") && vw_ctx_cell(ctx) == 0) vw_world_agree(the_world, VW_OK, NULL, 0);
     return VW_OK;
 }
 
@@ -200,6 +213,11 @@ int main(int argc, char **argv)
         CHECK(vw_world_create(&m, NULL, d, &cfg, &w) == VW_E_INVAL && !w);
         printf("workers: %s\n", vw_world_errmsg(NULL));
         CHECK(strstr(vw_world_errmsg(NULL), "-3 workers") != NULL);
+        /* What a world made with the count would run: none, where create refuses it. */
+        CHECK_EQ_INT(vw_engine_workers(-3), -1);
+        CHECK_EQ_INT(vw_engine_workers(5000), -1);
+        CHECK_EQ_INT(vw_engine_workers(3), 3);
+        CHECK_EQ_INT(vw_engine_workers(0), vw_host_cores());
     } else {
         CHECK(vw_world_create(&m, NULL, d, &cfg, &w) == VW_OK);
         the_world = w;
@@ -356,6 +374,36 @@ int main(int argc, char **argv)
             CHECK(done_asked[0] == 2 && done_asked[1] == 2); /* every cell, every time */
             CHECK_EQ_INT(vw_world_done(w2, NULL), VW_E_INVAL);
             vw_world_free(w2);
+        } else if (!strcmp(mode, "maperr")) {
+            /* Each failure says its own why, after an older failure too. */
+            int x = 0;
+            CHECK(vw_world_post(w, 5, 0, &x) == VW_E_INVAL);
+            CHECK_EQ_INT(vw_world_remap(w, NULL), VW_E_INVAL);
+            printf("remap: %s\n", vw_world_errmsg(w));
+            CHECK(strstr(vw_world_errmsg(w), "vw_world_remap: no mapping") != NULL);
+            CHECK(vw_world_post(w, 5, 0, &x) == VW_E_INVAL);
+            CHECK_EQ_INT(vw_world_traffic(w, NULL), VW_E_INVAL);
+            printf("traffic: %s\n", vw_world_errmsg(w));
+            CHECK(strstr(vw_world_errmsg(w), "vw_world_traffic: out is NULL") != NULL);
+            CHECK(vw_world_post(w, 5, 0, &x) == VW_E_INVAL);
+            CHECK_EQ_INT(vw_world_machines(w, NULL), VW_E_INVAL);
+            printf("machines: %s\n", vw_world_errmsg(w));
+            CHECK(strstr(vw_world_errmsg(w), "vw_world_machines: machine_of is NULL") != NULL);
+            /* A NULL world has no message to set; the answers are statuses alike. */
+            vw_traffic t;
+            int mach[1];
+            CHECK_EQ_INT(vw_world_traffic(NULL, &t), VW_E_INVAL);
+            CHECK_EQ_INT(vw_world_machines(NULL, mach), VW_E_INVAL);
+            CHECK_EQ_INT(vw_world_remap(NULL, mach), VW_E_INVAL);
+            /* And the calls still work. */
+            int swap[2] = {1, 0};
+            CHECK_EQ_INT(vw_world_remap(w, swap), VW_OK);
+            CHECK(!strcmp(vw_world_errmsg(w), "no error"));
+            CHECK_EQ_INT(vw_world_post(w, 0, 0, &x), VW_OK);
+            CHECK_EQ_INT(vw_world_run(w), VW_OK);
+            CHECK_EQ_INT(vw_world_traffic(w, &t), VW_OK);
+            CHECK_EQ_INT(vw_world_machines(w, mach), VW_OK);
+            CHECK_EQ_INT(mach[0], 0);
         } else if (!strcmp(mode, "post")) {
             int x = 0;
             CHECK(vw_world_post(w, 1, 1, &x) == VW_E_INVAL);

@@ -5,11 +5,12 @@
  * sequential reference, over two runs of the same world. Also: agreement between ranks,
  * a rank that dies in the middle of a run (for the fault tests), and a step of the
  * world's life that fails on one rank only (--fail: every rank must fail it, naming it),
- * a peer whose module differs (--agree) and a peer that sends a garbled packet (--wire).
+ * a peer whose module differs (--agree), a peer that sends a garbled packet (--wire) and
+ * a step() that calls vw_world_agree (--agree-in-step: the job must stop, naming it).
  *
  * usage: test_mpi_storm [--workers W] [--seeds N] [--agree] [--kill-rank R] [--exit-rank R]
  *                       [--hang-rank R]
- *                       [--fail STEP --fail-rank R] [--wire]
+ *                       [--fail STEP --fail-rank R] [--wire] [--agree-in-step]
  * Runs alone (threads engine) or under mpirun; honours VW_STRESS / VW_STRESS_SPLIT.
  */
 #include <mpi.h>
@@ -489,10 +490,49 @@ static int wire_garbled(void)
     return 1;
 }
 
+/* --agree-in-step: every process's step() calls vw_world_agree on its own world: a
+   collective made from a worker thread while the run's own collectives are under way,
+   which was let through (a hang, or an agreement mixed up with the run's messages).
+   Like the calls that change the world, it must stop the process, naming the call. */
+static vw_world *agree_world;
+
+static int agree_step(vw_ctx *ctx, void *state)
+{
+    (void)ctx, (void)state;
+    static int called; /* one worker, one cell per process */
+    if (called) return 0;
+    called = 1;
+    vw_world_agree(agree_world, VW_OK, NULL, 0);
+    return 1;
+}
+
+static int agree_in_step(void)
+{
+    vw_module m = storm_module;
+    m.cell_build = wire_build;
+    m.cell_free = NULL;
+    m.step = agree_step;
+    vw_box box = {{0, 0, 0}, {1, 1, 1}};
+    int dims[3] = {vw_engine_size(), 1, 1};
+    vw_decomp *d;
+    CHECK_EQ_INT(vw_decomp_create_grid(&box, dims, &d), VW_OK);
+    storm st = {1, dims[0], 0, 0, -1, -1};
+    vw_config cfg;
+    vw_config_init(&cfg);
+    cfg.workers = 1;
+    CHECK_EQ_INT(vw_world_create(&m, &st, d, &cfg, &agree_world), VW_OK);
+    CHECK_EQ_INT(vw_world_run(agree_world), VW_OK);
+    fprintf(stderr, "test_mpi_storm: process %d: vw_world_agree from step() went unnoticed\n",
+            vw_engine_rank());
+    vw_world_free(agree_world);
+    vw_decomp_free(d);
+    return 1;
+}
+
 int main(int argc, char **argv)
 {
     int workers = 2, seeds = 3, agree = 0, kill_rank = -1, exit_rank = -1, fail_rank = 1, wire = 0;
-    int hang_rank = -1;
+    int hang_rank = -1, agree_step_mode = 0;
     const char *fail = NULL;
     for (int i = 1; i < argc; i++) {
         if (!strcmp(argv[i], "--workers") && i + 1 < argc) workers = atoi(argv[++i]);
@@ -503,6 +543,7 @@ int main(int argc, char **argv)
         else if (!strcmp(argv[i], "--hang-rank") && i + 1 < argc) hang_rank = atoi(argv[++i]);
         else if (!strcmp(argv[i], "--fail") && i + 1 < argc) fail = argv[++i];
         else if (!strcmp(argv[i], "--wire")) wire = 1;
+        else if (!strcmp(argv[i], "--agree-in-step")) agree_step_mode = 1;
         else if (!strcmp(argv[i], "--fail-rank") && i + 1 < argc) fail_rank = atoi(argv[++i]);
         else {
             fprintf(stderr, "test_mpi_storm: bad argument '%s'\n", argv[i]);
@@ -515,8 +556,9 @@ int main(int argc, char **argv)
         return 1;
     }
     int rank = vw_engine_rank();
-    if (wire || fail) {
-        int rc = wire ? wire_garbled() : local_failure(fail, fail_rank, workers);
+    if (wire || fail || agree_step_mode) {
+        int rc = wire ? wire_garbled() : agree_step_mode ? agree_in_step()
+                                                         : local_failure(fail, fail_rank, workers);
         vw_engine_finish();
         return rc;
     }

@@ -8,6 +8,7 @@
  */
 #include "decomp/decomp_internal.h"
 
+#include <limits.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -226,22 +227,53 @@ vw_status vw_decomp_create_grid(const vw_box *world, const int dims[3], vw_decom
     return vw_decomp_create_grid_walls(world, dims, NULL, NULL, out);
 }
 
+/* A copy of n elements of `size` bytes (at least one, so that an empty array is not
+   taken for a failed allocation). */
+static void *dup_array(const void *p, size_t n, size_t size)
+{
+    void *q = malloc(size * (n ? n : 1));
+    if (q && n) memcpy(q, p, size * n);
+    return q;
+}
+
+/* A copy, not a rebuild: the same tree gives the same cell boxes, neighbour lists and
+   walk steps, so they are copied too (building them again cost most of the ray tracer's
+   load phase at 32x32x32 cells, for two clones a render). The clone takes d's number,
+   so every later comparison of the two, or of their clones, is immediate. */
 vw_status vw_decomp_clone(const vw_decomp *d, vw_decomp **out)
 {
     if (!d || !out) return VW_E_INVAL;
-    vw_status st;
-    if (d->kind == VW_DECOMP_GRID) {
-        const double *w[3] = {d->walls[0], d->walls[1], d->walls[2]};
-        st = vw_decomp_create_grid_walls(&d->world, d->dims, w, d->has_frame ? d->frame : NULL,
-                                         out);
-    } else {
-        st = vw_decomp_create_kd(&d->world, d->nodes, d->nnodes, d->has_frame ? d->frame : NULL,
-                                 d->kind, out);
+    *out = NULL;
+    vw_decomp *c = calloc(1, sizeof *c);
+    if (!c) return VW_E_NOMEM;
+    atomic_init(&c->same_as, atomic_load_explicit(&d->same_as, memory_order_relaxed));
+    c->kind = d->kind;
+    c->world = d->world;
+    c->has_frame = d->has_frame;
+    memcpy(c->frame, d->frame, sizeof c->frame);
+    c->nnodes = d->nnodes;
+    c->ncells = d->ncells;
+    memcpy(c->dims, d->dims, sizeof c->dims);
+    c->max_nb = d->max_nb;
+    size_t n = (size_t)d->ncells;
+    c->nodes = dup_array(d->nodes, (size_t)d->nnodes, sizeof *c->nodes);
+    c->cell_box = dup_array(d->cell_box, n, sizeof *c->cell_box);
+    c->cell_leaf = dup_array(d->cell_leaf, n, sizeof *c->cell_leaf);
+    c->nb_start = dup_array(d->nb_start, 6 * n + 1, sizeof *c->nb_start);
+    c->nb = dup_array(d->nb, (size_t)d->nb_start[6 * n], sizeof *c->nb);
+    c->face_step = dup_array(d->face_step, 6 * n, sizeof *c->face_step);
+    int ok = c->nodes && c->cell_box && c->cell_leaf && c->nb_start && c->nb && c->face_step;
+    for (int a = 0; a < 3 && ok; a++)
+        if (d->walls[a]) {
+            c->walls[a] = dup_array(d->walls[a], (size_t)(d->dims[a] - 1), sizeof(double));
+            ok = c->walls[a] != NULL;
+        }
+    if (!ok) {
+        vw_decomp_free(c);
+        return VW_E_NOMEM;
     }
-    /* Compared once here (which gives the clone d's number), so every later comparison
-       of the two, or of their clones, is immediate. */
-    if (st == VW_OK) (void)vw_decomp_equal(d, *out);
-    return st;
+    *out = c;
+    return VW_OK;
 }
 
 int vw_decomp_equal(const vw_decomp *a, const vw_decomp *b)
@@ -737,54 +769,128 @@ int vw_decomp_cells_overlapping(const vw_decomp *d, const vw_box *b, double pad,
     return overlap(d, 0, &f, pad, out, max, 0);
 }
 
-/* Two boxes share a face piece of positive area across axis a at coordinate s. */
-static int shares_face(const vw_box *p, const vw_box *q, int a)
+/* Face neighbours from the tree itself. Two cells sharing a face piece of positive area
+   across axis a lie on either side of the split that separates them first (their lowest
+   common node), and that split is on axis a at the face's coordinate: a split on another
+   axis would leave their extents along it overlapping in one point at most. So every
+   pair is found once, at one node on axis a, by matching the leaves of its low subtree
+   that touch the split with those of its high subtree that do (nb_match): each side's
+   leaves tile the node's cross-section, and the match descends both tilings together,
+   keeping only pieces that overlap with positive area. The cost is about the pairs
+   found times the depth of the subtrees below the split, at most; a query of each face's
+   plane from the root (as before) also visited every cell touching the face's edges and
+   corners, about 300 nodes a face at 32x32x32 cells. */
+
+typedef struct nb_pairs {
+    int *v; /* (low cell, high cell, axis) per pair */
+    size_t n, cap;
+    int fail;
+} nb_pairs;
+
+static void nb_push(nb_pairs *P, int lo, int hi, int a)
 {
-    for (int k = 0; k < 3; k++) {
-        if (k == a) continue;
-        double lo = p->lo[k] > q->lo[k] ? p->lo[k] : q->lo[k];
-        double hi = p->hi[k] < q->hi[k] ? p->hi[k] : q->hi[k];
-        if (!(hi > lo)) return 0;
+    if (P->n + 3 > P->cap) {
+        size_t cap = P->cap ? 2 * P->cap : 3 * 1024;
+        int *v = realloc(P->v, sizeof(int) * cap);
+        if (!v) {
+            P->fail = 1;
+            return;
+        }
+        P->v = v;
+        P->cap = cap;
     }
-    return 1;
+    P->v[P->n++] = lo;
+    P->v[P->n++] = hi;
+    P->v[P->n++] = a;
 }
 
-/* Neighbour lists per (cell, face), found with a flat box on the face plane. */
+/* Pairs the leaves of subtree l that touch the split plane across axis a from below with
+   those of subtree r that touch it from above, where their pieces of the plane overlap
+   with positive area. lb and rb are the subtrees' boxes, of which only the two axes
+   other than a are kept; they overlap with positive area on both. */
+static void nb_match(const vw_decomp *d, int l, vw_box lb, int r, vw_box rb, int a,
+                     nb_pairs *P)
+{
+    /* A split on axis a inside a subtree: only its side toward the plane touches it. */
+    while (d->nodes[l].axis == a) l = d->nodes[l].right;
+    while (d->nodes[r].axis == a) r = d->nodes[r].left;
+    const vw_kd_node *L = &d->nodes[l], *R = &d->nodes[r];
+    if (L->axis < 0 && R->axis < 0) {
+        nb_push(P, L->cell, R->cell, a);
+        return;
+    }
+    /* Divide the larger piece (a leaf is not divided): fewer calls per pair found. */
+    int b = (a + 1) % 3, c = (a + 2) % 3;
+    double la = (lb.hi[b] - lb.lo[b]) * (lb.hi[c] - lb.lo[c]);
+    double ra = (rb.hi[b] - rb.lo[b]) * (rb.hi[c] - rb.lo[c]);
+    int left = R->axis < 0 || (L->axis >= 0 && la >= ra);
+    const vw_kd_node *N = left ? L : R;
+    const vw_box *other = left ? &rb : &lb;
+    int k = N->axis;
+    vw_box lo = left ? lb : rb, hi = lo;
+    lo.hi[k] = N->split;
+    hi.lo[k] = N->split;
+    /* The whole overlaps `other` with positive length on axis k, so a half does iff the
+       split leaves it some of other's extent: edges and corners that merely touch are no
+       faces shared. */
+    if (N->split > other->lo[k]) {
+        if (left) nb_match(d, N->left, lo, r, rb, a, P);
+        else nb_match(d, l, lb, N->left, lo, a, P);
+    }
+    if (N->split < other->hi[k]) {
+        if (left) nb_match(d, N->right, hi, r, rb, a, P);
+        else nb_match(d, l, lb, N->right, hi, a, P);
+    }
+}
+
+/* Every node's pairs (nb_match). */
+static void nb_walk(const vw_decomp *d, int node, vw_box box, nb_pairs *P)
+{
+    const vw_kd_node *n = &d->nodes[node];
+    if (n->axis < 0) return;
+    vw_box l = box, r = box;
+    l.hi[n->axis] = n->split;
+    r.lo[n->axis] = n->split;
+    nb_match(d, n->left, l, n->right, r, n->axis, P);
+    nb_walk(d, n->left, l, P);
+    nb_walk(d, n->right, r, P);
+}
+
+/* Neighbour lists per (cell, face), each in the depth-first order of the leaves, low
+   side first, as a query of the face's plane from the root listed them: the order cells
+   send to their neighbours in (vw_send_neighbours), which decides the order of messages.
+   The pairs come in that order: all of a cell's neighbours across one face are found by
+   one nb_match (at the one split on that plane above the cell), and of its calls those
+   holding the cell divide the other side low half first, each half to the end. */
 static void build_neighbours(vw_decomp *d)
 {
     int n = d->ncells;
-    int cap = 16 * n + 16, used = 0;
-    int *tmp = malloc(sizeof(int) * (size_t)(n > 64 ? n : 64));
-    d->nb = malloc(sizeof(int) * (size_t)cap);
-    d->nb_start = malloc(sizeof(int) * (size_t)(6 * n + 1));
-    if (!tmp || !d->nb || !d->nb_start) goto fail;
+    nb_pairs P = {0};
+    d->nb_start = calloc((size_t)(6 * n + 1), sizeof(int));
+    int *pos = malloc(sizeof(int) * (size_t)(6 * n));
+    if (!d->nb_start || !pos) goto fail;
+    nb_walk(d, 0, d->world, &P);
+    if (P.fail || P.n / 3 > (size_t)(INT_MAX / 2)) goto fail;
+    size_t npairs = P.n / 3;
+    /* Counted per (cell, face), then placed in the order found. */
+    for (size_t i = 0; i < P.n; i += 3) {
+        d->nb_start[6 * P.v[i] + 2 * P.v[i + 2] + 1 + 1]++;
+        d->nb_start[6 * P.v[i + 1] + 2 * P.v[i + 2] + 1]++;
+    }
+    for (int s = 0; s < 6 * n; s++) d->nb_start[s + 1] += d->nb_start[s];
+    d->nb = malloc(sizeof(int) * (2 * npairs + 1));
+    if (!d->nb) goto fail;
+    memcpy(pos, d->nb_start, sizeof(int) * (size_t)(6 * n));
+    for (size_t i = 0; i < P.n; i += 3) {
+        int lo = P.v[i], hi = P.v[i + 1], a = P.v[i + 2];
+        d->nb[pos[6 * lo + 2 * a + 1]++] = hi;
+        d->nb[pos[6 * hi + 2 * a]++] = lo;
+    }
     d->max_nb = 0;
     for (int c = 0; c < n; c++) {
-        int total = 0;
-        for (int f = 0; f < 6; f++) {
-            d->nb_start[6 * c + f] = used;
-            int a = VW_FACE_AXIS(f);
-            vw_box flat = d->cell_box[c];
-            double s = VW_FACE_SIGN(f) > 0 ? flat.hi[a] : flat.lo[a];
-            flat.lo[a] = flat.hi[a] = s;
-            int k = overlap(d, 0, &flat, 0, tmp, n, 0);
-            for (int i = 0; i < k && i < n; i++) {
-                const vw_box *q = &d->cell_box[tmp[i]];
-                double qs = VW_FACE_SIGN(f) > 0 ? q->lo[a] : q->hi[a];
-                if (tmp[i] == c || qs != s || !shares_face(&d->cell_box[c], q, a)) continue;
-                if (used == cap) {
-                    cap *= 2;
-                    int *nb = realloc(d->nb, sizeof(int) * (size_t)cap);
-                    if (!nb) goto fail;
-                    d->nb = nb;
-                }
-                d->nb[used++] = tmp[i];
-                total++;
-            }
-        }
+        int total = d->nb_start[6 * c + 6] - d->nb_start[6 * c];
         if (total > d->max_nb) d->max_nb = total;
     }
-    d->nb_start[6 * n] = used;
     /* The faces a walk crosses in one step (vw_walk_next): one neighbour, flush with
        the cell on the two other axes, so the ray's exits along them stay the same. */
     d->face_step = malloc(sizeof *d->face_step * (size_t)(6 * n));
@@ -806,10 +912,12 @@ static void build_neighbours(vw_decomp *d)
             st->wall = up ? q->hi[a] : q->lo[a];
             st->inner = st->wall != (up ? d->world.hi[a] : d->world.lo[a]);
         }
-    free(tmp);
+    free(P.v);
+    free(pos);
     return;
 fail:
-    free(tmp);
+    free(P.v);
+    free(pos);
     free(d->nb_start);
     d->nb_start = NULL;
 }

@@ -11,7 +11,9 @@
  *
  * Invariants: every decomposition a balancer returns tiles the same world box (rotated
  * frames: the bounds of the rotated world box), so no object is lost; walls never cross
- * and keep at least min_width apart; every process computes the same result from the
+ * and keep at least min_width apart (one double apart where min_width is finer than the
+ * doubles there; where fewer doubles fit than walls, the balancer returns the current
+ * decomposition: no gain, no error); every process computes the same result from the
  * same (globally synchronised) measurements, so MPI ranks agree without talking.
  */
 #ifndef VWALLS_BALANCE_H
@@ -102,7 +104,9 @@ VW_API size_t vw_load_field_points(const vw_load_field *f);
 
 typedef struct vw_balance_params {
     vw_balance_strategy strategy;
-    int dims[3];        /* target layout (tensor, rotate, staggered); 0s: the current grid's */
+    int dims[3];        /* target layout (tensor, rotate, staggered); 0s: the current
+                           one's (a grid's dims; a staggered tree's slabs, columns a slab
+                           and cells a column; any other kind {cells, 1, 1}) */
     double min_width;   /* walls keep at least this fraction of the world extent apart
                            (default 1e-3) */
     int gworkers;       /* divide / duplicate, and rotate with speeds: all workers of the
@@ -118,7 +122,8 @@ VW_API void vw_balance_params_init(vw_balance_params *p);
 /* The new decomposition for the strategy (tensor, rotate, staggered, divide), from the
    current one and the load field. cell_worker (may be NULL) receives, for divide only, a
    mapping of the new cells onto gworkers workers (longest processing time first);
-   it must hold VW_MAX_CELLS entries. Others leave it untouched. */
+   it must hold VW_MAX_CELLS entries. Others leave it untouched. VW_E_INVAL for an
+   unknown strategy, a min_width outside [0, 1) or NaN, or negative dims. */
 VW_API vw_status vw_balance_decompose(const vw_decomp *current, const vw_load_field *f,
                                       const vw_balance_params *p, vw_decomp **out,
                                       int *cell_worker);

@@ -36,15 +36,58 @@ void vw_balance_params_init(vw_balance_params *p)
     p->tolerance = 0.03;
 }
 
+/* What is wrong with p, as a message, or NULL. The caller's mistakes, told apart from a
+   balancer that cannot move walls (cells a few doubles wide: it keeps them, no error). */
+static const char *params_problem(const vw_balance_params *p, char *buf, size_t len)
+{
+    if ((unsigned)p->strategy >= sizeof names / sizeof *names)
+        snprintf(buf, len, "unknown strategy %d", (int)p->strategy);
+    else if (!(p->min_width >= 0 && p->min_width < 1))
+        snprintf(buf, len, "min_width %g: must be a fraction of the world extent, from 0 to "
+                 "below 1", p->min_width);
+    else if (p->dims[0] < 0 || p->dims[1] < 0 || p->dims[2] < 0)
+        snprintf(buf, len, "dims %dx%dx%d: must be positive (or all 0: the current layout's)",
+                 p->dims[0], p->dims[1], p->dims[2]);
+    else
+        return NULL;
+    return buf;
+}
+
+/* The pieces of the subtree at `node` cut along `axis`: the subtrees below its splits on
+   that axis. */
+static int pieces_along(const vw_kd_node *nodes, int node, int axis)
+{
+    if (nodes[node].axis != axis) return 1;
+    return pieces_along(nodes, nodes[node].left, axis) +
+           pieces_along(nodes, nodes[node].right, axis);
+}
+
+/* A staggered decomposition's slabs, columns a slab and cells a column, read back from its
+   tree (the first slab's and column's: staggered.c cuts them all alike). vw_decomp_dims
+   gives any kd-tree but a grid as {cells, 1, 1}, and the next round of a 4x4x4 staggered
+   balance made 64 slabs of it. */
+static void staggered_dims(const vw_decomp *d, int dims[3])
+{
+    int nn, node = 0;
+    const vw_kd_node *nodes = vw_decomp_nodes(d, &nn);
+    for (int a = 0; a < 3; a++) {
+        dims[a] = pieces_along(nodes, node, a);
+        while (nodes[node].axis == a) node = nodes[node].left;
+    }
+}
+
 vw_status vw_balance_decompose(const vw_decomp *current, const vw_load_field *f,
                                const vw_balance_params *p, vw_decomp **out, int *cell_worker)
 {
     if (!out) return VW_E_INVAL;
     *out = NULL;
-    if (!current || !f || !p) return VW_E_INVAL;
+    char why[160];
+    if (!current || !f || !p || params_problem(p, why, sizeof why)) return VW_E_INVAL;
     int dims[3];
     if (p->dims[0] > 0 || p->dims[1] > 0 || p->dims[2] > 0)
         for (int a = 0; a < 3; a++) dims[a] = p->dims[a] > 0 ? p->dims[a] : 1;
+    else if (vw_decomp_get_kind(current) == VW_DECOMP_STAGGERED)
+        staggered_dims(current, dims);
     else
         vw_decomp_dims(current, dims);
     switch (p->strategy) {
@@ -144,8 +187,17 @@ static vw_status balance_duplicate(vw_world *w, const double *load, const vw_bal
 vw_status vw_balance_world(vw_world *w, const vw_load_field *f, const vw_balance_params *p,
                            const vw_balance_apply *a, vw_balance_report *rep)
 {
-    if (!w || !f || !p) return VW_E_INVAL;
+    if (!w) return VW_E_INVAL;
     vw__world_begin_step(w);
+    /* The caller's mistakes are refused on every process alike (they all pass the same
+       arguments), before anything is planned. */
+    char why[160];
+    if (rep) memset(rep, 0, sizeof *rep);
+    if (!f || !p)
+        return vw__world_error(w, VW_E_INVAL, "vw_balance_world: no %s (NULL)",
+                               !f ? "load field" : "parameters");
+    if (params_problem(p, why, sizeof why))
+        return vw__world_error(w, VW_E_INVAL, "vw_balance_world: %s", why);
     double t0 = vw__now();
     vw_balance_report r;
     memset(&r, 0, sizeof r);

@@ -26,14 +26,17 @@ typedef struct vw__lpt {
 long vw__field_points(const vw_load_field *f, const double *F, vw__lpt **out);
 
 /* Wall positions cutting pts[0..n) along axis into `parts` pieces of equal load, inside
-   [lo, hi], each piece at least minw wide, increasing. walls gets parts-1 values.
-   Reorders pts (sorted along axis). */
-void vw__cut(vw__lpt *pts, long n, int axis, double lo, double hi, int parts, double minw,
-             double *walls);
+   [lo, hi], each piece at least minw wide, or, where minw is finer than the doubles
+   there, one double: walls gets parts-1 values, lo < walls[0] < ... < hi. Returns 0 when
+   that cannot be (fewer than parts-1 doubles lie strictly between lo and hi: the caller
+   keeps the walls it has), else 1. Reorders pts (sorted along axis). */
+int vw__cut(vw__lpt *pts, long n, int axis, double lo, double hi, int parts, double minw,
+            double *walls);
 
-/* Tensor walls in frame F over world box (frame coordinates) wb: walls[a] dims[a]-1. */
+/* Tensor walls in frame F over world box (frame coordinates) wb: walls[a] dims[a]-1.
+   *fits 0 when some axis of wb is too thin for its cells (vw__cut). */
 vw_status vw__tensor_walls(const vw_load_field *f, const double *F, const vw_box *wb,
-                           const int dims[3], double minw_frac, double *walls[3]);
+                           const int dims[3], double minw_frac, double *walls[3], int *fits);
 
 vw_status vw__balance_tensor(const vw_decomp *cur, const vw_load_field *f,
                              const vw_balance_params *p, const int dims[3], vw_decomp **out);

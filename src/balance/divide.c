@@ -63,9 +63,9 @@ vw_status vw__balance_divide(const vw_decomp *cur, const vw_load_field *f,
         for (int a = 1; a < 3; a++)
             if (b.hi[a] - b.lo[a] > b.hi[axis] - b.lo[axis]) axis = a;
         double split;
-        vw__cut(tmp, m, axis, b.lo[axis], b.hi[axis], 2,
-                p->min_width * (wb.hi[axis] - wb.lo[axis]), &split);
-        if (!(split > b.lo[axis] && split < b.hi[axis])) break; /* too thin to divide */
+        if (!vw__cut(tmp, m, axis, b.lo[axis], b.hi[axis], 2,
+                     p->min_width * (wb.hi[axis] - wb.lo[axis]), &split))
+            break; /* too thin to divide: no double lies inside the cell */
         /* The leaf becomes a wall with the old cell on its low side, a new cell above. */
         nn = vw__kd_divide(nodes, nn, heavy, axis, split, nc);
         nc++;

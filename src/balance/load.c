@@ -251,10 +251,33 @@ CMP_AXIS(cmp_x, 0)
 CMP_AXIS(cmp_y, 1)
 CMP_AXIS(cmp_z, 2)
 
-void vw__cut(vw__lpt *pts, long n, int axis, double lo, double hi, int parts, double minw,
-             double *walls)
+/* Walls keep at least minw apart and from lo and hi: forward from lo, then backward from
+   hi (which wins when the box is too small for both). Where minw is below the spacing of
+   the doubles there (a box a few units in the last place wide: a scene far from the
+   origin for its size), prev + minw rounds to prev, and walls came out equal, which no
+   decomposition takes; so a wall is also at least the next double past its neighbour.
+   1 when lo < walls[0] < ... < walls[parts-2] < hi. */
+static int clamp_walls(double *walls, int parts, double lo, double hi, double minw)
 {
-    if (parts < 2) return;
+    double prev = lo;
+    for (int k = 0; k < parts - 1; k++) {
+        if (!(walls[k] >= prev + minw)) walls[k] = prev + minw;
+        if (!(walls[k] > prev)) walls[k] = nextafter(prev, INFINITY);
+        prev = walls[k];
+    }
+    double next = hi;
+    for (int k = parts - 2; k >= 0; k--) {
+        if (!(walls[k] <= next - minw)) walls[k] = next - minw;
+        if (!(walls[k] < next)) walls[k] = nextafter(next, -INFINITY);
+        next = walls[k];
+    }
+    return next > lo;
+}
+
+int vw__cut(vw__lpt *pts, long n, int axis, double lo, double hi, int parts, double minw,
+            double *walls)
+{
+    if (parts < 2) return 1;
     if (n > 1) qsort(pts, (size_t)n, sizeof *pts, axis == 0 ? cmp_x : axis == 1 ? cmp_y : cmp_z);
     /* Points with equal coordinates form one group (a cell's k x k sub-grid points share
        their x): each group's mass is spread evenly between the midpoints to the groups
@@ -293,17 +316,12 @@ void vw__cut(vw__lpt *pts, long n, int axis, double lo, double hi, int parts, do
     }
     free(gx);
     free(gw);
-    /* Walls never cross and keep minw apart and from the world's faces: clamp forward
-       from lo, then backward from hi (which wins when the box is too small for both). */
+    /* Walls never cross and keep minw apart and from the world's faces. */
     if (minw * parts > hi - lo) minw = (hi - lo) / parts * 0.5;
-    double prev = lo;
-    for (int k = 0; k < parts - 1; k++) {
-        if (!(walls[k] >= prev + minw)) walls[k] = prev + minw;
-        prev = walls[k];
-    }
-    double next = hi;
-    for (int k = parts - 2; k >= 0; k--) {
-        if (!(walls[k] <= next - minw)) walls[k] = next - minw;
-        next = walls[k];
-    }
+    if (!(minw >= 0)) minw = 0;
+    if (clamp_walls(walls, parts, lo, hi, minw)) return 1;
+    /* minw, rounded at the walls' magnitude, can still ask more than the box has: one
+       double apart is all a wall needs. Without minw the clamp fails only when fewer
+       than parts - 1 doubles lie strictly between lo and hi. */
+    return clamp_walls(walls, parts, lo, hi, 0);
 }

@@ -16,6 +16,7 @@ typedef struct stag {
     int nn;
     const int *dims;
     double minw[3];
+    int thin; /* a slab or column too thin for its cuts at the doubles' resolution */
 } stag;
 
 /* Points of pts[0..n) with lo <= x[axis] < hi moved to the front; returns their count. */
@@ -51,7 +52,8 @@ static int pieces(stag *s, vw__lpt *pts, long n, vw_box box, int axis, const dou
     s->nodes[me].split = b[mid];
     s->nodes[me].cell = -1;
     int l = pieces(s, pts, n, box, axis, b, i0, mid, idx);
-    int r = pieces(s, pts, n, box, axis, b, mid, i1, idx);
+    int r = l < 0 ? -1 : pieces(s, pts, n, box, axis, b, mid, i1, idx);
+    if (r < 0) return -1;
     s->nodes[me].left = l;
     s->nodes[me].right = r;
     return me;
@@ -76,8 +78,14 @@ static int build(stag *s, vw__lpt *pts, long n, vw_box box, int axis, int idx[3]
     if (!b) return -1;
     b[0] = box.lo[axis];
     b[parts] = box.hi[axis];
-    /* This slab's (column's) own cut: only its points count. */
-    vw__cut(pts, n, axis, box.lo[axis], box.hi[axis], parts, s->minw[axis], b + 1);
+    /* This slab's (column's) own cut: only its points count. Every cut spans the world
+       box on its axis, but that may be narrower than a double per cut (vw__cut): then
+       there is no tree to build, and the balancer keeps the walls it has. */
+    if (!vw__cut(pts, n, axis, box.lo[axis], box.hi[axis], parts, s->minw[axis], b + 1)) {
+        s->thin = 1;
+        free(b);
+        return -1;
+    }
     int me = pieces(s, pts, n, box, axis, b, 0, parts, idx);
     free(b);
     return me;
@@ -104,7 +112,10 @@ vw_status vw__balance_staggered(const vw_decomp *cur, const vw_load_field *f,
     for (int a = 0; a < 3; a++) s.minw[a] = p->min_width * (wb.hi[a] - wb.lo[a]);
     int idx[3] = {0, 0, 0};
     vw_status st = build(&s, pts, n, wb, 0, idx) < 0 ? VW_E_NOMEM : VW_OK;
-    if (st == VW_OK) st = vw_decomp_create_kd(&wb, s.nodes, s.nn, F, VW_DECOMP_STAGGERED, out);
+    if (s.thin) /* a balancer that cannot improve is no error: the walls stay */
+        st = vw_decomp_clone(cur, out);
+    else if (st == VW_OK)
+        st = vw_decomp_create_kd(&wb, s.nodes, s.nn, F, VW_DECOMP_STAGGERED, out);
     free(s.nodes);
     free(pts);
     return st;

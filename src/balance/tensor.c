@@ -17,31 +17,37 @@
 #include <string.h>
 
 vw_status vw__tensor_walls(const vw_load_field *f, const double *F, const vw_box *wb,
-                           const int dims[3], double minw_frac, double *walls[3])
+                           const int dims[3], double minw_frac, double *walls[3], int *fits)
 {
     vw__lpt *pts;
+    *fits = 1;
     long n = vw__field_points(f, F, &pts);
     if (n < 0) return VW_E_NOMEM;
     for (int a = 0; a < 3; a++) {
         if (dims[a] < 2) continue;
         double ext = wb->hi[a] - wb->lo[a];
-        vw__cut(pts, n, a, wb->lo[a], wb->hi[a], dims[a], minw_frac * ext, walls[a]);
+        if (!vw__cut(pts, n, a, wb->lo[a], wb->hi[a], dims[a], minw_frac * ext, walls[a]))
+            *fits = 0;
     }
     free(pts);
     return VW_OK;
 }
 
+/* The tensor walls in frame F over wb as a grid; *out NULL (and VW_OK) when they do not
+   fit: wb is too thin on some axis for its cells at the resolution of the doubles. */
 static vw_status tensor_in_frame(const vw_load_field *f, const double *F, const vw_box *wb,
                                  const int dims[3], double minw, vw_decomp **out)
 {
     double *walls[3] = {0};
     vw_status st = VW_OK;
+    int fits = 0;
+    *out = NULL;
     for (int a = 0; a < 3 && st == VW_OK; a++) {
         walls[a] = malloc(sizeof(double) * (size_t)(dims[a] > 1 ? dims[a] - 1 : 1));
         if (!walls[a]) st = VW_E_NOMEM;
     }
-    if (st == VW_OK) st = vw__tensor_walls(f, F, wb, dims, minw, walls);
-    if (st == VW_OK) {
+    if (st == VW_OK) st = vw__tensor_walls(f, F, wb, dims, minw, walls, &fits);
+    if (st == VW_OK && fits) {
         const double *cw[3] = {walls[0], walls[1], walls[2]};
         st = vw_decomp_create_grid_walls(wb, dims, cw, F, out);
     }
@@ -64,7 +70,10 @@ vw_status vw__balance_tensor(const vw_decomp *cur, const vw_load_field *f,
                              const vw_balance_params *p, const int dims[3], vw_decomp **out)
 {
     vw_box wb = vw_decomp_world(cur);
-    return tensor_in_frame(f, vw_decomp_frame(cur), &wb, dims, p->min_width, out);
+    vw_status st = tensor_in_frame(f, vw_decomp_frame(cur), &wb, dims, p->min_width, out);
+    /* Walls that cannot be moved are kept: a balancer that cannot improve is no error. */
+    if (st == VW_OK && !*out) st = vw_decomp_clone(cur, out);
+    return st;
 }
 
 /* Eigen-decomposition of a symmetric 3x3 matrix by Jacobi rotations: columns of V are
@@ -238,6 +247,7 @@ vw_status vw__balance_rotate(const vw_decomp *cur, const vw_load_field *f,
             vw_decomp *d = NULL;
             st = tensor_in_frame(f, F, &wb, dims, p->min_width, &d);
             if (st != VW_OK) break;
+            if (!d) continue; /* too thin in this frame for its cells: not a candidate */
             double lam = cells_lambda(f, d, p, ld, map);
             if (lam < best_lam - 1e-9) {
                 vw_decomp_free(best);

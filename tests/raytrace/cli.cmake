@@ -333,6 +333,39 @@ foreach(case "1 0 5;1 0 0;s 1 0 0 1e-20" "1e16 0 5;1e16 0 0;s 1e16 0 0 1"
     message(FATAL_ERROR "'${sphere}' seen from ${eye}: the PNG on 4x4x4 cells is not that on one")
   endif()
 endforeach()
+# ... and balanced: where min_width (1e-3 of the extent) is finer than the doubles, a wall
+# min_width past its neighbour was the neighbour itself, and --balance staggered (rotate
+# too, by chance of the busy times) failed with "vw_balance_world: invalid argument",
+# exit 1. Every --balance renders the unbalanced PNG, by counted work and by busy time;
+# a wall of triangles at x = 1e16, 35 doubles a cell on x, shows something to compare.
+file(WRITE ${WORK}/thin_wall.nff "v\nfrom 9999999999900000 20000 30000\nat 1e16 0 0\nup 0 0 1\n"
+     "angle 60\nhither 1\nresolution 24 24\nb 0.1 0.1 0.1\nl 9999999999950000 0 80000\n"
+     "l 9999999999950000 -80000 -20000\nf 1 0.2 0.2 1 0 0 0 0\n"
+     "p 3\n1e16 -50000 -50000\n1e16 50000 -50000\n1e16 0 50000\nf 0.2 1 0.2 1 0 0 0 0\n"
+     "p 3\n1e16 -50000 50000\n1e16 -40000 -10000\n1e16 -10000 50000\n")
+foreach(scene thin_s_1e16_0_0_1 thin_s_1_0_0_1e-20 thin_wall)
+  file(REMOVE ${WORK}/bal_ref.png)
+  execute_process(COMMAND ${VWALLS} render ${WORK}/${scene}.nff -o ${WORK}/bal_ref.png --quiet
+                          --cells 4x4x4 --workers 2 RESULT_VARIABLE rc ERROR_VARIABLE err)
+  if(NOT rc EQUAL 0)
+    message(FATAL_ERROR "${scene}.nff on 4x4x4 cells: exit ${rc} (${err})")
+  endif()
+  foreach(bal none tensor rotate staggered divide duplicate)
+    foreach(load segments busy)
+      set(out ${WORK}/bal_${bal}_${load}.png)
+      file(REMOVE ${out})
+      execute_process(COMMAND ${VWALLS} render ${WORK}/${scene}.nff -o ${out} --quiet
+                              --cells 4x4x4 --workers 2 --balance ${bal} --balance-load ${load}
+                      RESULT_VARIABLE rc ERROR_VARIABLE err)
+      execute_process(COMMAND ${CMAKE_COMMAND} -E compare_files ${WORK}/bal_ref.png ${out}
+                      RESULT_VARIABLE same)
+      if(NOT rc EQUAL 0 OR NOT same EQUAL 0)
+        message(FATAL_ERROR "${scene}.nff on 4x4x4 cells, --balance ${bal} --balance-load "
+                            "${load}: exit ${rc}, PNG the unbalanced one: ${same} (0: yes) ${err}")
+      endif()
+    endforeach()
+  endforeach()
+endforeach()
 # A pre-pass option without a pre-pass is said to do nothing (and renders); with one, not.
 foreach(case "--balance-iters;3;warn" "--prepass;2;warn" "--balance-load;segments;warn"
              "--prepass;2;--balance;tensor;quiet")

@@ -50,8 +50,13 @@ static void help(void)
            "                       element keeps 4^N fine cells, about 60 bytes each)\n"
            "  --max-shots N        stop after the round that reaches N shots (not\n"
            "                       converged; a round makes up to --per-round per cell)\n"
+           "  --stall-shots N      stop, stalled, when the last N shots absorbed or let escape\n"
+           "                       less than sf of the emitted power (checked every N shots;\n"
+           "                       default %d): a closed scene that reflects everything in a\n"
+           "                       channel (Kd 1) spends nothing and would run for ever\n"
            "  --csv FILE           per polygon: id, area, reflectance, emission, radiosity (the\n"
-           "                       values used: reflectance clamped to [0, 1], with a warning)\n"
+           "                       values used: reflectance clamped to [0, 1], with a warning;\n"
+           "                       a reflectance of 1 warns that the solve may stall)\n"
            "  --image FILE         picture from the scene's camera (or --view): .png (tone\n"
            "                       mapped) or .pfm (float: radiosity, not tone mapped)\n"
            "  --view F,A[,FOV]     camera: from x,y,z, at x,y,z, vertical angle (degrees,\n"
@@ -74,7 +79,7 @@ static void help(void)
            "  --quiet              no progress bar and no summary\n"
            "  --help               this text\n"
            "\nexit status: 0 success, 2 bad input or usage, 1 any other failure\n",
-           RAD_MAX_RES);
+           RAD_MAX_RES, RAD_STALL_SHOTS);
 }
 
 typedef struct run_ctx {
@@ -299,6 +304,10 @@ int vw_cmd_radiosity(int argc, char **argv)
             VALUE();
             if (vw_cli_int(CMD, a, v, 1, 0x7fffffffL, &lv)) return VW_EXIT_USAGE;
             o.max_shots = lv;
+        } else if (!strcmp(a, "--stall-shots")) {
+            VALUE();
+            if (vw_cli_int(CMD, a, v, 1, 0x7fffffffL, &lv)) return VW_EXIT_USAGE;
+            o.stall_shots = lv;
         } else if (!strcmp(a, "--max-rounds")) {
             VALUE();
             if (vw_cli_int(CMD, a, v, 1, 0x7fffffffL, &lv)) return VW_EXIT_USAGE;
@@ -375,10 +384,10 @@ int vw_cmd_radiosity(int argc, char **argv)
         static const char *const names[] = {"--cells", "--cells", "--cells", "--sf", "--hemicube",
                                             "--patch-size", "--elements", "--per-round",
                                             "--neighbourhood", "--subdivide", "--max-level",
-                                            "--max-shots", "--max-rounds"};
+                                            "--max-shots", "--max-rounds", "--stall-shots"};
         const double v[] = {o.dims[0], o.dims[1], o.dims[2], o.sf, o.res, o.patch_size,
                             o.elem_split, o.per_round, o.neighbourhood, o.subdivide,
-                            o.max_level, (double)o.max_shots, o.max_rounds};
+                            o.max_level, (double)o.max_shots, o.max_rounds, (double)o.stall_shots};
         _Static_assert(sizeof v / sizeof v[0] == sizeof names / sizeof names[0], "one name a value");
         if (vw_cli_same_options(CMD, names, v, sizeof v / sizeof v[0])) return VW_EXIT_USAGE;
     }
@@ -486,12 +495,15 @@ int vw_cmd_radiosity(int argc, char **argv)
     int converged = 0;
     st = rad_solver_run(s, on_progress, &r, &converged, err, sizeof err);
     vw_progress_end(&r.bar);
+    int64_t stall_span = 0;
+    double stall_lost = 0;
+    int stalled = st == VW_OK && rad_solver_stalled(s, &stall_span, &stall_lost);
     if (st != VW_OK || r.failed) {
         if (st != VW_OK) vw_cli_error(CMD, "%s", err);
         rc = VW_EXIT_FAIL;
         goto done;
     }
-    if (o.max_rounds > 0 && !converged) {
+    if (o.max_rounds > 0 && !converged && !stalled) {
         /* Stopped on purpose, as if killed: the checkpoint is the only output. */
         if (o.checkpoint && rad_solver_checkpoint(s, o.checkpoint, err, sizeof err) != VW_OK) {
             vw_cli_error(CMD, "%s", err);
@@ -550,11 +562,13 @@ int vw_cmd_radiosity(int argc, char **argv)
             char extra[768], n[7][32];
             snprintf(extra, sizeof extra,
                      "\"radiosity\": {\"shots\": %lld, \"unshot_ratio\": %s, \"energy_error\": %s, "
-                     "\"converged\": %s, \"sf\": %s, \"hemicube\": %d, \"pieces\": %zu, \"elements\": %zu, "
+                     "\"converged\": %s, \"stalled\": %s, \"sf\": %s, \"hemicube\": %d, \"pieces\": %zu, "
+                     "\"elements\": %zu, "
                      "\"emitted\": %s, \"absorbed\": %s, \"unshot\": %s, \"escaped\": %s, "
                      "\"shot_messages\": %lld, \"shot_bytes\": %lld, \"full_messages\": %lld}",
                      (long long)rad_solver_shots(s), json_number(rad_solver_unshot_ratio(s), n[0]),
-                     json_number(L.error, n[1]), converged ? "true" : "false", json_number(o.sf, n[2]),
+                     json_number(L.error, n[1]), converged ? "true" : "false", stalled ? "true" : "false",
+                     json_number(o.sf, n[2]),
                      o.res, mesh.npieces, ne, json_number(L.emitted[0] + L.emitted[1] + L.emitted[2], n[3]),
                      json_number(L.absorbed[0] + L.absorbed[1] + L.absorbed[2], n[4]),
                      json_number(L.unshot[0] + L.unshot[1] + L.unshot[2], n[5]),
@@ -573,13 +587,32 @@ int vw_cmd_radiosity(int argc, char **argv)
             char layout[64];
             vw_decomp_layout_string(d, layout, sizeof layout);
             printf("radiosity: %s, %zu pieces, %zu elements, cells %s, %d worker%s x %d process%s\n",
-                   converged ? "converged" : "stopped", mesh.npieces, ne, layout, vw_world_workers(w),
+                   converged ? "converged" : stalled ? "stalled" : "stopped", mesh.npieces, ne, layout,
+                   vw_world_workers(w),
                    vw_world_workers(w) == 1 ? "" : "s", vw_world_processes(w),
                    vw_world_processes(w) == 1 ? "" : "es");
             printf("shots %lld, unshot ratio %.3g (sf %.3g), energy error %.2e, time %.3f s\n",
                    (long long)rad_solver_shots(s), rad_solver_unshot_ratio(s), o.sf, L.error, t4 - t3);
             printf("shot messages %lld (%lld bytes), full notices %lld\n", (long long)sm, (long long)sb,
                    (long long)fm);
+        }
+        /* A warning (--quiet keeps it): the run ends with exit 0 and its outputs (the
+           solution so far, the unshot power in the display's ambient term), as after
+           --max-shots. */
+        if (stalled) {
+            double spent = stall_lost > 0 ? stall_lost : 0; /* not rounding's -1e-12 */
+            double unshot = (L.unshot[0] + L.unshot[1] + L.unshot[2]) /
+                            (L.emitted[0] + L.emitted[1] + L.emitted[2]);
+            fprintf(stderr, "vwalls radiosity: warning: stalled after %lld shots: the last %lld "
+                            "absorbed or let escape %.3g of the emitted power, less than --sf %g, "
+                            "so the unshot power (%.3g %% of the emitted) is only spread and the "
+                            "largest patch's share (unshot ratio %.3g) may never fall below --sf "
+                            "(a closed scene of reflectance 1?); the outputs hold the solution so "
+                            "far. Give a reflectance below 1, a larger --sf, or a larger "
+                            "--stall-shots than %lld\n",
+                    (long long)rad_solver_shots(s), (long long)stall_span, spent, o.sf, 100 * unshot,
+                    rad_solver_unshot_ratio(s),
+                    (long long)(o.stall_shots > 0 ? o.stall_shots : RAD_STALL_SHOTS));
         }
         /* sf bounds the largest patch's share of the emitted power: emitters meshed
            into more than 1/sf patches start below it, and nothing is lit. A warning, so

@@ -50,6 +50,14 @@ typedef struct rad_piece {
     double rho[3], emit[3]; /* reflectance; emitted radiosity (power per area) */
 } rad_piece;
 
+/* The default --stall-shots. A solve whose every shot loses (absorbs or lets escape)
+   at least 1/RAD_STALL_SHOTS of its power cannot stall: each shot carries at least sf
+   of the emitted power (the threshold; on one cell, where no wall cuts a patch), so a
+   stretch of RAD_STALL_SHOTS shots loses at least sf of it. Only a scene reflecting more than 99.99 % of what it receives can
+   stall, and a closed one with a reflectance of 1 in some channel does (nothing is
+   absorbed there, so the unshot power only spreads). */
+#define RAD_STALL_SHOTS 10000
+
 typedef struct rad_options {
     double sf;              /* stop when max unshot / emitted < sf */
     int res;                /* hemicube resolution (even, <= RAD_MAX_RES) */
@@ -62,6 +70,9 @@ typedef struct rad_options {
     double subdivide;       /* > 0: adaptive subdivision threshold (relative) */
     int max_level;          /* deepest subdivision level (<= RAD_MAX_LEVEL) */
     int64_t max_shots;      /* > 0: stop after this many shots (not converged) */
+    /* Stop, stalled, when less than sf of the emitted power (r+g+b) was absorbed or
+       escaped over this many shots (solve.c, RAD_STALL_SHOTS; rad_solver_stalled). */
+    int64_t stall_shots;
     int max_rounds;         /* > 0: stop after this many rounds (testing a kill) */
     const char *checkpoint; /* file to write checkpoints to, or NULL */
     double checkpoint_every;/* seconds between checkpoints (0: every round) */
@@ -109,6 +120,10 @@ double rad_default_patch_size(const vw_scene *s);
    emission clamped to >= 0. The one definition for the mesher and the CSV. Returns 1
    when the reflectance had to be clamped (NaN counts, and becomes 0). */
 int rad_material(const vw_material *mt, double rho[3], double emit[3]);
+/* 1 when a reflectance the solver uses (rad_material's rho) is 1 in some channel: such
+   a surface absorbs nothing of that channel, and a closed scene of them never loses
+   the power it emits there (the mesher warns; the solve stops as stalled). */
+int rad_reflects_all(const double rho[3]);
 
 /* Geometry helpers shared with the module and the outputs. */
 typedef struct rad_poly {
@@ -219,9 +234,16 @@ typedef void (*rad_progress_fn)(void *user, double unshot_ratio, int64_t shots);
 vw_status rad_solver_create(const rad_mesh *m, const vw_decomp *d, const rad_options *o,
                             rad_solver **out, char *err, size_t errlen);
 void rad_solver_free(rad_solver *s);
-/* Runs rounds until converged (or a limit of the options). *converged tells which. */
+/* Runs rounds until converged (or a limit of the options, or stalled: see
+   rad_solver_stalled). *converged tells whether it converged. */
 vw_status rad_solver_run(rad_solver *s, rad_progress_fn progress, void *user, int *converged,
                          char *err, size_t errlen);
+/* 1 when the last rad_solver_run stopped because the solve stalled: over the last
+   *span shots (about stall_shots, at least half, counted between two reports) only
+   *lost of the emitted power (r+g+b, a fraction) was absorbed or escaped, less than sf,
+   so the unshot power was only spread, not spent. Every process knows whether; span and lost
+   are valid on the output process (may be NULL). */
+int rad_solver_stalled(const rad_solver *s, int64_t *span, double *lost);
 /* Gathers the results on the output process (elements sorted by piece, level, gi, gj).
    Collective under MPI, like run: every process calls it; the results, the ledger and
    the unshot ratio below are valid on the output process only. */

@@ -570,6 +570,58 @@ static int output_says_yes(rad_solver *s, int yes)
     return vw_world_agree(s->w, mine, msg, sizeof msg) != VW_OK;
 }
 
+/* The power the shots so far have spent (absorbed or let escape), r+g+b, as the last
+   reports tell it (output process). */
+static double lost_sum(const rad_solver *s)
+{
+    const rad_ledger *L = &s->ledger;
+    return rad_sum3(L->absorbed) + rad_sum3(L->escaped);
+}
+
+/* The stall rule, after a round on every process: is it time to stop because the
+   shots no longer spend the unshot power? Every stall_shots shots (the global count,
+   which every process knows) the output process compares the power lost since the
+   last check with sf of the emitted power, and all agree on its answer (one agreement
+   a check, not one a round). A shot carries at least sf of the emitted power (the
+   threshold), so a scene whose every shot absorbs or lets escape at least
+   1/stall_shots of its power loses sf over the stretch and is never stopped; only a
+   surface of reflectance (nearly) 1 in a closed scene keeps the power circulating, and
+   there the largest patch's share may stay above sf for ever. The powers are the
+   reports', which lag by a round (they describe the round's start), on both ends of
+   the stretch alike. Walls change the rounds and the order of the shots, not the
+   rule: every layout stops, within a round of each other. */
+static int stall_check(rad_solver *s)
+{
+    int64_t every = s->opt.stall_shots > 0 ? s->opt.stall_shots : RAD_STALL_SHOTS;
+    int out = vw_world_is_output(s->w);
+    int64_t reported = s->base_shots + s->rep.nshots;
+    if (out && s->stall_at_reported < 0) { /* the first round's reports: the run's start */
+        s->stall_at_reported = reported;
+        s->stall_lost_at = lost_sum(s);
+    }
+    if (s->shots - s->stall_at < every) return 0;
+    s->stall_at = s->shots;
+    /* A stretch the reports saw only part of (the first, after rounds larger than
+       stall_shots) is too short to judge: the next check judges. */
+    double lost = out ? lost_sum(s) - s->stall_lost_at : 0;
+    int64_t span = reported - s->stall_at_reported;
+    int yes = output_says_yes(s, out && span >= every / 2 && !(lost >= s->opt.sf * s->emitted_sum));
+    if (out) {
+        s->stall_span = span;
+        s->stall_lost = s->emitted_sum > 0 ? lost / s->emitted_sum : 0;
+        s->stall_at_reported = reported;
+        s->stall_lost_at = lost_sum(s);
+    }
+    return yes;
+}
+
+int rad_solver_stalled(const rad_solver *s, int64_t *span, double *lost)
+{
+    if (span) *span = s->stall_span;
+    if (lost) *lost = s->stall_lost;
+    return s->stalled;
+}
+
 vw_status rad_solver_run(rad_solver *s, rad_progress_fn progress, void *user, int *converged,
                          char *err, size_t errlen)
 {
@@ -577,6 +629,9 @@ vw_status rad_solver_run(rad_solver *s, rad_progress_fn progress, void *user, in
     int ncells = vw_decomp_cell_count(s->d);
     double last_ck = now();
     int rounds = 0;
+    s->stalled = 0;
+    s->stall_at = s->shots;
+    s->stall_at_reported = -1;
     for (;;) {
         rad_go_msg g;
         memset(&g, 0, sizeof g);
@@ -608,6 +663,10 @@ vw_status rad_solver_run(rad_solver *s, rad_progress_fn progress, void *user, in
             break;
         }
         if (s->opt.max_shots > 0 && s->shots >= s->opt.max_shots) break;
+        if (stall_check(s)) {
+            s->stalled = 1;
+            break;
+        }
         if (s->opt.checkpoint && output_says_yes(s, now() - last_ck >= s->opt.checkpoint_every)) {
             st = rad_solver_checkpoint(s, s->opt.checkpoint, err, errlen);
             if (st != VW_OK) return st;

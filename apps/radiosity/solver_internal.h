@@ -91,6 +91,13 @@ struct rad_solver {
     double base_absorbed[3], base_escaped[3];  /* from a resumed checkpoint */
     int64_t base_shots;
     int64_t shots;
+    /* The stall rule (solve.c, stall_check): the shots and the power lost (absorbed +
+       escaped, r+g+b, output process) at the last check, and what stopped the run. */
+    int64_t stall_at, stall_at_reported;
+    double stall_lost_at;
+    int stalled;
+    int64_t stall_span;
+    double stall_lost;
     double ratio;
     rad_ledger ledger;
     rad_elem_result *elems;

@@ -7,7 +7,8 @@
 #    back wall is made 3.2 mm off planar for it, as the published red wall is and as
 #    `gen cornell` once wrote it);
 #  - --checkpoint-every under MPI (rank 0's clock decides for all): a job stopped after a
-#    checkpoint resumes under MPI to the solution; a missing checkpoint fails every rank.
+#    checkpoint resumes under MPI to the solution; a missing checkpoint fails every rank;
+#  - a closed box of Kd 1 stops, stalled, on every rank together (--stall-shots).
 set -u
 NP=$1 V=$2 TR=$3 T=$4
 shift 4
@@ -76,4 +77,24 @@ $LAUNCH "$V" radiosity "$T/cornell.nff" --cells 2x2x2 --workers 1 $common --csv 
 [ $rc -ne 0 ] || fail "missing checkpoint: exit 0"
 grep -q "cannot open checkpoint" "$T/missing.err" || fail "missing checkpoint: $(cat "$T/missing.err")"
 [ ! -e "$T/x.csv" ] || fail "missing checkpoint: output written"
+
+# A closed box of Kd 1 (closed.sh) stalls under MPI too: the stall check is an
+# agreement every --stall-shots shots (rank 0 judges by the ledger, every rank stops
+# after the same round), one warning of each kind from rank 0, exit 0 on every rank.
+SRC=$(dirname "$0")
+cp "$SRC/closed_box.obj" "$SRC/closed_white.mtl" "$T/" || fail "closed box: copy"
+tag="np${NP}_stall"
+$LAUNCH "$V" radiosity "$T/closed_box.obj" --cells 2x2x2 --workers 1 --patch-size 0.5 --hemicube 16 \
+  --stall-shots 1000 --max-shots 20000 --quiet --stats "$T/$tag.json" 2>"$T/$tag.err" ||
+  fail "$tag: exit $? ($(cat "$T/$tag.err"))"
+python3 - "$T/$tag.json" <<'PY' || fail "$tag: $(cat "$T/$tag.json")"
+import json, sys
+r = json.load(open(sys.argv[1]))["radiosity"]
+print(f"  stalled {r['stalled']} after {r['shots']} shots, energy error {r['energy_error']:.2e}")
+sys.exit(0 if r["stalled"] and not r["converged"] and 1000 <= r["shots"] < 1200
+         and r["energy_error"] <= 1e-9 else 1)
+PY
+[ "$(grep -c "warning: stalled after" "$T/$tag.err")" -eq 1 ] &&
+  [ "$(grep -c "closed_box.obj:47: warning: reflectance 1 1 1" "$T/$tag.err")" -eq 1 ] ||
+  fail "$tag: warnings $(cat "$T/$tag.err")"
 echo "ok"

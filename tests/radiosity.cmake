@@ -55,9 +55,10 @@ add_test(NAME radiosity_input
                  ${CMAKE_CURRENT_BINARY_DIR}/radiosity_input $<TARGET_FILE:test_radiosity>)
 set_tests_properties(radiosity_input PROPERTIES LABELS "radiosity;threads" TIMEOUT 60)
 
-# A closed box of Kd 1 absorbs nothing: a warning before the solve names the polygon's
-# line, and the solve stops, stalled, after --stall-shots shots that spend less than sf
-# (on 1, 2x2x2 and 6x6x6 cells); absorbing and open boxes converge as before.
+# A closed box of Kd 1 absorbs nothing: a warning before the solve names the material's
+# Kd line and the first polygon's, and the solve stops, stalled, after --stall-shots
+# shots that spend less than sf (on 1, 2x2x2 and 6x6x6 cells); absorbing and open boxes
+# converge as before.
 add_test(NAME radiosity_closed
          COMMAND sh ${PROJECT_SOURCE_DIR}/tests/radiosity/closed.sh $<TARGET_FILE:vwalls_tool>
                  ${PROJECT_SOURCE_DIR}/tests/radiosity ${CMAKE_CURRENT_BINARY_DIR}/radiosity_closed)

@@ -234,6 +234,41 @@ static void where(char *out, size_t len, const char *path, const vw_polygon *pg,
         snprintf(out + n, len - (size_t)n, ": polygon %zu", k);
 }
 
+/* How the two reflectance warnings begin, and which polygon they name. A material read
+   from a file is named where it was defined, "FILE:LINE: warning: material 'NAME': "
+   (an MTL Kd line, an NFF 'f'), so that the user finds the value to change; the first
+   polygon that uses it is then given as ", PATH:LINE" after its id (polyref). One from
+   no file (a generated scene, a default) is named by that polygon, as where() does. */
+static void material_where(char *head, size_t hlen, char *name, size_t nlen, char *polyref,
+                           size_t plen, const vw_scene *s, const vw_material *mat,
+                           const char *path, const vw_polygon *pg, size_t k, size_t nfile,
+                           const rad_mesh *m)
+{
+    const char *file = vw_scene_string(s, mat->file), *nm = vw_scene_string(s, mat->name);
+    name[0] = polyref[0] = '\0';
+    if (!file) {
+        where(head, hlen, path, pg, k, nfile, m);
+        return;
+    }
+    if (mat->line > 0)
+        snprintf(head, hlen, "%s:%d", file, mat->line);
+    else
+        snprintf(head, hlen, "%s", file);
+    if (nm) {
+        /* A file's name may hold anything: shown printable and bounded, as the readers do. */
+        char shown[48];
+        size_t n = strlen(nm), i, j = 0;
+        for (i = 0; i < n && j < 40; i++) {
+            unsigned char c = (unsigned char)nm[i];
+            shown[j++] = c >= 0x20 && c < 0x7f && c != '\'' ? (char)c : '?';
+        }
+        if (i < n) memcpy(shown + j, "...", 3), j += 3;
+        shown[j] = '\0';
+        snprintf(name, nlen, "material '%s': ", shown);
+    }
+    if (pg->line > 0) snprintf(polyref, plen, ", %s:%d", path ? path : "scene", pg->line);
+}
+
 static int push_piece(rad_mesh *m, size_t *cap, const rad_piece *pc, int owner)
 {
     if (m->npieces == *cap) {
@@ -824,14 +859,15 @@ vw_status rad_mesh_build(const vw_scene *s, const char *path, const vw_decomp *d
     if (st == VW_OK && nclamped && !o->quiet) {
         const vw_polygon *pg = &s->polygons[first_clamped];
         const vw_material *mat = &s->materials[pg->material];
-        char at[512];
-        where(at, sizeof at, path, pg, first_clamped, s0->npolygons, m);
+        char at[512], name[64], polyref[512];
+        material_where(at, sizeof at, name, sizeof name, polyref, sizeof polyref, s, mat, path, pg,
+                       first_clamped, s0->npolygons, m);
         int facet = first_clamped >= s0->npolygons;
         fprintf(stderr,
-                "%s: warning: reflectance %g %g %g of %s (id %d) is outside [0, 1], clamped "
+                "%s: warning: %sreflectance %g %g %g of %s (id %d%s) is outside [0, 1], clamped "
                 "(%zu polygon%s in all); the solver and the CSV use the clamped values\n",
-                at, mat->diffuse[0], mat->diffuse[1], mat->diffuse[2], facet ? "object" : "polygon",
-                facet ? (int)m->facet_object[pg->id - m->facet_base] : pg->id, nclamped,
+                at, name, mat->diffuse[0], mat->diffuse[1], mat->diffuse[2], facet ? "object" : "polygon",
+                facet ? (int)m->facet_object[pg->id - m->facet_base] : pg->id, polyref, nclamped,
                 nclamped == 1 ? "" : "s");
     }
     /* A surface of reflectance 1 absorbs nothing in that channel: in a closed scene of
@@ -843,17 +879,18 @@ vw_status rad_mesh_build(const vw_scene *s, const char *path, const vw_decomp *d
     if (st == VW_OK && nwhite && !o->quiet) {
         const vw_polygon *pg = &s->polygons[first_white];
         const vw_material *mat = &s->materials[pg->material];
-        char at[512];
-        where(at, sizeof at, path, pg, first_white, s0->npolygons, m);
+        char at[512], name[64], polyref[512];
+        material_where(at, sizeof at, name, sizeof name, polyref, sizeof polyref, s, mat, path, pg,
+                       first_white, s0->npolygons, m);
         int facet = first_white >= s0->npolygons;
         fprintf(stderr,
-                "%s: warning: reflectance %g %g %g of %s (id %d) is 1 or more in a channel, so it "
+                "%s: warning: %sreflectance %g %g %g of %s (id %d%s) is 1 or more in a channel, so it "
                 "absorbs nothing there (%zu polygon%s in all, lights not counted): in a closed "
                 "scene the solve may be slow or not reach --sf %g; it stops, stalled, when %lld "
                 "shots (--stall-shots) absorb or let escape less than sf of the emitted power. "
                 "Give --max-shots, or a reflectance below 1 (Kd 0.9, say)\n",
-                at, mat->diffuse[0], mat->diffuse[1], mat->diffuse[2], facet ? "object" : "polygon",
-                facet ? (int)m->facet_object[pg->id - m->facet_base] : pg->id, nwhite,
+                at, name, mat->diffuse[0], mat->diffuse[1], mat->diffuse[2], facet ? "object" : "polygon",
+                facet ? (int)m->facet_object[pg->id - m->facet_base] : pg->id, polyref, nwhite,
                 nwhite == 1 ? "" : "s", o->sf,
                 (long long)(o->stall_shots > 0 ? o->stall_shots : RAD_STALL_SHOTS));
     }

@@ -27,6 +27,21 @@ typedef struct vw_material {
     float ior;          /* index of refraction (NFF ior, MTL Ni); 1 when absent, and
                            for an MTL illum other than 6 or 7 (no refraction) */
     float emission[3];  /* MTL Ke, NFF '#vw Ke' after an 'f'; zero otherwise */
+    /* Where the material was defined, so that a problem found after parsing (a
+       reflectance the radiosity solver clamps) can be reported as file:line. These are
+       not values: the fields above are the material, and neither vw_scene_fingerprint,
+       the NFF writer nor NFF's sharing of equal materials looks past them. file and
+       name are numbers of strings of the scene (vw_scene_string), 0 for none, so that a
+       material stays plain data and a file's name is kept once however many materials
+       it defines. A zeroed material has no place and no name. */
+    int line;           /* MTL: its Kd line (the reflectance), else its newmtl; NFF: its
+                           'f'; PLY (ASCII): the face record that gave its colour (its
+                           own or its corners' mean); 0: none (a default material, a
+                           generated scene, binary PLY data) */
+    int file;           /* the file it was read from (MTL: the library's path as the
+                           reader opened it; NFF, PLY: the name given to the reader);
+                           0 for a default material and a generated scene */
+    int name;           /* MTL: its newmtl (or usemtl) name; 0 in NFF and PLY */
 } vw_material;
 
 typedef struct vw_light {
@@ -84,6 +99,10 @@ typedef struct vw_scene {
        normals. */
     int *indices;           size_t nindices;
     double (*normals)[3];
+    /* The strings that materials' file and name number (strings[k - 1] is string k):
+       each file's name once, however many materials it defines. The scene owns them
+       (vw_scene_free frees them); a scene a program builds may leave them NULL and 0. */
+    char **strings;         size_t nstrings;
 } vw_scene;
 
 /* Parsers. On failure they return VW_E_INPUT and write "file:line: message" into
@@ -135,8 +154,12 @@ VW_API vw_status vw_scene_write_nff_file(const vw_scene *s, const char *path,
 
 /* Queries */
 VW_API size_t vw_scene_count_objects(const vw_scene *s);
+/* String k of the scene (a material's file or name), or NULL when k is 0 or not one of
+   its strings. */
+VW_API const char *vw_scene_string(const vw_scene *s, int k);
 /* A 64-bit hash (FNV-1a) of everything in the scene but its camera: objects, vertices
-   and normals, materials, lights, background, value by value. The same file read by the
+   and normals, materials (their values, not where they were defined), lights,
+   background, value by value. The same file read by the
    same binary gives the same fingerprint; the commands compare it between MPI processes
    (the camera is compared with the command line's overrides, as the view). */
 VW_API uint64_t vw_scene_fingerprint(const vw_scene *s);

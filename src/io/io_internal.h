@@ -8,6 +8,7 @@
 #define VW_IO_INTERNAL_H
 
 #include <stdarg.h>
+#include <stddef.h>
 #include <stdio.h>
 #include "vwalls/scene.h"
 
@@ -45,7 +46,7 @@ int vw__parse_double(const char *s, size_t n, double *out);
 typedef struct vw__sb {
     vw_scene *s;
     size_t cap_lights, cap_materials, cap_spheres, cap_cones, cap_polygons;
-    size_t cap_vertices, cap_indices;
+    size_t cap_vertices, cap_indices, cap_strings;
     int next_id;
     int line;                /* the reader's: the line of the object being added */
     size_t poly_first;       /* first index of the polygon being built */
@@ -60,13 +61,20 @@ void vw__sb_abort(vw__sb *b);
 /* A reader's end: with st == VW_OK the scene goes to *out, else it is freed. Returns st. */
 vw_status vw__sb_close(vw__sb *b, vw_status st, vw_scene **out);
 
+/* The bytes of a vw_material that are its values: all floats, no padding, so that
+   equal materials compare and hash alike whatever their file, line and name. */
+#define VW__MATERIAL_VALUE_BYTES offsetof(vw_material, line)
+
 void vw__default_material(vw_material *m);
+/* Copies str[0..n) into the scene's strings; *k gets its number (vw_scene_string). */
+vw_status vw__sb_add_string(vw__sb *b, const char *str, size_t n, int *k);
 vw_status vw__sb_add_light(vw__sb *b, const double pos[3], const float color[3]);
 /* Appends a material unconditionally (OBJ: names matter, values may repeat). */
 vw_status vw__sb_add_material(vw__sb *b, const vw_material *m, int *index);
-/* Returns the index of a bit-identical material, adding it if there is none. NFF
-   has no material names, so equal values are the same material; this is also what
-   makes write-then-read reproduce the material table. */
+/* Returns the index of a material with bit-identical values, adding it if there is
+   none. NFF has no material names, so equal values are the same material (the first
+   one added keeps its file and line); this is also what makes write-then-read
+   reproduce the material table. */
 vw_status vw__sb_intern_material(vw__sb *b, const vw_material *m, int *index);
 vw_status vw__sb_add_sphere(vw__sb *b, int material, const double c[3], double r);
 vw_status vw__sb_add_cone(vw__sb *b, int material, const double base[3], double base_r,

@@ -31,6 +31,7 @@ typedef struct lexer {
 
 typedef struct nff {
     const char *name;
+    int file;               /* name as a string of the scene, for its materials */
     lexer lx;
     char *err;
     size_t errlen;
@@ -361,6 +362,9 @@ static vw_status parse_fill(nff *P)
         return st;
     m.specular[1] = m.specular[2] = m.specular[0];
     memcpy(m.reflect, m.specular, sizeof m.reflect);
+    /* Defined by this 'f' (the #vw lines after it only complete it). */
+    m.line = P->entity_line;
+    m.file = P->file;
     P->cur = m;
     P->cur_index = -1;
     P->have_f = 1;
@@ -571,7 +575,8 @@ VW_API vw_status vw_scene_read_nff(const char *name, const char *text, size_t le
         vw__errf(err, errlen, "%s: out of memory", P.name);
         return st;
     }
-    st = parse_all(&P);
+    st = vw__sb_add_string(&P.b, P.name, strlen(P.name), &P.file);
+    st = st == VW_OK ? parse_all(&P) : fail_status(&P, st);
     free(P.nocolor);
     return vw__sb_close(&P.b, st, out);
 }

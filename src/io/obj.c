@@ -38,12 +38,14 @@ typedef struct obj {
     size_t nvt, nvn;
     double (*vn)[3];
     size_t cap_vn;
-    char **mat_names;     /* mat_names[i] names scene material mat_ids[i] */
+    char **mat_names;     /* mat_names[i] names scene material mat_ids[i] (the scene's
+                             string, which the scene owns) */
     int *mat_ids;
     int *mat_wait;        /* the line of the first usemtl of a name no library has defined
                              yet (its material waits, 0.8 grey, for a newmtl); 0 once it is */
     size_t nnames, cap_names;
     int cur_mat;          /* -1: the default material, created on first use */
+    int mtl_file;         /* the library being read, as a string of the scene */
     int default_mat;
     char **warned;        /* what was warned about ("lib PATH", "mat NAME"): once each */
     size_t nwarned, cap_warned;
@@ -328,7 +330,8 @@ static void mtl_apply_illum(vw_material *m, int illum)
 }
 
 /* A material named name, 0.8 grey until its statements say otherwise; wait_line is
-   the line of a usemtl that names it before any library defined it, else 0. */
+   the line of a usemtl that names it before any library defined it, else 0. Its file
+   and line are its newmtl's, set by the caller (a usemtl defines nothing). */
 static vw_status add_named_material(obj *O, span name, int wait_line)
 {
     if (O->nnames == O->cap_names) {
@@ -347,21 +350,17 @@ static vw_status add_named_material(obj *O, span name, int wait_line)
         O->mat_wait = r;
         O->cap_names = ncap;
     }
-    char *copy = malloc(name.n + 1);
-    if (!copy)
-        return fail_status(O, VW_E_NOMEM);
-    memcpy(copy, name.s, name.n);
-    copy[name.n] = '\0';
+    /* The name is the scene's string (the material's name), kept once for both. */
     vw_material m;
     vw__default_material(&m);
     m.diffuse[0] = m.diffuse[1] = m.diffuse[2] = OBJ_DEFAULT_REFLECTANCE;
     int id;
-    vw_status st = vw__sb_add_material(&O->b, &m, &id);
-    if (st != VW_OK) {
-        free(copy);
+    vw_status st = vw__sb_add_string(&O->b, name.s, name.n, &m.name);
+    if (st == VW_OK)
+        st = vw__sb_add_material(&O->b, &m, &id);
+    if (st != VW_OK)
         return fail_status(O, st);
-    }
-    O->mat_names[O->nnames] = copy;
+    O->mat_names[O->nnames] = O->b.s->strings[m.name - 1];
     O->mat_ids[O->nnames] = id;
     O->mat_wait[O->nnames] = wait_line;
     O->nnames++;
@@ -427,12 +426,15 @@ static vw_status parse_mtl(obj *O, const char *text, size_t len)
             if (i >= 0 && O->mat_wait[i]) {
                 O->mat_wait[i] = 0;
                 m = &O->b.s->materials[O->mat_ids[i]];
-                continue;
+            } else {
+                vw_status st = add_named_material(O, name, 0);
+                if (st != VW_OK)
+                    return st;
+                m = &O->b.s->materials[O->b.s->nmaterials - 1];
             }
-            vw_status st = add_named_material(O, name, 0);
-            if (st != VW_OK)
-                return st;
-            m = &O->b.s->materials[O->b.s->nmaterials - 1];
+            /* Defined here; a Kd line moves its line there (see below). */
+            m->file = O->mtl_file;
+            m->line = O->line;
             continue;
         }
         static const char *const known[] = {"Kd", "Ks", "Ke", "Ns", "d", "Tr", "Ni", "illum"};
@@ -479,9 +481,13 @@ static vw_status parse_mtl(obj *O, const char *text, size_t len)
                 return fail_status(O, st);
             continue;
         }
-        if (!strcmp(k, "Kd"))
-            st = mtl_color(O, &line, k, m->diffuse);
-        else if (!strcmp(k, "Ks"))
+        if (!strcmp(k, "Kd")) {
+            /* The line a message about the reflectance (radiosity clamps it) should name:
+               the key's own line (a continuation may have moved O->line past it). */
+            int kd_line = O->line;
+            if ((st = mtl_color(O, &line, k, m->diffuse)) == VW_OK)
+                m->line = kd_line;
+        } else if (!strcmp(k, "Ks"))
             st = mtl_color(O, &line, k, m->specular);
         else if (!strcmp(k, "Ke"))
             st = mtl_color(O, &line, k, m->emission);
@@ -535,15 +541,24 @@ static vw_status load_mtllib(obj *O, const char *dir, span fname)
         free(path);
         return st == VW_OK ? VW_OK : fail_status(O, st);
     }
+    /* The path, kept once in the scene, is the file of every material it defines. */
+    int file;
+    st = vw__sb_add_string(&O->b, path, strlen(path), &file);
+    free(path);
+    if (st != VW_OK) {
+        free(text);
+        return fail_status(O, st);
+    }
     const char *obj_name = O->name;
     int obj_line = O->line, obj_next = O->next_no;
-    O->name = path;
+    O->name = O->b.s->strings[file - 1];
+    O->mtl_file = file;
     st = parse_mtl(O, text, len);
     O->name = obj_name;
     O->line = obj_line;
     O->next_no = obj_next;
+    O->mtl_file = 0;
     free(text);
-    free(path);
     return st;
 }
 
@@ -726,8 +741,6 @@ VW_API vw_status vw_scene_read_obj(const char *name, const char *text, size_t le
         return st;
     }
     st = parse_obj(&O, text ? text : "", len, dir);
-    for (size_t i = 0; i < O.nnames; i++)
-        free(O.mat_names[i]);
     free(O.mat_names);
     for (size_t i = 0; i < O.nwarned; i++)
         free(O.warned[i]);

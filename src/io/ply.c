@@ -46,6 +46,7 @@ typedef struct elem {
 
 typedef struct ply {
     const char *name;
+    int file;                     /* name as a string of the scene, for its materials */
     char *err;
     size_t errlen;
     const unsigned char *p, *end; /* what is left to read */
@@ -485,12 +486,19 @@ static vw_status read_vertices(ply *P, const elem *e)
     return st;
 }
 
+/* The material of a face of colour rgb (NULL: none, the default grey), defined where the
+   colour was: the face's record (P->b.line: its line in ASCII, 0 in binary data). Equal
+   colours share a material, which keeps the place of the first face of that colour. */
 static vw_status material_of(ply *P, const float rgb[3], int *mat)
 {
     vw_material m;
     vw__default_material(&m);
     for (int k = 0; k < 3; k++)
         m.diffuse[k] = rgb ? rgb[k] : PLY_DEFAULT_REFLECTANCE;
+    if (rgb) {
+        m.file = P->file;
+        m.line = P->b.line;
+    }
     if (!rgb && P->default_mat >= 0) {
         *mat = P->default_mat;
         return VW_OK;
@@ -651,7 +659,8 @@ VW_API vw_status vw_scene_read_ply(const char *name, const void *data, size_t le
         vw__errf(err, errlen, "%s: out of memory", P.name);
         return st;
     }
-    st = parse_ply(&P);
+    st = vw__sb_add_string(&P.b, P.name, strlen(P.name), &P.file);
+    st = st == VW_OK ? parse_ply(&P) : fail_status(&P, st);
     for (int i = 0; i < P.nelems; i++)
         free(P.elems[i].props);
     free(P.elems);

@@ -237,9 +237,15 @@ vw_status vw__sb_add_material(vw__sb *b, const vw_material *m, int *index)
     return VW_OK;
 }
 
-/* vw_material is all floats, so there is no padding and bit-identical materials hash
-   alike. */
-static uint64_t material_hash(const vw_material *m) { return vw__fnv1a(VW__FNV_OFFSET, m, sizeof *m); }
+/* A material's values are all floats, so there is no padding and bit-identical values
+   hash alike; where it was defined is not hashed. A value added after `line` would be
+   left out of the hash, the comparison and the fingerprint: this says so at build time. */
+_Static_assert(VW__MATERIAL_VALUE_BYTES == 15 * sizeof(float),
+               "vw_material: its values are the floats before 'line'");
+static uint64_t material_hash(const vw_material *m)
+{
+    return vw__fnv1a(VW__FNV_OFFSET, m, VW__MATERIAL_VALUE_BYTES);
+}
 
 static int mat_hash_insert(int *tab, size_t cap, const vw_material *mats, int index)
 {
@@ -271,7 +277,7 @@ vw_status vw__sb_intern_material(vw__sb *b, const vw_material *m, int *index)
     }
     size_t i = (size_t)material_hash(m) & (b->mat_hash_cap - 1);
     while (b->mat_hash[i] >= 0) {
-        if (memcmp(&s->materials[b->mat_hash[i]], m, sizeof *m) == 0) {
+        if (memcmp(&s->materials[b->mat_hash[i]], m, VW__MATERIAL_VALUE_BYTES) == 0) {
             *index = b->mat_hash[i];
             return VW_OK;
         }
@@ -281,6 +287,23 @@ vw_status vw__sb_intern_material(vw__sb *b, const vw_material *m, int *index)
     if (st != VW_OK)
         return st;
     b->mat_hash[i] = *index;
+    return VW_OK;
+}
+
+vw_status vw__sb_add_string(vw__sb *b, const char *str, size_t n, int *k)
+{
+    vw_scene *s = b->s;
+    if (s->nstrings >= INT32_MAX || n == SIZE_MAX)
+        return VW_E_LIMIT;
+    if (!grow((void **)&s->strings, &b->cap_strings, s->nstrings + 1, sizeof *s->strings))
+        return VW_E_NOMEM;
+    char *copy = malloc(n + 1);
+    if (!copy)
+        return VW_E_NOMEM;
+    memcpy(copy, str, n);
+    copy[n] = '\0';
+    s->strings[s->nstrings++] = copy;
+    *k = (int)s->nstrings;
     return VW_OK;
 }
 
@@ -431,6 +454,9 @@ VW_API void vw_scene_free(vw_scene *s)
     free(s->vertices);
     free(s->indices);
     free(s->normals);
+    for (size_t i = 0; i < s->nstrings; i++)
+        free(s->strings[i]);
+    free(s->strings);
     free(s);
 }
 
@@ -510,6 +536,11 @@ VW_API size_t vw_scene_count_objects(const vw_scene *s)
     return s ? s->nspheres + s->ncones + s->npolygons : 0;
 }
 
+VW_API const char *vw_scene_string(const vw_scene *s, int k)
+{
+    return s && s->strings && k > 0 && (size_t)k <= s->nstrings ? s->strings[k - 1] : NULL;
+}
+
 VW_API uint64_t vw_scene_fingerprint(const vw_scene *s)
 {
     uint64_t h = VW__FNV_OFFSET;
@@ -520,7 +551,10 @@ VW_API uint64_t vw_scene_fingerprint(const vw_scene *s)
     H(s->nlights);
     for (size_t i = 0; i < s->nlights; i++) H(s->lights[i].pos), H(s->lights[i].color);
     H(s->nmaterials);
-    HN(s->materials, s->nmaterials); /* all floats: no padding */
+    /* Each material's values (all floats: no padding), not where it was defined: the
+       same hash as the whole array gave when a material held nothing else. */
+    for (size_t i = 0; i < s->nmaterials; i++)
+        h = vw__fnv1a(h, &s->materials[i], VW__MATERIAL_VALUE_BYTES);
     H(s->nspheres);
     for (size_t i = 0; i < s->nspheres; i++) {
         const vw_sphere *x = &s->spheres[i];

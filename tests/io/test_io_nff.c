@@ -126,6 +126,66 @@ static void test_fingerprint(void)
     vw_scene_free(b);
 }
 
+/* A material keeps where it was defined: its 'f' line and the file's name (no name of
+   its own: NFF has none). An 'f' no primitive uses leaves no material; one equal to an
+   earlier material is that material, with the earlier 'f' line; the default before any
+   'f' has no place. The place is not a value: two files of the same text give equal
+   scenes, fingerprints and NFF. */
+static void test_material_place(void)
+{
+    static const char *const text =
+        VIEW                                              /* 1 */
+        "s 0 0 -3 1\n"                                    /* 2: the default material */
+        "f 1 0 0 1 0 0 0 1\n"                             /* 3: used by nothing */
+        "f 0.5 0.5 0.5 1 0 0 0 1\n#vw Ke 1 1 1\n"         /* 4, 5 */
+        "p 3\n0 0 0\n1 0 0\n0 1 0\n"                      /* 6-9 */
+        "\n"                                              /* 10 */
+        "f\n1 1 1 1 0 5 0 1\n"                            /* 11, 12: the 'f' on line 11 */
+        "s 0 0 3 1\n"                                     /* 13 */
+        "f 0.5 0.5 0.5 1 0 0 0 1\n#vw Ke 1 1 1\n"         /* 14, 15: as line 4 */
+        "s 0 3 0 1\n";                                    /* 16 */
+    for (int form = 0; form < 3; form++) {
+        char *t = form ? vw_test_line_ends(text, strlen(text), form - 1, NULL) : NULL;
+        vw_scene *s = read_text("dir/scene.nff", t ? t : text);
+        vw_scene *o = read_text("other.nff", t ? t : text);
+        free(t);
+        CHECK_EQ_INT(s->nmaterials, 3);
+        const vw_material *dflt = &s->materials[s->spheres[0].material];
+        const vw_material *grey = &s->materials[s->polygons[0].material];
+        const vw_material *white = &s->materials[s->spheres[1].material];
+        EXPECT(dflt->line == 0 && dflt->file == 0 && dflt->name == 0,
+               "default material: line %d, file %d, name %d", dflt->line, dflt->file, dflt->name);
+        EXPECT(grey->line == 4 && white->line == 11, "'f' lines %d and %d, want 4 and 11 (form %d)",
+               grey->line, white->line, form);
+        CHECK_EQ_INT(s->spheres[2].material, s->polygons[0].material);
+        CHECK(vw_scene_string(s, grey->file) && !strcmp(vw_scene_string(s, grey->file), "dir/scene.nff"));
+        CHECK_EQ_INT(white->file, grey->file);   /* one copy of the name for all */
+        CHECK(vw_scene_string(s, grey->name) == NULL && vw_scene_string(s, white->name) == NULL);
+        CHECK(!strcmp(vw_scene_string(o, o->materials[1].file), "other.nff"));
+        CHECK(vw_scene_string(s, 0) == NULL && vw_scene_string(s, -1) == NULL &&
+              vw_scene_string(s, (int)s->nstrings + 1) == NULL && vw_scene_string(NULL, 1) == NULL);
+        CHECK(scene_equal(s, o));
+        CHECK(vw_scene_fingerprint(s) == vw_scene_fingerprint(o));
+        char *ws = nff_string(s, NULL), *wo = nff_string(o, NULL);
+        CHECK(ws && wo && !strcmp(ws, wo));
+        /* Read back, the materials are the written file's 'f' lines, values unchanged. */
+        vw_scene *back = read_text("back.nff", ws);
+        CHECK(scene_equal(s, back));
+        for (size_t i = 0; i < back->nmaterials; i++) {
+            int ln = back->materials[i].line;
+            const char *at = ws;
+            for (int l = 1; l < ln && at; l++)
+                at = strchr(at, '\n') ? strchr(at, '\n') + 1 : NULL;
+            EXPECT(ln > 0 && at && !strncmp(at, "f ", 2), "material %zu: line %d is not an 'f'", i, ln);
+        }
+        vw_scene_free(back);
+        free(ws);
+        free(wo);
+        vw_scene_free(s);
+        vw_scene_free(o);
+    }
+}
+
 int main(int argc, char **argv)
 {
     CHECK(argc == 2);
@@ -416,5 +476,6 @@ int main(int argc, char **argv)
     vw_scene_free(s);
     free(text);
     test_fingerprint();
+    test_material_place();
     TEST_DONE();
 }

@@ -159,11 +159,106 @@ static void illum_models(void)
     CHECK_EQ_INT(b->npolygons, s->npolygons);   /* NFF shares equal materials: by face */
     for (size_t i = 0; i < s->npolygons; i++)
         CHECK(memcmp(&b->materials[b->polygons[i].material],
-                     &s->materials[s->polygons[i].material], sizeof *s->materials) == 0);
+                     &s->materials[s->polygons[i].material], offsetof(vw_material, line)) == 0);
     vw_scene_free(b);
     free(w);
     vw_scene_free(s);
     remove(path);
+    rmdir(dir);
+}
+
+static void write_file(const char *dir, const char *name, const char *text)
+{
+    char path[512];
+    snprintf(path, sizeof path, "%s/%s", dir, name);
+    FILE *f = fopen(path, "w");
+    CHECK(f != NULL);
+    CHECK(fputs(text, f) >= 0);
+    CHECK(fclose(f) == 0);
+}
+
+/* Where each material was defined: the library's path as the reader opened it (one copy
+   for all the materials of a library, another library another path), the line of its Kd
+   (the reflectance, which the radiosity solver may clamp and names), else of its newmtl,
+   and its name. A usemtl before the mtllib gets its place from the newmtl that comes
+   later; a name no library defines has a name and no place; the default material
+   neither. */
+static void material_place(void)
+{
+    char dir[] = "/tmp/vw_mtlplace_XXXXXX", path[512], err[512];
+    CHECK(mkdtemp(dir) != NULL);
+    write_file(dir, "a.mtl", "# two materials\n"          /* 1 */
+                             "newmtl red\n"               /* 2 */
+                             "Ks 0.5 0.5 0.5\n"           /* 3 */
+                             "Kd 0.8 0.1 0.1\n"           /* 4 */
+                             "newmtl nokd\n"              /* 5 */
+                             "Ks 0.1 0.1 0.1\n");         /* 6 */
+    write_file(dir, "b.mtl", "newmtl white\n"             /* 1 */
+                             "Kd 0.5 0.5 0.5\n"           /* 2: overridden */
+                             "\n"                         /* 3 */
+                             "Kd \\\n"                    /* 4: continued */
+                             "1 1 1\n"                    /* 5 */
+                             "Kd spectral white.rfl\n"    /* 6: ignored, with a warning */
+                             "newmtl late\n"              /* 7 */
+                             "Kd 0.2 0.2 0.2\n");         /* 8 */
+    write_file(dir, "m.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\n"
+                             "f 1 2 3\n"
+                             "usemtl late\nf 1 2 3\n"
+                             "mtllib a.mtl b.mtl\n"
+                             "usemtl red\nf 1 2 3\n"
+                             "usemtl nokd\nf 1 2 3\n"
+                             "usemtl white\nf 1 2 3\n"
+                             "usemtl ghost\nf 1 2 3\n");
+    snprintf(path, sizeof path, "%s/m.obj", dir);
+    vw_scene *s = NULL;
+    nwarnings = 0;
+    vw_status st = vw_scene_read_file(path, &s, err, sizeof err);
+    if (st != VW_OK)
+        fprintf(stderr, "%s\n", err);
+    CHECK_EQ_INT(st, VW_OK);
+    CHECK_EQ_INT(s->npolygons, 6);
+    CHECK_EQ_INT(nwarnings, 2);   /* Kd spectral, ghost */
+    char a_path[600], b_path[600];
+    snprintf(a_path, sizeof a_path, "%s/a.mtl", dir);
+    snprintf(b_path, sizeof b_path, "%s/b.mtl", dir);
+    static const struct { const char *name; int in_b, line; } want[6] = {
+        {NULL, -1, 0}, {"late", 1, 8}, {"red", 0, 4}, {"nokd", 0, 5}, {"white", 1, 4},
+        {"ghost", -1, 0}};
+    for (int i = 0; i < 6; i++) {
+        const vw_material *m = &s->materials[s->polygons[i].material];
+        const char *file = vw_scene_string(s, m->file), *name = vw_scene_string(s, m->name);
+        const char *wfile = want[i].in_b < 0 ? NULL : want[i].in_b ? b_path : a_path;
+        EXPECT(m->line == want[i].line, "face %d: line %d, want %d", i, m->line, want[i].line);
+        EXPECT(wfile ? file && !strcmp(file, wfile) : !file, "face %d: file '%s', want '%s'", i,
+               file ? file : "(none)", wfile ? wfile : "(none)");
+        EXPECT(want[i].name ? name && !strcmp(name, want[i].name) : !name,
+               "face %d: name '%s', want '%s'", i, name ? name : "(none)",
+               want[i].name ? want[i].name : "(none)");
+    }
+    /* One string per library, however many materials it defines; the OBJ's own name
+       is not one (no material is defined there). */
+    const vw_material *red = &s->materials[s->polygons[2].material];
+    const vw_material *nokd = &s->materials[s->polygons[3].material];
+    const vw_material *white = &s->materials[s->polygons[4].material];
+    CHECK(red->file == nokd->file && red->file != white->file);
+    CHECK_EQ_INT(s->nstrings, 2 + 5);   /* a.mtl, b.mtl; late, ghost, red, nokd, white */
+    CHECK(white->diffuse[0] == 1.0f && red->diffuse[1] == 0.1f);
+    /* The same scene from another directory differs only where it came from. */
+    vw_scene *t = NULL;
+    char *text = NULL;
+    size_t len = 0;
+    text = slurp(path, &len);
+    CHECK(text != NULL);
+    CHECK_EQ_INT(vw_scene_read_obj("m.obj", text, len, dir, &t, err, sizeof err), VW_OK);
+    CHECK(scene_equal(s, t) && vw_scene_fingerprint(s) == vw_scene_fingerprint(t));
+    free(text);
+    vw_scene_free(t);
+    vw_scene_free(s);
+    const char *names[] = {"a.mtl", "b.mtl", "m.obj"};
+    for (int i = 0; i < 3; i++) {
+        snprintf(path, sizeof path, "%s/%s", dir, names[i]);
+        remove(path);
+    }
     rmdir(dir);
 }
 
@@ -272,7 +367,8 @@ int main(int argc, char **argv)
     CHECK_EQ_INT(n->camera.valid, 1);
     CHECK_EQ_INT(n->npolygons, 7);
     CHECK_EQ_INT(n->nmaterials, 3);
-    CHECK(memcmp(n->materials, s->materials, 3 * sizeof *s->materials) == 0);
+    for (int i = 0; i < 3; i++)   /* the values; the NFF's materials are its 'f' lines */
+        CHECK(memcmp(&n->materials[i], &s->materials[i], offsetof(vw_material, line)) == 0);
     for (size_t i = 0; i < 7; i++)
         for (int k = 0; k < s->polygons[i].count; k++)
             CHECK(memcmp(n->vertices[corner(n, i, k)], s->vertices[corner(s, i, k)],
@@ -314,6 +410,7 @@ int main(int argc, char **argv)
     nwarnings = 0;
     warn_corpus(argv[1]);
     illum_models();
+    material_place();
     /* A library that is there but wrong is still an error. */
     snprintf(path, sizeof path, "%s/bad/obj_mtl_error.obj", argv[1]);
     CHECK_EQ_INT(vw_scene_read_file(path, &n, err, sizeof err), VW_E_INPUT);

@@ -127,6 +127,12 @@ int main(void)
     CHECK(sr->nmaterials == 1);
     for (int k = 0; k < 3; k++) EXPECT(sr->materials[0].diffuse[k] > 0.33f && sr->materials[0].diffuse[k] < 0.34f,
                                        "vertices' mean colour %d: %g", k, sr->materials[0].diffuse[k]);
+    /* A material is defined where its colour was taken: the first face of that colour
+       (line 25, after 21 header lines and 3 vertices), in the file given; no name. */
+    EXPECT(sr->materials[0].line == 25, "vertices' mean colour: line %d", sr->materials[0].line);
+    CHECK(vw_scene_string(sr, sr->materials[0].file) &&
+          !strcmp(vw_scene_string(sr, sr->materials[0].file), "t.ply"));
+    CHECK(vw_scene_string(sr, sr->materials[0].name) == NULL);
     vw_scene_free(sr);
     const char *facecol = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
                           "property float z\nelement face 2\nproperty list uchar int vertex_indices\n"
@@ -135,7 +141,36 @@ int main(void)
     vw_scene *sf = good(facecol, strlen(facecol), "face colours");
     CHECK(sf && sf->nmaterials == 1 && sf->materials[0].diffuse[0] == 0.25f &&
           sf->materials[0].diffuse[1] == 0.5f && sf->materials[0].diffuse[2] == 1.0f);
+    EXPECT(sf->materials[0].line == 16, "face colour: line %d", sf->materials[0].line);
+    CHECK(!strcmp(vw_scene_string(sf, sf->materials[0].file), "t.ply"));
     vw_scene_free(sf);
+    /* The same in binary: the file, and no line to name. */
+    const char *bh = "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\n"
+                     "property float y\nproperty float z\nelement face 1\n"
+                     "property list uchar int vertex_indices\nproperty uchar red\n"
+                     "property uchar green\nproperty uchar blue\nend_header\n";
+    unsigned char bin[512], *q = bin + strlen(bh);
+    memcpy(bin, bh, strlen(bh));
+    const float bv[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+    for (int k = 0; k < 9; k++) {
+        uint32_t u;
+        memcpy(&u, &bv[k], 4);
+        for (int i = 0; i < 4; i++) *q++ = (unsigned char)(u >> (8 * i));
+    }
+    *q++ = 3;
+    for (int k = 0; k < 3; k++) *q++ = (unsigned char)k, *q++ = 0, *q++ = 0, *q++ = 0;
+    *q++ = 255, *q++ = 0, *q++ = 51;
+    vw_scene *sb = good(bin, (size_t)(q - bin), "binary face colour");
+    CHECK(sb && sb->nmaterials == 1 && sb->materials[0].diffuse[0] == 1.0f &&
+          sb->materials[0].diffuse[2] == 0.2f);
+    EXPECT(sb->materials[0].line == 0, "binary face colour: line %d", sb->materials[0].line);
+    CHECK(!strcmp(vw_scene_string(sb, sb->materials[0].file), "t.ply"));
+    vw_scene_free(sb);
+    /* No colour: the default grey, defined nowhere. */
+    vw_scene *sg = good(ascii(), strlen(ascii()), "no colour");
+    CHECK(sg && sg->nmaterials == 1 && sg->materials[0].line == 0 && sg->materials[0].file == 0 &&
+          sg->materials[0].name == 0);
+    vw_scene_free(sg);
 
     /* Bad input: the message, on the line it names. */
     bad("plx\n", 0, "t.ply:1: not a PLY file");

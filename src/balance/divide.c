@@ -4,7 +4,10 @@
  *
  * Loop: map the cells onto the workers longest-processing-time first; while the
  * predicted imbalance exceeds the tolerance, split the heaviest cell in two at the
- * median of its load along its longest side. Bounded by max_extra splits.
+ * median of its load along its longest side (or, where that side is too few doubles
+ * wide to hold a wall or its cut would leave all the load on one side, the next longest
+ * that is not). Bounded by max_extra splits; ends early when the heaviest cell cannot be
+ * cut on any side.
  */
 #include "balance/balance_internal.h"
 #include "decomp/decomp_internal.h"
@@ -59,13 +62,43 @@ vw_status vw__balance_divide(const vw_decomp *cur, const vw_load_field *f,
                                       F[3 * a + 2] * pts[i].x[2];
                 m++;
             }
-        int axis = 0;
-        for (int a = 1; a < 3; a++)
-            if (b.hi[a] - b.lo[a] > b.hi[axis] - b.lo[axis]) axis = a;
-        double split;
-        if (!vw__cut(tmp, m, axis, b.lo[axis], b.hi[axis], 2,
-                     p->min_width * (wb.hi[axis] - wb.lo[axis]), &split))
-            break; /* too thin to divide: no double lies inside the cell */
+        /* Its sides longest first (of equal ones the lower axis). A side with no double
+           inside it (a cell far from the origin for its size) cannot be cut, and the next
+           longest is tried: the sphere of radius 1 at x = 1e16 has cells a few doubles
+           wide on x, the longest side in world units, and normal on y and z. A cut that
+           leaves all the cell's load on one side (its load lies on one coordinate there:
+           a line or plane of load, or a side a few doubles wide) moves nothing; the next
+           side whose cut divides the load is taken instead, and only when none does the
+           longest that can be cut, as before. */
+        int order[3] = {0, 1, 2};
+        for (int i = 1; i < 3; i++)
+            for (int j = i; j > 0; j--) {
+                int u = order[j - 1], v = order[j];
+                if (!(b.hi[v] - b.lo[v] > b.hi[u] - b.lo[u])) break;
+                order[j - 1] = v, order[j] = u;
+            }
+        int axis = -1, first = -1;
+        double split = 0, first_split = 0;
+        for (int i = 0; i < 3 && axis < 0; i++) {
+            int a = order[i];
+            double s;
+            if (!vw__cut(tmp, m, a, b.lo[a], b.hi[a], 2, p->min_width * (wb.hi[a] - wb.lo[a]),
+                         &s))
+                continue;
+            if (first < 0) first = a, first_split = s;
+            /* Some of the cell's load below the wall and some above (a point on the
+               wall is above it, as vw_decomp_locate has it)? */
+            int below = 0, above = 0;
+            for (long k = 0; k < m && !(below && above); k++) {
+                if (tmp[k].x[a] < s)
+                    below = 1;
+                else
+                    above = 1;
+            }
+            if (below && above) axis = a, split = s;
+        }
+        if (axis < 0) axis = first, split = first_split;
+        if (axis < 0) break; /* too thin to divide: no side has a double inside it */
         /* The leaf becomes a wall with the old cell on its low side, a new cell above. */
         nn = vw__kd_divide(nodes, nn, heavy, axis, split, nc);
         nc++;

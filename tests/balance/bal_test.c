@@ -24,6 +24,10 @@
  *                         size): every balancer returns a decomposition round after
  *                         round, every point in a cell, and a box with too few doubles
  *                         for the cells asked keeps its walls; bad parameters are refused
+ *   divide_thin           divide on a box a few doubles wide on x (its longest side) and
+ *                         normal on y and z, the load along y (and in a frame turned
+ *                         45 degrees, along z): it cuts the sides that can be cut and
+ *                         divide the load, down to lambda <= 1.10 on 8 workers
  */
 #include <float.h>
 #include <math.h>
@@ -1021,6 +1025,125 @@ static int t_thin(void)
     return vw_test_failures ? 1 : 0;
 }
 
+/* ---- divide_thin: divide cuts a side that can be cut ------------------------------------ */
+
+/* Divide splits the heaviest cell along its longest side in world units. Far from the
+   origin for its size that side can be a few doubles wide (x below: 2 apart at 1e16)
+   while y and z are normal; divide stopped at the first cell whose longest side had no
+   double inside it, though a cut on y or z would have balanced the load. The load: on
+   the box's middle on axis 3 - la - sa, 40 values along axis la (weight growing along
+   it), 5 along sa, in frame coordinates (frame F, NULL: none); with `uniform` also one
+   unit a cell of the grid, as a first measurement on it gives. 8 workers. Returns lambda
+   of the divided cells by the mapping divide made; *cells their count, *cut a bit per
+   axis on which some cell is narrower than the world. */
+static double divide_far(const vw_box *world, const int dims[3], const double *F, int la,
+                         int sa, int uniform, int *cells, int *cut)
+{
+    double mid[3];
+    const double *walls[3];
+    for (int a = 0; a < 3; a++) {
+        CHECK(dims[a] == 1 || dims[a] == 2);
+        mid[a] = 0.5 * (world->lo[a] + world->hi[a]);
+        walls[a] = &mid[a];
+    }
+    vw_decomp *d;
+    CHECK(vw_decomp_create_grid_walls(world, dims, walls, F, &d) == VW_OK);
+    vw_load_field *f;
+    CHECK(vw_load_field_create(&f) == VW_OK);
+    double *loads = malloc(sizeof(double) * VW_MAX_CELLS);
+    int *map = malloc(sizeof(int) * VW_MAX_CELLS);
+    CHECK(loads && map);
+    if (uniform) {
+        for (int c = 0; c < vw_decomp_cell_count(d); c++) loads[c] = 1;
+        CHECK(vw_load_field_add_cells(f, d, loads, 4) == VW_OK);
+    }
+    int ma = 3 - la - sa;
+    for (int i = 0; i < 40; i++)
+        for (int k = 0; k < 5; k++) {
+            double q[3], p[3];
+            q[ma] = 0.5 * (world->lo[ma] + world->hi[ma]);
+            q[la] = world->lo[la] + (world->hi[la] - world->lo[la]) * (i + 0.5) / 40;
+            q[sa] = world->lo[sa] + (world->hi[sa] - world->lo[sa]) * (k + 0.5) / 5;
+            vw_decomp_from_frame(d, q, p);
+            CHECK(vw_load_field_add_point(f, p, 1 + 0.1 * i) == VW_OK);
+        }
+    for (size_t i = 0; i < f->n; i++) CHECK(vw_decomp_locate(d, f->p[i], NULL) >= 0);
+    vw_balance_params p;
+    vw_balance_params_init(&p);
+    p.strategy = VW_BALANCE_DIVIDE;
+    p.gworkers = 8;
+    vw_decomp *nd = NULL;
+    vw_status st = vw_balance_decompose(d, f, &p, &nd, map);
+    EXPECT(st == VW_OK && nd, "divide: %s", vw_status_name(st));
+    double lam = INFINITY;
+    *cells = 0, *cut = 0;
+    if (nd) {
+        *cells = cells_ok(nd, "divide far from the origin");
+        vw_load_field_cell_loads(f, nd, loads);
+        lam = vw_balance_imbalance(loads, map, *cells, 8, NULL);
+        for (int c = 0; c < *cells; c++) {
+            vw_box b = vw_decomp_cell_box(nd, c);
+            for (int a = 0; a < 3; a++)
+                if (b.lo[a] != world->lo[a] || b.hi[a] != world->hi[a]) *cut |= 1 << a;
+        }
+        int lost = 0;
+        for (size_t i = 0; i < f->n; i++) lost += vw_decomp_locate(nd, f->p[i], NULL) < 0;
+        EXPECT(lost == 0, "divide: %d of %zu points in no cell", lost, f->n);
+    }
+    vw_decomp_free(nd);
+    vw_decomp_free(d);
+    vw_load_field_free(f);
+    free(loads);
+    free(map);
+    return lam;
+}
+
+static int t_divide_thin(void)
+{
+    int cells, cut;
+    /* One cell, x two units (adjacent doubles: none inside) and longer than y and z:
+       divide kept the one cell, lambda 8. */
+    {
+        vw_box world = {{1e16, -0.9, -0.5}, {1e16 + 2, 0.9, 0.5}};
+        int one[3] = {1, 1, 1};
+        double lam = divide_far(&world, one, NULL, 1, 2, 0, &cells, &cut);
+        printf("divide_thin: x without a double inside, 1 cell: %d cells, lambda %.3f\n", cells,
+               lam);
+        EXPECT(cells >= 8 && lam <= 1.10, "1 cell: %d cells, lambda %.3f (want <= 1.10)", cells,
+               lam);
+        EXPECT(cut == 6, "1 cell: cuts on axes %d (want y and z: 6; x has no double inside)",
+               cut);
+    }
+    /* The ray tracer's box for a sphere of radius 1 at x = 1e16 on 2x2x2 cells: x 32 units,
+       16 doubles (8 a cell), y and z 2; a uniform first field. Divide cut x, the longest,
+       until its pieces were one double wide, and stopped with the load in them: 9 cells,
+       lambda 3.2. */
+    {
+        vw_box world = {{1e16 - 16, -1, -1}, {1e16 + 16, 1, 1}};
+        int dims[3] = {2, 2, 2};
+        double lam = divide_far(&world, dims, NULL, 1, 2, 1, &cells, &cut);
+        printf("divide_thin: x 16 doubles, 2x2x2: %d cells, lambda %.3f\n", cells, lam);
+        EXPECT(lam <= 1.10, "2x2x2: %d cells, lambda %.3f (want <= 1.10)", cells, lam);
+    }
+    /* The same far away in a frame turned 45 degrees about z: frame x and y (7e15, doubles
+       1 apart) 32 doubles wide, the longest sides, and the load 5 values on frame y;
+       only z, 2 units, cuts it finely. Lengths in the frame are lengths in the world (the
+       frame is orthonormal), so the longest side is still the longest in world units. */
+    {
+        const double h = sqrt(0.5), F[9] = {h, h, 0, -h, h, 0, 0, 0, 1};
+        double cx = h * 1e16, cy = -h * 1e16;
+        vw_box world = {{cx - 12, cy - 12, -1}, {cx + 12, cy + 12, 1}};
+        int dims[3] = {2, 2, 1};
+        double lam = divide_far(&world, dims, F, 2, 1, 1, &cells, &cut);
+        printf("divide_thin: rotated frame, x and y 32 doubles, 2x2x1: %d cells, lambda %.3f\n",
+               cells, lam);
+        EXPECT(lam <= 1.10 && (cut & 4), "rotated: %d cells, lambda %.3f (want <= 1.10), cuts %d",
+               cells, lam, cut);
+    }
+    printf("divide_thin: %d failures\n", vw_test_failures);
+    return vw_test_failures ? 1 : 0;
+}
+
 /* ---- two threads balancing at once ------------------------------------------------------ */
 
 /* The mappers and balancers are plain functions of their inputs: two threads running
@@ -1096,7 +1219,7 @@ static int t_concurrent(void)
 int main(int argc, char **argv)
 {
     if (argc < 2) {
-        fprintf(stderr, "usage: bal_test identical|conserve|staggered8|divide16|rotate|map|duplicate|field|concurrent|thin [...]\n");
+        fprintf(stderr, "usage: bal_test identical|conserve|staggered8|divide16|rotate|map|duplicate|field|concurrent|thin|divide_thin [...]\n");
         return 2;
     }
     const char *cmd = argv[1];
@@ -1110,6 +1233,7 @@ int main(int argc, char **argv)
     if (!strcmp(cmd, "field")) return t_field();
     if (!strcmp(cmd, "concurrent")) return t_concurrent();
     if (!strcmp(cmd, "thin")) return t_thin();
+    if (!strcmp(cmd, "divide_thin")) return t_divide_thin();
     fprintf(stderr, "bal_test: unknown test '%s'\n", cmd);
     return 2;
 }

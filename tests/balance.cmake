@@ -2,7 +2,8 @@
 # images bit-identical with every strategy and mapping, objects conserved by migration,
 # staggered reaching lambda <= 1.10 and divide <= 1.06 (16 cells, clustered) on deterministic
 # work, rotation following the load, cells a few doubles wide (balance_thin; divide
-# cutting the sides that can be cut there, balance_divide_thin),
+# cutting the sides that can be cut there, balance_divide_thin; going on past a cell that
+# cannot be cut, balance_divide_hot),
 # and the mapping invariants. Deterministic work counts only: no timings are asserted.
 
 add_executable(vw_test_balance ${PROJECT_SOURCE_DIR}/tests/balance/bal_test.c)
@@ -24,9 +25,10 @@ add_test(NAME balance_field COMMAND vw_test_balance field)
 add_test(NAME balance_concurrent COMMAND vw_test_balance concurrent)
 add_test(NAME balance_thin COMMAND vw_test_balance thin)
 add_test(NAME balance_divide_thin COMMAND vw_test_balance divide_thin)
+add_test(NAME balance_divide_hot COMMAND vw_test_balance divide_hot)
 set_tests_properties(balance_identical_spheres balance_identical_mixed balance_conserve
   balance_staggered8 balance_divide16 balance_rotate balance_map balance_duplicate
-  balance_field balance_concurrent balance_thin balance_divide_thin PROPERTIES LABELS "balance;threads"
+  balance_field balance_concurrent balance_thin balance_divide_thin balance_divide_hot PROPERTIES LABELS "balance;threads"
   ENVIRONMENT "${VW_BAL_TSAN}")
 
 # The command line: PNG bytes equal for every --balance and --map, under the threads

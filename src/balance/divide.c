@@ -6,8 +6,10 @@
  * predicted imbalance exceeds the tolerance, split the heaviest cell in two at the
  * median of its load along its longest side (or, where that side is too few doubles
  * wide to hold a wall or its cut would leave all the load on one side, the next longest
- * that is not). Bounded by max_extra splits; ends early when the heaviest cell cannot be
- * cut on any side.
+ * that is not). A cell that cannot be cut on any side (every side too few doubles wide)
+ * is marked and passed over for the next heaviest: the other cells' pieces can still
+ * fill the other workers. Bounded by max_extra splits; ends early when no cell can be
+ * cut.
  */
 #include "balance/balance_internal.h"
 #include "decomp/decomp_internal.h"
@@ -15,6 +17,61 @@
 
 #include <stdlib.h>
 #include <string.h>
+
+/* The side on which cell `cell` of d is cut and the wall (*split), or -1 when no side of
+   it can be cut (none has a double inside it). pts: the field's npts points in world
+   coordinates; tmp room for them (the cell's, in the frame F, are gathered there). */
+static int cut_side(const vw_decomp *d, int cell, const vw__lpt *pts, long npts, vw__lpt *tmp,
+                    const double *F, const vw_box *wb, double min_width, double *split)
+{
+    vw_box b = vw_decomp_cell_box(d, cell);
+    long m = 0;
+    for (long i = 0; i < npts; i++)
+        if (vw_decomp_locate(d, pts[i].x, NULL) == cell) {
+            tmp[m] = pts[i];
+            if (F)
+                for (int a = 0; a < 3; a++)
+                    tmp[m].x[a] = F[3 * a] * pts[i].x[0] + F[3 * a + 1] * pts[i].x[1] +
+                                  F[3 * a + 2] * pts[i].x[2];
+            m++;
+        }
+    /* Its sides longest first (of equal ones the lower axis). A side with no double
+       inside it (a cell far from the origin for its size) cannot be cut, and the next
+       longest is tried: the sphere of radius 1 at x = 1e16 has cells a few doubles
+       wide on x, the longest side in world units, and normal on y and z. A cut that
+       leaves all the cell's load on one side (its load lies on one coordinate there:
+       a line or plane of load, or a side a few doubles wide) moves nothing; the next
+       side whose cut divides the load is taken instead, and only when none does the
+       longest that can be cut, as before. */
+    int order[3] = {0, 1, 2};
+    for (int i = 1; i < 3; i++)
+        for (int j = i; j > 0; j--) {
+            int u = order[j - 1], v = order[j];
+            if (!(b.hi[v] - b.lo[v] > b.hi[u] - b.lo[u])) break;
+            order[j - 1] = v, order[j] = u;
+        }
+    int axis = -1, first = -1;
+    double first_split = 0;
+    for (int i = 0; i < 3 && axis < 0; i++) {
+        int a = order[i];
+        double s;
+        if (!vw__cut(tmp, m, a, b.lo[a], b.hi[a], 2, min_width * (wb->hi[a] - wb->lo[a]), &s))
+            continue;
+        if (first < 0) first = a, first_split = s;
+        /* Some of the cell's load below the wall and some above (a point on the wall
+           is above it, as vw_decomp_locate has it)? */
+        int below = 0, above = 0;
+        for (long k = 0; k < m && !(below && above); k++) {
+            if (tmp[k].x[a] < s)
+                below = 1;
+            else
+                above = 1;
+        }
+        if (below && above) axis = a, *split = s;
+    }
+    if (axis < 0) axis = first, *split = first_split;
+    return axis;
+}
 
 vw_status vw__balance_divide(const vw_decomp *cur, const vw_load_field *f,
                              const vw_balance_params *p, vw_decomp **out, int *cell_worker)
@@ -29,11 +86,14 @@ vw_status vw__balance_divide(const vw_decomp *cur, const vw_load_field *f,
     vw_kd_node *nodes = malloc(sizeof *nodes * (size_t)cap_nodes);
     double *load = calloc((size_t)cap_cells, sizeof *load);
     int *map = malloc(sizeof(int) * (size_t)cap_cells);
+    /* Cells found uncuttable (no side with a double inside). A cut changes only the cell
+       cut (its box and points), so the mark holds for the other cells to the end. */
+    unsigned char *uncut = calloc((size_t)cap_cells, 1);
     vw__lpt *pts = NULL;
     long npts = vw__field_points(f, NULL, &pts); /* world coordinates */
     vw__lpt *tmp = malloc(sizeof *tmp * (size_t)(npts > 0 ? npts : 1));
     vw_decomp *d = NULL;
-    vw_status st = (!nodes || !load || !map || npts < 0 || !tmp) ? VW_E_NOMEM : VW_OK;
+    vw_status st = (!nodes || !load || !map || !uncut || npts < 0 || !tmp) ? VW_E_NOMEM : VW_OK;
     if (st == VW_OK) {
         memcpy(nodes, n0, sizeof *nodes * (size_t)nn0);
         st = vw_decomp_clone(cur, &d);
@@ -47,58 +107,24 @@ vw_status vw__balance_divide(const vw_decomp *cur, const vw_load_field *f,
         if (st != VW_OK) break;
         double lam = vw_balance_imbalance(load, map, nc, gw, p->speeds);
         if (lam <= 1.0 + p->tolerance || extra >= max_extra) break;
-        int heavy = 0;
-        for (int c = 1; c < nc; c++)
-            if (load[c] > load[heavy]) heavy = c;
-        /* The heaviest cell's points, in its frame, and its longest side. */
-        vw_box b = vw_decomp_cell_box(d, heavy);
-        long m = 0;
-        for (long i = 0; i < npts; i++)
-            if (vw_decomp_locate(d, pts[i].x, NULL) == heavy) {
-                tmp[m] = pts[i];
-                if (F)
-                    for (int a = 0; a < 3; a++)
-                        tmp[m].x[a] = F[3 * a] * pts[i].x[0] + F[3 * a + 1] * pts[i].x[1] +
-                                      F[3 * a + 2] * pts[i].x[2];
-                m++;
-            }
-        /* Its sides longest first (of equal ones the lower axis). A side with no double
-           inside it (a cell far from the origin for its size) cannot be cut, and the next
-           longest is tried: the sphere of radius 1 at x = 1e16 has cells a few doubles
-           wide on x, the longest side in world units, and normal on y and z. A cut that
-           leaves all the cell's load on one side (its load lies on one coordinate there:
-           a line or plane of load, or a side a few doubles wide) moves nothing; the next
-           side whose cut divides the load is taken instead, and only when none does the
-           longest that can be cut, as before. */
-        int order[3] = {0, 1, 2};
-        for (int i = 1; i < 3; i++)
-            for (int j = i; j > 0; j--) {
-                int u = order[j - 1], v = order[j];
-                if (!(b.hi[v] - b.lo[v] > b.hi[u] - b.lo[u])) break;
-                order[j - 1] = v, order[j] = u;
-            }
-        int axis = -1, first = -1;
-        double split = 0, first_split = 0;
-        for (int i = 0; i < 3 && axis < 0; i++) {
-            int a = order[i];
-            double s;
-            if (!vw__cut(tmp, m, a, b.lo[a], b.hi[a], 2, p->min_width * (wb.hi[a] - wb.lo[a]),
-                         &s))
-                continue;
-            if (first < 0) first = a, first_split = s;
-            /* Some of the cell's load below the wall and some above (a point on the
-               wall is above it, as vw_decomp_locate has it)? */
-            int below = 0, above = 0;
-            for (long k = 0; k < m && !(below && above); k++) {
-                if (tmp[k].x[a] < s)
-                    below = 1;
-                else
-                    above = 1;
-            }
-            if (below && above) axis = a, split = s;
+        /* The heaviest cell not marked uncuttable; one that proves uncuttable is marked
+           and the next heaviest tried: stopping there left the other cells as they
+           were, though their pieces could still fill the other workers. Each cell is
+           marked at most once, so this costs at most one more gathering of points per
+           cell. A cell without load is not cut: its pieces change no worker's share. */
+        int heavy = -1, axis = -1;
+        double split = 0;
+        for (;;) {
+            heavy = -1;
+            for (int c = 0; c < nc; c++)
+                if (!uncut[c] && (heavy < 0 || load[c] > load[heavy])) heavy = c;
+            if (heavy >= 0 && !(load[heavy] > 0)) heavy = -1;
+            if (heavy < 0) break;
+            axis = cut_side(d, heavy, pts, npts, tmp, F, &wb, p->min_width, &split);
+            if (axis >= 0) break;
+            uncut[heavy] = 1;
         }
-        if (axis < 0) axis = first, split = first_split;
-        if (axis < 0) break; /* too thin to divide: no side has a double inside it */
+        if (heavy < 0) break; /* no loaded cell can be cut: each too thin on every side */
         /* The leaf becomes a wall with the old cell on its low side, a new cell above. */
         nn = vw__kd_divide(nodes, nn, heavy, axis, split, nc);
         nc++;
@@ -114,6 +140,6 @@ vw_status vw__balance_divide(const vw_decomp *cur, const vw_load_field *f,
         *out = d;
     else
         vw_decomp_free(d);
-    free(nodes), free(load), free(map), free(pts), free(tmp);
+    free(nodes), free(load), free(map), free(uncut), free(pts), free(tmp);
     return st;
 }

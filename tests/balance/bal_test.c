@@ -28,6 +28,10 @@
  *                         normal on y and z, the load along y (and in a frame turned
  *                         45 degrees, along z): it cuts the sides that can be cut and
  *                         divide the load, down to lambda <= 1.10 on 8 workers
+ *   divide_hot            divide with an uncuttable cell (one double wide on every side)
+ *                         holding a point of load, the heaviest: the other cells are
+ *                         divided still (lambda 1.29 -> <= 1.05 on 2 workers, 1.75 ->
+ *                         <= 1.15 on 8), the hot cell kept whole, no empty cell cut
  */
 #include <float.h>
 #include <math.h>
@@ -1144,6 +1148,105 @@ static int t_divide_thin(void)
     return vw_test_failures ? 1 : 0;
 }
 
+/* ---- divide_hot: an uncuttable heaviest cell does not end divide ------------------------ */
+
+/* World [1, 2]^3 on 2x2x2 cells, each axis's wall one double past 1: the cell at the
+   origin corner is one double wide on every side, no wall fits in it, and it holds a
+   point of load 10. The other load is spread: `line` on a line along x in the cell one
+   double wide on y and z (cuttable on x only), `bulk` on an 8x8x8 grid of points in the
+   cell [w, 2]^3. gw workers, at most 32 extra cells. Divide stopped ("break") as soon as
+   the heaviest cell could not be cut, with the other cells still overloading a worker.
+   Returns lambda of the result by divide's mapping; *cells its cell count; *hot_whole 1
+   when the hot point's cell is the uncuttable corner, unchanged. */
+static double divide_hot(int gw, double line, double bulk, int *cells, int *hot_whole)
+{
+    const double w = nextafter(1.0, 2.0);
+    vw_box world = {{1, 1, 1}, {2, 2, 2}};
+    int dims[3] = {2, 2, 2};
+    const double *walls[3] = {&w, &w, &w};
+    vw_decomp *d;
+    CHECK(vw_decomp_create_grid_walls(&world, dims, walls, NULL, &d) == VW_OK);
+    vw_load_field *f;
+    CHECK(vw_load_field_create(&f) == VW_OK);
+    const double hot[3] = {1, 1, 1};
+    CHECK(vw_load_field_add_point(f, hot, 10) == VW_OK);
+    for (int i = 0; line > 0 && i < 16; i++) {
+        const double q[3] = {1.1 + 0.05 * i, 1, 1};
+        CHECK(vw_load_field_add_point(f, q, line / 16) == VW_OK);
+    }
+    for (int i = 0; bulk > 0 && i < 512; i++) {
+        const double q[3] = {1.1 + 0.1 * (i % 8), 1.1 + 0.1 * (i / 8 % 8), 1.1 + 0.1 * (i / 64)};
+        CHECK(vw_load_field_add_point(f, q, bulk / 512) == VW_OK);
+    }
+    CHECK(vw_decomp_locate(d, hot, NULL) >= 0);
+    vw_box hb = vw_decomp_cell_box(d, vw_decomp_locate(d, hot, NULL));
+    CHECK(hb.hi[0] == w && hb.hi[1] == w && hb.hi[2] == w);
+    double *loads = malloc(sizeof(double) * VW_MAX_CELLS);
+    int *map = malloc(sizeof(int) * VW_MAX_CELLS);
+    CHECK(loads && map);
+    vw_balance_params p;
+    vw_balance_params_init(&p);
+    p.strategy = VW_BALANCE_DIVIDE;
+    p.gworkers = gw;
+    p.max_extra = 32;
+    vw_decomp *nd = NULL;
+    vw_status st = vw_balance_decompose(d, f, &p, &nd, map);
+    EXPECT(st == VW_OK && nd, "divide: %s", vw_status_name(st));
+    double lam = INFINITY;
+    *cells = 0, *hot_whole = 0;
+    if (nd) {
+        *cells = cells_ok(nd, "divide with a hot cell");
+        vw_load_field_cell_loads(f, nd, loads);
+        lam = vw_balance_imbalance(loads, map, *cells, gw, NULL);
+        int hc = vw_decomp_locate(nd, hot, NULL);
+        if (hc >= 0) {
+            vw_box b = vw_decomp_cell_box(nd, hc);
+            *hot_whole = 1;
+            for (int a = 0; a < 3; a++)
+                *hot_whole &= b.lo[a] == hb.lo[a] && b.hi[a] == hb.hi[a];
+        }
+        int lost = 0;
+        for (size_t i = 0; i < f->n; i++) lost += vw_decomp_locate(nd, f->p[i], NULL) < 0;
+        EXPECT(lost == 0, "divide: %d of %zu points in no cell", lost, f->n);
+    }
+    vw_decomp_free(nd);
+    vw_decomp_free(d);
+    vw_load_field_free(f);
+    free(loads);
+    free(map);
+    return lam;
+}
+
+static int t_divide_hot(void)
+{
+    int cells, whole;
+    /* 2 workers, the hot cell 10 the heaviest, the line and the bulk 9 each: the hot
+       cell on one worker, 18 on the other, lambda 18 / 14 = 1.29; divide stopped at
+       once, 8 cells. */
+    double lam = divide_hot(2, 9, 9, &cells, &whole);
+    printf("divide_hot: 2 workers, hot 10, line 9, bulk 9: %d cells, lambda %.3f\n", cells, lam);
+    EXPECT(lam <= 1.05 && cells > 8 && whole,
+           "2 workers: %d cells, lambda %.3f (want <= 1.05, more than 8 cells), hot cell whole %d",
+           cells, lam, whole);
+    /* 8 workers, the bulk 70: it is cut into pieces of 8.75, then the hot cell is the
+       heaviest; divide stopped there with two pieces on one worker, lambda 17.5 / 10.
+       Going on, the 32 extra cells halve the bulk into 32 pieces of 70 / 32 for the 7
+       other workers: 5 on one, lambda 1.094. */
+    lam = divide_hot(8, 0, 70, &cells, &whole);
+    printf("divide_hot: 8 workers, hot 10, bulk 70: %d cells, lambda %.3f\n", cells, lam);
+    EXPECT(lam <= 1.15 && whole,
+           "8 workers: %d cells, lambda %.3f (want <= 1.15), hot cell whole %d", cells, lam,
+           whole);
+    /* Only the hot point: no loaded cell can be cut, and no empty one is: 8 cells, lambda
+       8, as before. */
+    lam = divide_hot(8, 0, 0, &cells, &whole);
+    printf("divide_hot: 8 workers, hot 10 alone: %d cells, lambda %.3f\n", cells, lam);
+    EXPECT(cells == 8 && whole && fabs(lam - 8) < 1e-9,
+           "hot alone: %d cells (want 8: empty cells not cut), lambda %.3f", cells, lam);
+    printf("divide_hot: %d failures\n", vw_test_failures);
+    return vw_test_failures ? 1 : 0;
+}
+
 /* ---- two threads balancing at once ------------------------------------------------------ */
 
 /* The mappers and balancers are plain functions of their inputs: two threads running
@@ -1219,7 +1322,7 @@ static int t_concurrent(void)
 int main(int argc, char **argv)
 {
     if (argc < 2) {
-        fprintf(stderr, "usage: bal_test identical|conserve|staggered8|divide16|rotate|map|duplicate|field|concurrent|thin|divide_thin [...]\n");
+        fprintf(stderr, "usage: bal_test identical|conserve|staggered8|divide16|rotate|map|duplicate|field|concurrent|thin|divide_thin|divide_hot [...]\n");
         return 2;
     }
     const char *cmd = argv[1];
@@ -1234,6 +1337,7 @@ int main(int argc, char **argv)
     if (!strcmp(cmd, "concurrent")) return t_concurrent();
     if (!strcmp(cmd, "thin")) return t_thin();
     if (!strcmp(cmd, "divide_thin")) return t_divide_thin();
+    if (!strcmp(cmd, "divide_hot")) return t_divide_hot();
     fprintf(stderr, "bal_test: unknown test '%s'\n", cmd);
     return 2;
 }

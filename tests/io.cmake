@@ -18,12 +18,13 @@ add_test(NAME io_outfile COMMAND test_io_outfile)
 set_tests_properties(io_outfile PROPERTIES TIMEOUT 60)
 
 # The subcommands are tested in-process: their sources are compiled with a test main,
-# so this does not depend on tools/vwalls.c registering them.
+# so this does not depend on tools/vwalls.c registering them. vwalls_apps for info
+# --materials, which flags reflectances by the radiosity solver's own checks.
 add_executable(test_io_cli ${PROJECT_SOURCE_DIR}/tests/io/test_io_cli.c
   ${PROJECT_SOURCE_DIR}/tools/cmd_gen.c ${PROJECT_SOURCE_DIR}/tools/cmd_info.c
   ${PROJECT_SOURCE_DIR}/tools/cli.c)
 target_include_directories(test_io_cli PRIVATE ${PROJECT_SOURCE_DIR}/tests ${PROJECT_SOURCE_DIR}/tools)
-target_link_libraries(test_io_cli PRIVATE vwalls_static m)
+target_link_libraries(test_io_cli PRIVATE vwalls_apps m)
 # cli.c uses clock_gettime, which -std=c11 hides without a feature macro.
 target_compile_definitions(test_io_cli PRIVATE _GNU_SOURCE)
 add_test(NAME io_cli COMMAND test_io_cli ${PROJECT_SOURCE_DIR}/tests/data)
@@ -41,9 +42,9 @@ target_include_directories(test_io_triangulate PRIVATE ${PROJECT_SOURCE_DIR}/tes
 target_link_libraries(test_io_triangulate PRIVATE vwalls_static m)
 add_test(NAME io_triangulate COMMAND test_io_triangulate)
 
-# The command's output files and its help texts (each script says what it checks; a
-# few seconds).
-foreach(t outputs help args)
+# The command's output files and its help texts, and info --materials (each script says
+# what it checks; a few seconds).
+foreach(t outputs help args info)
   add_test(NAME io_cli_${t}
            COMMAND sh ${PROJECT_SOURCE_DIR}/tests/io/cli_${t}.sh $<TARGET_FILE:vwalls_tool>
                    ${CMAKE_CURRENT_BINARY_DIR}/io_cli_${t})

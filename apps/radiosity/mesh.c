@@ -250,22 +250,16 @@ static void material_where(char *head, size_t hlen, char *name, size_t nlen, cha
         where(head, hlen, path, pg, k, nfile, m);
         return;
     }
+    /* A file (and a name in it) may hold anything: shown printable, on one line. */
+    char shown[512];
+    vw_text_shown(file, strlen(file), 0, shown, sizeof shown);
     if (mat->line > 0)
-        snprintf(head, hlen, "%s:%d", file, mat->line);
+        snprintf(head, hlen, "%s:%d", shown, mat->line);
     else
-        snprintf(head, hlen, "%s", file);
-    if (nm) {
-        /* A file's name may hold anything: shown printable and bounded, as the readers do. */
-        char shown[48];
-        size_t n = strlen(nm), i, j = 0;
-        for (i = 0; i < n && j < 40; i++) {
-            unsigned char c = (unsigned char)nm[i];
-            shown[j++] = c >= 0x20 && c < 0x7f && c != '\'' ? (char)c : '?';
-        }
-        if (i < n) memcpy(shown + j, "...", 3), j += 3;
-        shown[j] = '\0';
-        snprintf(name, nlen, "material '%s': ", shown);
-    }
+        snprintf(head, hlen, "%s", shown);
+    if (nm)
+        snprintf(name, nlen, "material '%s': ",
+                 vw_text_shown(nm, strlen(nm), VW_SHOWN_NAME, shown, sizeof shown));
     if (pg->line > 0) snprintf(polyref, plen, ", %s:%d", path ? path : "scene", pg->line);
 }
 

@@ -157,6 +157,13 @@ VW_API size_t vw_scene_count_objects(const vw_scene *s);
 /* String k of the scene (a material's file or name), or NULL when k is 0 or not one of
    its strings. */
 VW_API const char *vw_scene_string(const vw_scene *s, int k);
+/* Text from a file shown in a message, on one line: the n bytes at s with every byte
+   that is not printable ASCII, and the quote ' that delimits names, as '?'; at most
+   max of them (0: no bound but out's), then "...". out holds outlen bytes (max + 4
+   hold any name whole). Returns out. The readers, the radiosity solver and
+   `vwalls info` show names and tokens so. */
+#define VW_SHOWN_NAME 40 /* the bound messages keep names and tokens to */
+VW_API const char *vw_text_shown(const char *s, size_t n, size_t max, char *out, size_t outlen);
 /* A 64-bit hash (FNV-1a) of everything in the scene but its camera: objects, vertices
    and normals, materials (their values, not where they were defined), lights,
    background, value by value. The same file read by the

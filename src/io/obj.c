@@ -130,17 +130,7 @@ static int span_is(span t, const char *kw)
 
 static const char *show(span t, char buf[48])
 {
-    size_t n = t.n < 40 ? t.n : 40, i;
-    for (i = 0; i < n; i++) {
-        unsigned char c = (unsigned char)t.s[i];
-        buf[i] = (c >= 0x20 && c < 0x7f && c != '\'') ? (char)c : '?';
-    }
-    if (t.n > n) {
-        memcpy(buf + i, "...", 3);
-        i += 3;
-    }
-    buf[i] = '\0';
-    return buf;
+    return vw_text_shown(t.s, t.n, VW_SHOWN_NAME, buf, 48);
 }
 
 static vw_status fail(obj *O, const char *fmt, ...)

@@ -541,6 +541,23 @@ VW_API const char *vw_scene_string(const vw_scene *s, int k)
     return s && s->strings && k > 0 && (size_t)k <= s->nstrings ? s->strings[k - 1] : NULL;
 }
 
+VW_API const char *vw_text_shown(const char *s, size_t n, size_t max, char *out, size_t outlen)
+{
+    if (!out || !outlen) return out;
+    size_t room = outlen - 1, cut = max && max < n ? max : n, i;
+    if (cut > room) cut = room >= 3 ? room - 3 : room;
+    for (i = 0; i < cut; i++) {
+        unsigned char c = (unsigned char)s[i];
+        out[i] = c >= 0x20 && c < 0x7f && c != '\'' ? (char)c : '?';
+    }
+    if (i < n && i + 3 <= room) {
+        memcpy(out + i, "...", 3);
+        i += 3;
+    }
+    out[i] = '\0';
+    return out;
+}
+
 VW_API uint64_t vw_scene_fingerprint(const vw_scene *s)
 {
     uint64_t h = VW__FNV_OFFSET;

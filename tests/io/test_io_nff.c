@@ -126,6 +126,24 @@ static void test_fingerprint(void)
     vw_scene_free(b);
 }
 
+/* vw_text_shown: what messages show of a file's text. Every byte that is not printable
+   ASCII, and the quote, becomes '?'; a name is cut at max bytes and marked "..."; a
+   buffer too small for the whole cuts it too, the mark included, never overrunning. */
+static void test_text_shown(void)
+{
+    char b[64];
+    CHECK(!strcmp(vw_text_shown("plain", 5, 40, b, sizeof b), "plain"));
+    CHECK(!strcmp(vw_text_shown("a'b\nc\x7f\xc3", 7, 40, b, sizeof b), "a?b?c??"));
+    CHECK(!strcmp(vw_text_shown("abcdef", 6, 4, b, sizeof b), "abcd..."));
+    CHECK(!strcmp(vw_text_shown("abcdef", 6, 0, b, sizeof b), "abcdef"));
+    CHECK(!strcmp(vw_text_shown("abcd", 2, 0, b, sizeof b), "ab")); /* n bytes, not to NUL */
+    char s[8] = {'x', 'x', 'x', 'x', 'x', 'x', 'x', 'x'};
+    CHECK(!strcmp(vw_text_shown("abcdefghij", 10, 0, s, 7), "abc...") && s[7] == 'x');
+    memset(s, 'x', sizeof s);
+    CHECK(!strcmp(vw_text_shown("abcdefghij", 10, 0, s, 3), "ab") && s[3] == 'x');
+    CHECK(!strcmp(vw_text_shown("", 0, 40, b, sizeof b), ""));
+}
+
 /* A material keeps where it was defined: its 'f' line and the file's name (no name of
    its own: NFF has none). An 'f' no primitive uses leaves no material; one equal to an
    earlier material is that material, with the earlier 'f' line; the default before any
@@ -477,5 +495,6 @@ int main(int argc, char **argv)
     free(text);
     test_fingerprint();
     test_material_place();
+    test_text_shown();
     TEST_DONE();
 }

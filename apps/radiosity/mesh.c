@@ -13,6 +13,7 @@
 #include "radiosity/vec.h"
 
 #include <math.h>
+#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -261,6 +262,31 @@ static void material_where(char *head, size_t hlen, char *name, size_t nlen, cha
         snprintf(name, nlen, "material '%s': ",
                  vw_text_shown(nm, strlen(nm), VW_SHOWN_NAME, shown, sizeof shown));
     if (pg->line > 0) snprintf(polyref, plen, ", %s:%d", path ? path : "scene", pg->line);
+}
+
+/* A warning about the material of the k-th polygon of the meshed scene s (the first
+   nfile from the file), placed and named by material_where: "AT: warning: [material
+   'NAME': ]reflectance R G B of polygon (id N[, FILE:LINE]) " and then fmt's text. */
+static void material_warning(const vw_scene *s, size_t nfile, const char *path,
+                             const rad_mesh *m, size_t k, const char *fmt, ...)
+    __attribute__((format(printf, 6, 7)));
+static void material_warning(const vw_scene *s, size_t nfile, const char *path,
+                             const rad_mesh *m, size_t k, const char *fmt, ...)
+{
+    const vw_polygon *pg = &s->polygons[k];
+    const vw_material *mat = &s->materials[pg->material];
+    char at[512], name[64], polyref[512];
+    material_where(at, sizeof at, name, sizeof name, polyref, sizeof polyref, s, mat, path, pg,
+                   k, nfile, m);
+    int facet = k >= nfile;
+    fprintf(stderr, "%s: warning: %sreflectance %g %g %g of %s (id %d%s) ", at, name,
+            mat->diffuse[0], mat->diffuse[1], mat->diffuse[2], facet ? "object" : "polygon",
+            facet ? (int)m->facet_object[pg->id - m->facet_base] : pg->id, polyref);
+    va_list ap;
+    va_start(ap, fmt);
+    vfprintf(stderr, fmt, ap);
+    va_end(ap);
+    fputc('\n', stderr);
 }
 
 static int push_piece(rad_mesh *m, size_t *cap, const rad_piece *pc, int owner)
@@ -850,44 +876,25 @@ vw_status rad_mesh_build(const vw_scene *s, const char *path, const vw_decomp *d
     m->npolys = (size_t)(max_id + 1);
     m->patch_size = S;
     /* Once, not per polygon: a scene usually shares a few materials among many. */
-    if (st == VW_OK && nclamped && !o->quiet) {
-        const vw_polygon *pg = &s->polygons[first_clamped];
-        const vw_material *mat = &s->materials[pg->material];
-        char at[512], name[64], polyref[512];
-        material_where(at, sizeof at, name, sizeof name, polyref, sizeof polyref, s, mat, path, pg,
-                       first_clamped, s0->npolygons, m);
-        int facet = first_clamped >= s0->npolygons;
-        fprintf(stderr,
-                "%s: warning: %sreflectance %g %g %g of %s (id %d%s) is outside [0, 1], clamped "
-                "(%zu polygon%s in all); the solver and the CSV use the clamped values\n",
-                at, name, mat->diffuse[0], mat->diffuse[1], mat->diffuse[2], facet ? "object" : "polygon",
-                facet ? (int)m->facet_object[pg->id - m->facet_base] : pg->id, polyref, nclamped,
-                nclamped == 1 ? "" : "s");
-    }
+    if (st == VW_OK && nclamped && !o->quiet)
+        material_warning(s, s0->npolygons, path, m, first_clamped,
+                         "is outside [0, 1], clamped (%zu polygon%s in all); the solver and "
+                         "the CSV use the clamped values", nclamped, nclamped == 1 ? "" : "s");
     /* A surface of reflectance 1 absorbs nothing in that channel: in a closed scene of
        them the emitted power is never spent, only spread over the patches, and the
        largest patch's share may stay above --sf for ever (a closed box of Kd 1 and 27
        patches: the largest held 7.7 % of the emitted power after 12000 shots, against
        --sf 1e-3). Said before the solve, with what to do; the solve itself stops as
        stalled (solve.c, stall_check). */
-    if (st == VW_OK && nwhite && !o->quiet) {
-        const vw_polygon *pg = &s->polygons[first_white];
-        const vw_material *mat = &s->materials[pg->material];
-        char at[512], name[64], polyref[512];
-        material_where(at, sizeof at, name, sizeof name, polyref, sizeof polyref, s, mat, path, pg,
-                       first_white, s0->npolygons, m);
-        int facet = first_white >= s0->npolygons;
-        fprintf(stderr,
-                "%s: warning: %sreflectance %g %g %g of %s (id %d%s) is 1 or more in a channel, so it "
-                "absorbs nothing there (%zu polygon%s in all, lights not counted): in a closed "
-                "scene the solve may be slow or not reach --sf %g; it stops, stalled, when %lld "
-                "shots (--stall-shots) absorb or let escape less than sf of the emitted power. "
-                "Give --max-shots, or a reflectance below 1 (Kd 0.9, say)\n",
-                at, name, mat->diffuse[0], mat->diffuse[1], mat->diffuse[2], facet ? "object" : "polygon",
-                facet ? (int)m->facet_object[pg->id - m->facet_base] : pg->id, polyref, nwhite,
-                nwhite == 1 ? "" : "s", o->sf,
-                (long long)(o->stall_shots > 0 ? o->stall_shots : RAD_STALL_SHOTS));
-    }
+    if (st == VW_OK && nwhite && !o->quiet)
+        material_warning(s, s0->npolygons, path, m, first_white,
+                         "is 1 or more in a channel, so it absorbs nothing there (%zu polygon%s "
+                         "in all, lights not counted): in a closed scene the solve may be slow "
+                         "or not reach --sf %g; it stops, stalled, when %lld shots "
+                         "(--stall-shots) absorb or let escape less than sf of the emitted "
+                         "power. Give --max-shots, or a reflectance below 1 (Kd 0.9, say)",
+                         nwhite, nwhite == 1 ? "" : "s", o->sf,
+                         (long long)(o->stall_shots > 0 ? o->stall_shots : RAD_STALL_SHOTS));
     if (st == VW_E_NOMEM) snprintf(err, errlen, "%s: out of memory while meshing", path ? path : "scene");
     if (st == VW_E_LIMIT)
         snprintf(err, errlen,

@@ -1031,6 +1031,38 @@ static int t_thin(void)
 
 /* ---- divide_thin: divide cuts a side that can be cut ------------------------------------ */
 
+/* Divides d on field f for gw workers (max_extra 0: the default), expecting success and
+   every point of f in a cell of the result (what names the case). Returns the result
+   (NULL on failure); *lam its lambda by the mapping divide made, *cells its count. */
+static vw_decomp *divide_checked(const vw_decomp *d, vw_load_field *f, int gw, int max_extra,
+                                 const char *what, double *lam, int *cells)
+{
+    double *loads = malloc(sizeof(double) * VW_MAX_CELLS);
+    int *map = malloc(sizeof(int) * VW_MAX_CELLS);
+    CHECK(loads && map);
+    vw_balance_params p;
+    vw_balance_params_init(&p);
+    p.strategy = VW_BALANCE_DIVIDE;
+    p.gworkers = gw;
+    p.max_extra = max_extra;
+    vw_decomp *nd = NULL;
+    vw_status st = vw_balance_decompose(d, f, &p, &nd, map);
+    EXPECT(st == VW_OK && nd, "%s: divide: %s", what, vw_status_name(st));
+    *lam = INFINITY;
+    *cells = 0;
+    if (nd) {
+        *cells = cells_ok(nd, what);
+        vw_load_field_cell_loads(f, nd, loads);
+        *lam = vw_balance_imbalance(loads, map, *cells, gw, NULL);
+        int lost = 0;
+        for (size_t i = 0; i < f->n; i++) lost += vw_decomp_locate(nd, f->p[i], NULL) < 0;
+        EXPECT(lost == 0, "%s: %d of %zu points in no cell", what, lost, f->n);
+    }
+    free(loads);
+    free(map);
+    return nd;
+}
+
 /* Divide splits the heaviest cell along its longest side in world units. Far from the
    origin for its size that side can be a few doubles wide (x below: 2 apart at 1e16)
    while y and z are normal; divide stopped at the first cell whose longest side had no
@@ -1055,8 +1087,7 @@ static double divide_far(const vw_box *world, const int dims[3], const double *F
     vw_load_field *f;
     CHECK(vw_load_field_create(&f) == VW_OK);
     double *loads = malloc(sizeof(double) * VW_MAX_CELLS);
-    int *map = malloc(sizeof(int) * VW_MAX_CELLS);
-    CHECK(loads && map);
+    CHECK(loads);
     if (uniform) {
         for (int c = 0; c < vw_decomp_cell_count(d); c++) loads[c] = 1;
         CHECK(vw_load_field_add_cells(f, d, loads, 4) == VW_OK);
@@ -1072,33 +1103,18 @@ static double divide_far(const vw_box *world, const int dims[3], const double *F
             CHECK(vw_load_field_add_point(f, p, 1 + 0.1 * i) == VW_OK);
         }
     for (size_t i = 0; i < f->n; i++) CHECK(vw_decomp_locate(d, f->p[i], NULL) >= 0);
-    vw_balance_params p;
-    vw_balance_params_init(&p);
-    p.strategy = VW_BALANCE_DIVIDE;
-    p.gworkers = 8;
-    vw_decomp *nd = NULL;
-    vw_status st = vw_balance_decompose(d, f, &p, &nd, map);
-    EXPECT(st == VW_OK && nd, "divide: %s", vw_status_name(st));
-    double lam = INFINITY;
-    *cells = 0, *cut = 0;
-    if (nd) {
-        *cells = cells_ok(nd, "divide far from the origin");
-        vw_load_field_cell_loads(f, nd, loads);
-        lam = vw_balance_imbalance(loads, map, *cells, 8, NULL);
-        for (int c = 0; c < *cells; c++) {
-            vw_box b = vw_decomp_cell_box(nd, c);
-            for (int a = 0; a < 3; a++)
-                if (b.lo[a] != world->lo[a] || b.hi[a] != world->hi[a]) *cut |= 1 << a;
-        }
-        int lost = 0;
-        for (size_t i = 0; i < f->n; i++) lost += vw_decomp_locate(nd, f->p[i], NULL) < 0;
-        EXPECT(lost == 0, "divide: %d of %zu points in no cell", lost, f->n);
+    double lam;
+    vw_decomp *nd = divide_checked(d, f, 8, 0, "divide far from the origin", &lam, cells);
+    *cut = 0;
+    for (int c = 0; c < *cells; c++) {
+        vw_box b = vw_decomp_cell_box(nd, c);
+        for (int a = 0; a < 3; a++)
+            if (b.lo[a] != world->lo[a] || b.hi[a] != world->hi[a]) *cut |= 1 << a;
     }
     vw_decomp_free(nd);
     vw_decomp_free(d);
     vw_load_field_free(f);
     free(loads);
-    free(map);
     return lam;
 }
 
@@ -1181,39 +1197,18 @@ static double divide_hot(int gw, double line, double bulk, int *cells, int *hot_
     CHECK(vw_decomp_locate(d, hot, NULL) >= 0);
     vw_box hb = vw_decomp_cell_box(d, vw_decomp_locate(d, hot, NULL));
     CHECK(hb.hi[0] == w && hb.hi[1] == w && hb.hi[2] == w);
-    double *loads = malloc(sizeof(double) * VW_MAX_CELLS);
-    int *map = malloc(sizeof(int) * VW_MAX_CELLS);
-    CHECK(loads && map);
-    vw_balance_params p;
-    vw_balance_params_init(&p);
-    p.strategy = VW_BALANCE_DIVIDE;
-    p.gworkers = gw;
-    p.max_extra = 32;
-    vw_decomp *nd = NULL;
-    vw_status st = vw_balance_decompose(d, f, &p, &nd, map);
-    EXPECT(st == VW_OK && nd, "divide: %s", vw_status_name(st));
-    double lam = INFINITY;
-    *cells = 0, *hot_whole = 0;
-    if (nd) {
-        *cells = cells_ok(nd, "divide with a hot cell");
-        vw_load_field_cell_loads(f, nd, loads);
-        lam = vw_balance_imbalance(loads, map, *cells, gw, NULL);
-        int hc = vw_decomp_locate(nd, hot, NULL);
-        if (hc >= 0) {
-            vw_box b = vw_decomp_cell_box(nd, hc);
-            *hot_whole = 1;
-            for (int a = 0; a < 3; a++)
-                *hot_whole &= b.lo[a] == hb.lo[a] && b.hi[a] == hb.hi[a];
-        }
-        int lost = 0;
-        for (size_t i = 0; i < f->n; i++) lost += vw_decomp_locate(nd, f->p[i], NULL) < 0;
-        EXPECT(lost == 0, "divide: %d of %zu points in no cell", lost, f->n);
+    double lam;
+    vw_decomp *nd = divide_checked(d, f, gw, 32, "divide with a hot cell", &lam, cells);
+    *hot_whole = 0;
+    int hc = nd ? vw_decomp_locate(nd, hot, NULL) : -1;
+    if (hc >= 0) {
+        vw_box b = vw_decomp_cell_box(nd, hc);
+        *hot_whole = 1;
+        for (int a = 0; a < 3; a++) *hot_whole &= b.lo[a] == hb.lo[a] && b.hi[a] == hb.hi[a];
     }
     vw_decomp_free(nd);
     vw_decomp_free(d);
     vw_load_field_free(f);
-    free(loads);
-    free(map);
     return lam;
 }
 

@@ -465,13 +465,14 @@ static int wire_step(vw_ctx *ctx, void *state)
     return 1;
 }
 
-static int wire_garbled(void)
+/* A world of one cell per process on one worker each, running step (wire_build's
+   cells), which the caller expects to stop the job: 1 when the run ended instead. */
+static int run_line_world(vw_world **w, int (*step)(vw_ctx *, void *), const char *unnoticed)
 {
-    if (vw_engine_rank() == 1) setenv("VW_FAULT", "wire-garble", 1); /* read by the transport */
     vw_module m = storm_module;
     m.cell_build = wire_build;
     m.cell_free = NULL;
-    m.step = wire_step;
+    m.step = step;
     vw_box box = {{0, 0, 0}, {1, 1, 1}};
     int dims[3] = {vw_engine_size(), 1, 1};
     vw_decomp *d;
@@ -480,14 +481,19 @@ static int wire_garbled(void)
     vw_config cfg;
     vw_config_init(&cfg);
     cfg.workers = 1;
-    vw_world *w;
-    CHECK_EQ_INT(vw_world_create(&m, &st, d, &cfg, &w), VW_OK);
-    CHECK_EQ_INT(vw_world_run(w), VW_OK);
-    fprintf(stderr, "test_mpi_storm: process %d: the run ended without noticing the garbled packet\n",
-            vw_engine_rank());
-    vw_world_free(w);
+    CHECK_EQ_INT(vw_world_create(&m, &st, d, &cfg, w), VW_OK);
+    CHECK_EQ_INT(vw_world_run(*w), VW_OK);
+    fprintf(stderr, "test_mpi_storm: process %d: %s\n", vw_engine_rank(), unnoticed);
+    vw_world_free(*w);
     vw_decomp_free(d);
     return 1;
+}
+
+static int wire_garbled(void)
+{
+    if (vw_engine_rank() == 1) setenv("VW_FAULT", "wire-garble", 1); /* read by the transport */
+    vw_world *w;
+    return run_line_world(&w, wire_step, "the run ended without noticing the garbled packet");
 }
 
 /* --agree-in-step: every process's step() calls vw_world_agree on its own world: a
@@ -508,25 +514,7 @@ static int agree_step(vw_ctx *ctx, void *state)
 
 static int agree_in_step(void)
 {
-    vw_module m = storm_module;
-    m.cell_build = wire_build;
-    m.cell_free = NULL;
-    m.step = agree_step;
-    vw_box box = {{0, 0, 0}, {1, 1, 1}};
-    int dims[3] = {vw_engine_size(), 1, 1};
-    vw_decomp *d;
-    CHECK_EQ_INT(vw_decomp_create_grid(&box, dims, &d), VW_OK);
-    storm st = {1, dims[0], 0, 0, -1, -1};
-    vw_config cfg;
-    vw_config_init(&cfg);
-    cfg.workers = 1;
-    CHECK_EQ_INT(vw_world_create(&m, &st, d, &cfg, &agree_world), VW_OK);
-    CHECK_EQ_INT(vw_world_run(agree_world), VW_OK);
-    fprintf(stderr, "test_mpi_storm: process %d: vw_world_agree from step() went unnoticed\n",
-            vw_engine_rank());
-    vw_world_free(agree_world);
-    vw_decomp_free(d);
-    return 1;
+    return run_line_world(&agree_world, agree_step, "vw_world_agree from step() went unnoticed");
 }
 
 int main(int argc, char **argv)

@@ -252,7 +252,7 @@ static void material_where(char *head, size_t hlen, char *name, size_t nlen, cha
         return;
     }
     /* A file (and a name in it) may hold anything: shown printable, on one line. */
-    char shown[512];
+    char shown[400], nshown[VW_SHOWN_NAME + 4];
     vw_text_shown(file, strlen(file), 0, shown, sizeof shown);
     if (mat->line > 0)
         snprintf(head, hlen, "%s:%d", shown, mat->line);
@@ -260,7 +260,7 @@ static void material_where(char *head, size_t hlen, char *name, size_t nlen, cha
         snprintf(head, hlen, "%s", shown);
     if (nm)
         snprintf(name, nlen, "material '%s': ",
-                 vw_text_shown(nm, strlen(nm), VW_SHOWN_NAME, shown, sizeof shown));
+                 vw_text_shown(nm, strlen(nm), VW_SHOWN_NAME, nshown, sizeof nshown));
     if (pg->line > 0) snprintf(polyref, plen, ", %s:%d", path ? path : "scene", pg->line);
 }
 

@@ -9,7 +9,8 @@
  * that is not). A cell that cannot be cut on any side (every side too few doubles wide)
  * is marked and passed over for the next heaviest: the other cells' pieces can still
  * fill the other workers. Bounded by max_extra splits; ends early when no cell can be
- * cut.
+ * cut, and when an uncuttable cell alone sets lambda on a fastest worker (no cut can
+ * lower lambda then: see divide_stops).
  */
 #include "balance/balance_internal.h"
 #include "decomp/decomp_internal.h"
@@ -73,6 +74,53 @@ static int cut_side(const vw_decomp *d, int cell, const vw__lpt *pts, long npts,
     return axis;
 }
 
+/* Whether no cut can lower lambda any more: some worker's time (its load over its speed
+   as a fraction of the fastest, as vw_map_greedy and vw__lambda take it) t_max, the
+   largest, equals the load of a cell that cannot be cut. Wherever any mapping puts
+   that cell, its worker takes at least its load over that worker's speed, so at least
+   its load (speeds are at most 1 as fractions); the total load does not change with
+   cuts, so neither can lambda. It is not enough that the most loaded worker holds only
+   an uncuttable cell: with unequal speeds it may sit on a slower worker, and pieces of
+   other cells can let the mapper give it a faster one (speeds 2 and 1, a cell 12 that
+   can be cut and 10 that cannot: 12 | 10 is 20 on the slow worker, 10 + 6 | 6 is 16).
+   Only cells whose load is at least t_max are candidates: t_max >= a cell's load over
+   its worker's speed >= its load, with equality only for a cell alone (but for cells
+   without load) on a fastest worker that sets lambda. A candidate not yet tried is
+   tried (cut_side) and marked when it cannot be cut; *known / *kaxis / *ksplit hand a
+   candidate found cuttable on to the caller, so the cut is not sought twice (it is the
+   heaviest cell, the one cut next). A cell whose load lies on one point but whose sides
+   hold doubles counts as cuttable, as in the loop: its pieces may share the load at the
+   next measurement, and after a few cuts it is a few doubles wide and uncuttable. */
+static int divide_stops(const vw_decomp *d, const double *load, const int *map, int nc, int gw,
+                        const double *speeds, unsigned char *uncut, const vw__lpt *pts,
+                        long npts, vw__lpt *tmp, const double *F, const vw_box *wb,
+                        double min_width, int *known, int *kaxis, double *ksplit)
+{
+    double *t = calloc((size_t)gw, sizeof *t), smax = 0, tmax = 0;
+    if (!t) return 0; /* the bound is an economy: without it, cut on as before */
+    for (int c = 0; c < nc; c++)
+        if (map[c] >= 0 && map[c] < gw && load[c] > 0) t[map[c]] += load[c];
+    for (int g = 0; speeds && g < gw; g++) smax = speeds[g] > smax ? speeds[g] : smax;
+    for (int g = 0; g < gw; g++) {
+        double x = t[g] / (speeds ? speeds[g] / smax : 1.0);
+        tmax = x > tmax ? x : tmax;
+    }
+    free(t);
+    for (int c = 0; c < nc && tmax > 0; c++) {
+        if (!(load[c] >= tmax)) continue;
+        if (!uncut[c] && *known != c) {
+            double s;
+            int a = cut_side(d, c, pts, npts, tmp, F, wb, min_width, &s);
+            if (a < 0)
+                uncut[c] = 1;
+            else if (*known < 0)
+                *known = c, *kaxis = a, *ksplit = s;
+        }
+        if (uncut[c]) return 1;
+    }
+    return 0;
+}
+
 vw_status vw__balance_divide(const vw_decomp *cur, const vw_load_field *f,
                              const vw_balance_params *p, vw_decomp **out, int *cell_worker)
 {
@@ -107,6 +155,13 @@ vw_status vw__balance_divide(const vw_decomp *cur, const vw_load_field *f,
         if (st != VW_OK) break;
         double lam = vw_balance_imbalance(load, map, nc, gw, p->speeds);
         if (lam <= 1.0 + p->tolerance || extra >= max_extra) break;
+        /* An uncuttable cell alone on a fastest worker sets lambda: cuts would spend cells
+           up to max_extra for nothing (they did, lambda unchanged). */
+        int known = -1, kaxis = -1;
+        double ksplit = 0;
+        if (divide_stops(d, load, map, nc, gw, p->speeds, uncut, pts, npts, tmp, F, &wb,
+                         p->min_width, &known, &kaxis, &ksplit))
+            break;
         /* The heaviest cell not marked uncuttable; one that proves uncuttable is marked
            and the next heaviest tried: stopping there left the other cells as they
            were, though their pieces could still fill the other workers. Each cell is
@@ -120,7 +175,10 @@ vw_status vw__balance_divide(const vw_decomp *cur, const vw_load_field *f,
                 if (!uncut[c] && (heavy < 0 || load[c] > load[heavy])) heavy = c;
             if (heavy >= 0 && !(load[heavy] > 0)) heavy = -1;
             if (heavy < 0) break;
-            axis = cut_side(d, heavy, pts, npts, tmp, F, &wb, p->min_width, &split);
+            if (heavy == known)
+                axis = kaxis, split = ksplit;
+            else
+                axis = cut_side(d, heavy, pts, npts, tmp, F, &wb, p->min_width, &split);
             if (axis >= 0) break;
             uncut[heavy] = 1;
         }

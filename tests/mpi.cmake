@@ -152,3 +152,16 @@ vw_mpi_script_test(mpi_wire_check 2 must_say.sh 60 wire
 vw_mpi_script_test(mpi_agree_in_step 2 must_say.sh 60 agree-in-step
                    "called vw_world_agree from a callback during a run"
                    $<TARGET_FILE:test_mpi_storm> --agree-in-step)
+
+# vw_world_traffic and vw_world_machines given a NULL pointer on some ranks only: every
+# rank fails with the lowest failing rank's message, none waits for the others (a hang
+# is caught by the time limit); alone, the threads engine's plain message.
+add_executable(test_mpi_traffic_agree ${PROJECT_SOURCE_DIR}/tests/mpi/test_mpi_traffic_agree.c)
+target_include_directories(test_mpi_traffic_agree PRIVATE ${PROJECT_SOURCE_DIR}/tests)
+target_link_libraries(test_mpi_traffic_agree PRIVATE vwalls_static m)
+foreach(np 1 2 3)
+  vw_mpi_test(mpi_traffic_agree_np${np} ${np} COMMAND $<TARGET_FILE:test_mpi_traffic_agree>)
+  set_tests_properties(mpi_traffic_agree_np${np} PROPERTIES TIMEOUT 60)
+endforeach()
+add_test(NAME traffic_agree_threads COMMAND test_mpi_traffic_agree)
+set_tests_properties(traffic_agree_threads PROPERTIES LABELS "mpi" TIMEOUT 60)

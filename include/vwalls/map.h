@@ -73,11 +73,15 @@ VW_API vw_status vw_world_remap(vw_world *w, const int *cell_worker);
 
 /* Share of neighbour traffic that stayed inside the sending worker, inside its process
    and inside its machine (messages and bytes, from the runtime's counters by
-   destination class) since the last vw_world_reset_stats. Collective under MPI.
-   Only messages sent count: work a module does in a cell of its own worker through
-   vw_ctx_enter is no message (the ray tracer hands every ray on that way, so its
-   msgs_worker stays 0 unless VW_STRESS refuses hand-offs). VW_E_INVAL when out is NULL,
-   VW_E_NOMEM, or vw_world_machines's failure. */
+   destination class) since the last vw_world_reset_stats. Only messages sent count:
+   work a module does in a cell of its own worker through vw_ctx_enter is no message
+   (the ray tracer hands every ray on that way, so its msgs_worker stays 0 unless
+   VW_STRESS refuses hand-offs). VW_E_INVAL when out is NULL, VW_E_NOMEM for the table
+   of machines, VW_E_MPI as vw_world_machines. Collective under MPI, and ends in
+   agreement like a step of the world's life (world.h): a failure on one process only
+   (out NULL there, no memory there) fails the call on every process with the lowest
+   failing one's status, vw_world_errmsg saying "rank R: <its message>" everywhere, and
+   no process is left waiting for another. */
 typedef struct vw_traffic {
     uint64_t msgs, bytes;                 /* cell-to-cell messages */
     uint64_t msgs_worker, bytes_worker;   /* ... whose destination is the same worker */
@@ -87,8 +91,9 @@ typedef struct vw_traffic {
 VW_API vw_status vw_world_traffic(vw_world *w, vw_traffic *out);
 /* The machine of every process (machine_of[vw_world_processes()]): the lowest rank that
    shares memory with it (MPI_Comm_split_type(MPI_COMM_TYPE_SHARED)); without MPI, 0.
-   Collective under MPI. VW_E_INVAL when machine_of is NULL, VW_E_MPI when MPI cannot
-   group the processes. */
+   Collective under MPI, and ends in agreement as vw_world_traffic does (machine_of
+   NULL on one process only fails the call on all). VW_E_INVAL when machine_of is NULL,
+   VW_E_MPI when MPI cannot group the processes. */
 VW_API vw_status vw_world_machines(vw_world *w, int *machine_of);
 
 #ifdef __cplusplus

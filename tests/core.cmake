@@ -21,7 +21,11 @@ vw_core_test(test_neighbours)
 add_test(NAME core_neighbours COMMAND test_neighbours)
 set_tests_properties(core_neighbours PROPERTIES LABELS "core")
 
+# The message storm (test_storm.c), on the threads engine here; the same program is the
+# MPI engine's storm and its agreement, fault and failure tests (mpi.cmake), so it knows
+# whether the build has MPI.
 vw_core_test(test_storm)
+target_compile_definitions(test_storm PRIVATE VW_HAVE_MPI=${VW_HAVE_MPI})
 add_test(NAME core_storm COMMAND test_storm 20)
 add_test(NAME core_storm_stress COMMAND test_storm 8 --stress)
 add_test(NAME core_storm_split COMMAND test_storm 4 --stress)

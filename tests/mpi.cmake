@@ -10,10 +10,8 @@ endif()
 
 # The launcher flags (VW_MPI_PREFLAGS, VW_MPI_FLAVOUR, VW_MPI_ENV): cmake/mpi_launcher.cmake.
 
-add_executable(test_mpi_storm ${PROJECT_SOURCE_DIR}/tests/mpi/test_mpi_storm.c)
-target_include_directories(test_mpi_storm PRIVATE ${PROJECT_SOURCE_DIR}/tests)
-target_link_libraries(test_mpi_storm PRIVATE vwalls_static m)
-target_compile_definitions(test_mpi_storm PRIVATE _GNU_SOURCE)
+# The storm and its agreement, fault and failure modes: tests/core/test_storm.c, the
+# threads engine's storm test (core.cmake), run by every rank of a job here.
 
 # vw_mpi_test(NAME NP [ENV list] COMMAND args...)
 function(vw_mpi_test name np)
@@ -37,7 +35,7 @@ endfunction()
 
 foreach(np 1 2 4 8)
   foreach(w 1 2)
-    vw_mpi_test(mpi_storm_np${np}_w${w} ${np} COMMAND $<TARGET_FILE:test_mpi_storm> --workers ${w} --seeds 2)
+    vw_mpi_test(mpi_storm_np${np}_w${w} ${np} COMMAND $<TARGET_FILE:test_storm> --workers ${w} --seeds 2)
     vw_mpi_test(mpi_pairs_np${np}_w${w} ${np}
                 COMMAND $<TARGET_FILE:vwalls_tool> example-pairs --spheres 3000 --radius 0.03 --seed 5
                         --cells 4x4x2 --workers ${w} --check --quiet)
@@ -45,17 +43,15 @@ foreach(np 1 2 4 8)
 endforeach()
 foreach(np 2 4 8)
   vw_mpi_test(mpi_storm_stress_np${np} ${np} ENV "VW_STRESS=${np}"
-              COMMAND $<TARGET_FILE:test_mpi_storm> --workers 2 --seeds 2)
+              COMMAND $<TARGET_FILE:test_storm> --workers 2 --seeds 2)
   vw_mpi_test(mpi_storm_split_np${np} ${np} ENV "VW_STRESS=1${np};VW_STRESS_SPLIT=1"
-              COMMAND $<TARGET_FILE:test_mpi_storm> --workers 1 --seeds 1)
+              COMMAND $<TARGET_FILE:test_storm> --workers 1 --seeds 1)
 endforeach()
 vw_mpi_test(mpi_pairs_stress_np4 4 ENV "VW_STRESS=99"
             COMMAND $<TARGET_FILE:vwalls_tool> example-pairs --spheres 3000 --radius 0.03 --cells 4x4x4
                     --workers 2 --check --quiet)
-# The threads engine's storm test, unchanged, run by every rank of an MPI job.
-if(TARGET test_storm)
-  vw_mpi_test(mpi_core_storm_np3 3 COMMAND $<TARGET_FILE:test_storm> 2)
-endif()
+# The storm as the threads engine's tests run it (1 to 8 workers per process, varying).
+vw_mpi_test(mpi_core_storm_np3 3 COMMAND $<TARGET_FILE:test_storm> 2)
 # A step() that sends and reports no work: what it sent arrives in that run, across
 # processes too.
 if(TARGET test_runtime)
@@ -72,8 +68,8 @@ if(TARGET test_farm)
                      "asked for turns of cell 0, copy [0-9]+, which this process does not host"
                      $<TARGET_FILE:test_farm> --mpi --garble-turn)
 endif()
-vw_mpi_test(mpi_agree_np1 1 COMMAND $<TARGET_FILE:test_mpi_storm> --agree)
-vw_mpi_test(mpi_agree_np3 3 COMMAND $<TARGET_FILE:test_mpi_storm> --agree)
+vw_mpi_test(mpi_agree_np1 1 COMMAND $<TARGET_FILE:test_storm> --agree)
+vw_mpi_test(mpi_agree_np3 3 COMMAND $<TARGET_FILE:test_storm> --agree)
 
 # Counters and per-cell messages of the stats JSON equal the threads engine's.
 set(VW_MPI_LAUNCH ${MPIEXEC_EXECUTABLE} ${MPIEXEC_NUMPROC_FLAG})
@@ -103,7 +99,7 @@ vw_mpi_script_test(mpi_rank_alone 2 rank_alone.sh 150
 # Faults: the job ends within 10 s, non-zero, naming the rank (a rank that hangs: by the
 # launcher's time limit, MPIEXEC_TIMEOUT).
 foreach(mode kill exit hang)
-  vw_mpi_script_test(mpi_fault_${mode} 4 fault.sh 60 ${mode} $<TARGET_FILE:test_mpi_storm>)
+  vw_mpi_script_test(mpi_fault_${mode} 4 fault.sh 60 ${mode} $<TARGET_FILE:test_storm>)
 endforeach()
 
 # Two machines: network namespaces joined by a veth pair, TCP only (Open MPI's rsh
@@ -123,7 +119,7 @@ endif()
 # the others. So does a run that a handler fails on one rank (vw_ctx_fail) while every
 # step() sends for ever: every rank drops its work from the next wave on.
 foreach(step create add update replicas redecompose commit run handler)
-  vw_mpi_script_test(mpi_local_fail_${step} 3 local_fail.sh 60 ${step} 3 $<TARGET_FILE:test_mpi_storm>)
+  vw_mpi_script_test(mpi_local_fail_${step} 3 local_fail.sh 60 ${step} 3 $<TARGET_FILE:test_storm>)
 endforeach()
 
 # A run that fails on the output process alone (an output only rank 0 writes, in every
@@ -145,13 +141,13 @@ vw_mpi_test(mpi_build_mixed 2 ENV "VW_FAULT=build-id;VW_MIXED_BUILDS=1"
 # A peer whose module has a message kind more (another build): the receiver checks every
 # packet from another process and stops the job, naming the sender.
 vw_mpi_script_test(mpi_wire_check 2 must_say.sh 60 wire
-                   "rank 0: packet from rank 1 .*malformed: message 0 is of kind 2"
-                   $<TARGET_FILE:test_mpi_storm> --wire)
+                   "rank 0: packet from rank 1 .*malformed: message 0 is of kind 3"
+                   $<TARGET_FILE:test_storm> --wire)
 # A step() that calls vw_world_agree (a collective, from a worker thread mid-run) stops
 # the job naming the call, as the calls that change the world from a callback do.
 vw_mpi_script_test(mpi_agree_in_step 2 must_say.sh 60 agree-in-step
                    "called vw_world_agree from a callback during a run"
-                   $<TARGET_FILE:test_mpi_storm> --agree-in-step)
+                   $<TARGET_FILE:test_storm> --agree-in-step)
 
 # vw_world_traffic and vw_world_machines given a NULL pointer on some ranks only: every
 # rank fails with the lowest failing rank's message, none waits for the others (a hang

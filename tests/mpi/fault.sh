@@ -6,7 +6,7 @@
 # status and a message naming the rank; a hung rank sends no such message (nothing has
 # failed), so that job must end by the launcher's time limit (MPIEXEC_TIMEOUT, honoured
 # by Open MPI's mpirun and MPICH's Hydra alike), saying so.
-# usage: fault.sh kill|exit|hang TEST_MPI_STORM "MPIEXEC -n 4 [flags]"
+# usage: fault.sh kill|exit|hang TEST_STORM "MPIEXEC -n 4 [flags]"
 mode=$1 prog=$2 launch=$3
 case $mode in
 kill) args="--kill-rank 2" rank=2 ;;

@@ -161,3 +161,16 @@ foreach(np 1 2 3)
 endforeach()
 add_test(NAME traffic_agree_threads COMMAND test_mpi_traffic_agree)
 set_tests_properties(traffic_agree_threads PROPERTIES LABELS "mpi" TIMEOUT 60)
+
+# The object records under MPI: each process keeps only its cells' and copies' share,
+# and every cell gets its records whole through remaps, new decompositions, copies and
+# moves (records fetched from the processes that keep them). Alone: every record kept.
+add_executable(test_mpi_records ${PROJECT_SOURCE_DIR}/tests/mpi/test_mpi_records.c)
+target_include_directories(test_mpi_records PRIVATE ${PROJECT_SOURCE_DIR}/tests ${PROJECT_SOURCE_DIR}/src)
+target_link_libraries(test_mpi_records PRIVATE vwalls_static m)
+foreach(np 2 3 4)
+  vw_mpi_test(mpi_records_np${np} ${np} COMMAND $<TARGET_FILE:test_mpi_records>)
+endforeach()
+vw_mpi_test(mpi_records_np2_w2 2 ENV "VW_STRESS=7" COMMAND $<TARGET_FILE:test_mpi_records> --workers 2)
+add_test(NAME records_threads COMMAND test_mpi_records --workers 2)
+set_tests_properties(records_threads PROPERTIES LABELS "mpi" TIMEOUT 60)

@@ -119,7 +119,10 @@ VW_API const char *vw_world_errmsg(const vw_world *w);
 /* Objects get global ids in the order added (0, 1, ...); no callback is told the id, so
    a module that needs it keeps it in its object record. An object whose bounds meet no
    cell (outside the world box) is held by no cell: that is how a removed object keeps
-   its id (the dynamic scenes do so), and vw_world_cells_of_object reports 0 for it. */
+   its id (the dynamic scenes do so), and vw_world_cells_of_object reports 0 for it.
+   Under MPI every process is given every object, and keeps the records of those its
+   cells and copies hold (and of some no cell holds): each its share, fetched from the
+   others at a commit that needs them (docs/runtime.md, "Object records"). */
 VW_API vw_status vw_world_add_objects(vw_world *w, const void *objects, size_t n);
 /* Build every cell (cell_build on the hosting worker). */
 VW_API vw_status vw_world_commit(vw_world *w);

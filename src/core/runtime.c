@@ -1083,18 +1083,27 @@ static vw_status build_unit(vw_world *w, int cell, int rep, vw__worker *wk)
     const unsigned char *objs = NULL;
     unsigned char *gathered = NULL;
     if (c->nobjs) {
-        /* A cell whose objects are a run of the world's, in order (a cell that holds
-           them all), builds from the world's own records: they stay as they are while
-           the cells are built, and a copy would be the largest allocation of the build. */
-        size_t first = c->objs[0], k = 1;
-        while (k < c->nobjs && c->objs[k] == first + k) k++;
-        if (k == c->nobjs) {
-            objs = w->objects + first * osz;
+        /* A cell whose objects' records are a run of the world's, in order (a cell that
+           holds them all), builds from the world's own records: they stay as they are
+           while the cells are built, and a copy would be the largest allocation of the
+           build. Under MPI the process keeps the records of the cells it builds (the
+           commit fetched them: share_records, world.c). */
+        const unsigned char *first = vw__world_record(w, c->objs[0]);
+        size_t k = 1;
+        while (first && k < c->nobjs && vw__world_record(w, c->objs[k]) == first + k * osz) k++;
+        if (first && k == c->nobjs) {
+            objs = first;
         } else {
             gathered = malloc(osz * c->nobjs);
             if (!gathered) return VW_E_NOMEM;
-            for (size_t i = 0; i < c->nobjs; i++)
-                memcpy(gathered + i * osz, w->objects + c->objs[i] * osz, osz);
+            for (size_t i = 0; i < c->nobjs; i++) {
+                const unsigned char *r = vw__world_record(w, c->objs[i]);
+                if (!r) { /* (not for want of memory: a defect, said as a state error) */
+                    free(gathered);
+                    return VW_E_STATE;
+                }
+                memcpy(gathered + i * osz, r, osz);
+            }
             objs = gathered;
         }
     }

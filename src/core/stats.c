@@ -52,6 +52,7 @@ void vw__stats_local(vw_world *w)
         ws->bytes_remote = wk->bytes_remote;
         ws->turns_remote = wk->turns_remote;
         ws->peak_rss = rss;
+        ws->records = w->nslots;
     }
 }
 
@@ -67,6 +68,8 @@ static void write_body(vw_world *w, FILE *f, const char *command, const char *ex
     fprintf(f, "  \"decomposition\": {\"kind\": \"%s\", \"layout\": \"%s\", \"cells\": %d, \"max_neighbours\": %d, \"rotated\": %s},\n",
             vw_decomp_kind_name(vw_decomp_get_kind(w->decomp)), layout, w->ncells,
             vw_decomp_max_neighbours(w->decomp), vw_decomp_frame(w->decomp) ? "true" : "false");
+    /* Every object; each process keeps the records of its share (workers[].records). */
+    fprintf(f, "  \"objects\": %zu,\n", w->nobjects);
     double lambda = vw_world_imbalance(w);
     /* The strategy and the phases are named by the caller: escaped like every string. */
     fprintf(f, "  \"balance\": {\"strategy\": ");
@@ -145,9 +148,10 @@ static void write_body(vw_world *w, FILE *f, const char *command, const char *ex
         /* The worker's speed (vw_config.worker_speeds, 1 when none were given): with
            speeds lambda is the longest time against a split by speed, which a reader
            can recompute from busy_s only when the speeds are here. */
-        fprintf(f, "    {\"id\": %d, \"process\": %d, \"speed\": %.9g, \"busy_s\": %.6f, \"peak_rss_bytes\": %llu, \"messages\": %llu, \"bytes\": %llu, \"remote_count\": %llu, \"remote_bytes\": %llu, \"remote_turns\": %llu",
+        fprintf(f, "    {\"id\": %d, \"process\": %d, \"speed\": %.9g, \"busy_s\": %.6f, \"peak_rss_bytes\": %llu, \"records\": %llu, \"messages\": %llu, \"bytes\": %llu, \"remote_count\": %llu, \"remote_bytes\": %llu, \"remote_turns\": %llu",
                 g, vw__worker_process(w, g), num(w->speeds ? w->speeds[g] : 1.0),
                 num(vw_world_worker_busy(w, g)), (unsigned long long)rss,
+                (unsigned long long)(vw__worker_process(w, g) == w->rank ? w->nslots : ws->records),
                 (unsigned long long)ws->msgs_sent, (unsigned long long)ws->bytes_sent,
                 (unsigned long long)ws->msgs_remote, (unsigned long long)ws->bytes_remote,
                 (unsigned long long)ws->turns_remote);

@@ -9,6 +9,7 @@
 #include "core/world_internal.h"
 #include "vwalls/engine.h"
 
+#include <limits.h>
 #include <link.h>
 #include <math.h>
 #include <stdarg.h>
@@ -470,6 +471,8 @@ void vw_world_free(vw_world *w)
     pthread_cond_destroy(&w->pool_cv);
     vw_decomp_free(w->decomp);
     free(w->objects);
+    free(w->slot);
+    free(w->bounds);
     for (int i = 0; i < w->nphases; i++) free(w->phases[i].name);
     free(w->phases);
     free(w);
@@ -490,16 +493,159 @@ static vw_status cell_add_object(vw__cell *c, size_t id)
     return VW_OK;
 }
 
+/* Object id's bounds: kept for every object under MPI (a process need not keep its
+   record), else read from its record. */
+static void object_box(const vw_world *w, size_t id, vw_box *b)
+{
+    if (w->bounds)
+        *b = w->bounds[id];
+    else
+        w->m->object_bounds(w->objects + id * w->m->object_size, b, w->user);
+}
+
 /* The cells object id overlaps; returns the count, list in *out (caller frees). */
 static int object_cells(vw_world *w, size_t id, int **out)
 {
     vw_box b;
-    w->m->object_bounds(w->objects + id * w->m->object_size, &b, w->user);
+    object_box(w, id, &b);
     int n = vw_decomp_cells_overlapping(w->decomp, &b, w->pad, NULL, 0);
     *out = malloc(sizeof(int) * (size_t)(n ? n : 1));
     if (!*out) return -1;
     vw_decomp_cells_overlapping(w->decomp, &b, w->pad, *out, n);
     return n;
+}
+
+/* ---- the records this process keeps (vw_world.objects) -------------------------------- */
+
+/* Whether this process hosts cell c or one of its copies: then it builds it, from the
+   records of the cell's objects. */
+static int cell_here(const vw_world *w, int c)
+{
+    const vw__cell *cl = &w->cells[c];
+    if (vw__worker_process(w, cl->worker) == w->rank) return 1;
+    for (int r = 0; r < cl->nreps; r++)
+        if (vw__worker_process(w, cl->reps[r].worker) == w->rank) return 1;
+    return 0;
+}
+
+/* The process that keeps the record of an object no cell holds (so that every record
+   is kept somewhere: a later decomposition or update may place it again). */
+static int home_of(const vw_world *w, size_t id) { return (int)(id % (size_t)w->nprocs); }
+
+/* Whether a process keeps the record of object id, held by cells[0..n): it builds one
+   of them, or none holds it and this is its home. */
+static int record_kept_here(const vw_world *w, size_t id, const int *cells, int n)
+{
+    if (n == 0) return home_of(w, id) == w->rank;
+    for (int i = 0; i < n; i++)
+        if (cell_here(w, cells[i])) return 1;
+    return 0;
+}
+
+/* Room for `more` records past the nslots kept (doubling); 0 if out of memory. */
+static int reserve_slots(vw_world *w, size_t more)
+{
+    size_t osz = w->m->object_size;
+    if (more > SIZE_MAX / osz - w->nslots) return 0;
+    if (w->nslots + more <= w->capslots) return 1;
+    size_t cap = w->capslots ? w->capslots : 64;
+    while (cap < w->nslots + more) cap = cap > SIZE_MAX / osz / 2 ? w->nslots + more : 2 * cap;
+    unsigned char *o = realloc(w->objects, cap * osz);
+    if (!o) return 0;
+    w->objects = o;
+    w->capslots = cap;
+    return 1;
+}
+
+/* Under MPI: the record of object id given (add, update), held by cells[0..n), kept
+   when this process keeps it (record_kept_here), else forgotten. */
+static vw_status keep_record(vw_world *w, size_t id, const void *record, const int *cells, int n)
+{
+    size_t osz = w->m->object_size;
+    if (!record_kept_here(w, id, cells, n)) {
+        w->slot[id] = VW__NO_SLOT; /* a record kept before is dropped at the next commit */
+        return VW_OK;
+    }
+    if (w->slot[id] == VW__NO_SLOT) {
+        if (!reserve_slots(w, 1)) return VW_E_NOMEM;
+        w->slot[id] = w->nslots++;
+    }
+    memcpy(w->objects + w->slot[id] * osz, record, osz);
+    return VW_OK;
+}
+
+/* At the commit, under MPI: the records this process's cells and copies now hold (a new
+   decomposition, mapping or copies may have given it cells whose records it did not
+   keep) are fetched from processes that keep them, then those it no longer needs are
+   dropped: only after every process has what it needs, so no record is ever lost. The
+   records kept are laid out by id, so a cell holding a run of objects builds from them
+   in place (runtime.c). Collective; st is this process's status so far; every failure
+   is agreed (msg says why), and a failed share leaves every process's records as they
+   were. */
+static vw_status share_records(vw_world *w, vw_status st, char *msg, size_t len)
+{
+    size_t n = w->nobjects, osz = w->m->object_size;
+    /* keep[id]: this process keeps record id from now on; held[id]: some cell holds it */
+    unsigned char *keep = calloc(n ? n : 1, 1), *held = calloc(n ? n : 1, 1);
+    uint64_t *ask = NULL;
+    unsigned char *store = NULL;
+    size_t nkeep = 0, nask = 0;
+    if (st == VW_OK && !(keep && held)) {
+        st = VW_E_NOMEM;
+        snprintf(msg, len, "out of memory fetching object records");
+    }
+    if (st == VW_OK && osz > INT_MAX) { /* (an MPI count of bytes) */
+        st = VW_E_LIMIT;
+        snprintf(msg, len, "object records of %zu bytes cannot cross MPI (at most %d)", osz, INT_MAX);
+    }
+    if (st == VW_OK) {
+        for (int c = 0; c < w->ncells; c++) {
+            int here = cell_here(w, c);
+            for (size_t k = 0; k < w->cells[c].nobjs; k++) {
+                held[w->cells[c].objs[k]] = 1;
+                if (here) keep[w->cells[c].objs[k]] = 1;
+            }
+        }
+        for (size_t id = 0; id < n; id++) {
+            if (!held[id] && home_of(w, id) == w->rank) keep[id] = 1;
+            nkeep += keep[id];
+            nask += keep[id] && w->slot[id] == VW__NO_SLOT;
+        }
+        ask = malloc(sizeof *ask * (nask ? nask : 1));
+        store = malloc(osz * (nkeep ? nkeep : 1));
+        if (!ask || !store) {
+            st = VW_E_NOMEM;
+            snprintf(msg, len, "out of memory keeping %zu object records", nkeep);
+        }
+    }
+    for (size_t id = 0, k = 0; st == VW_OK && id < n; id++)
+        if (keep[id] && w->slot[id] == VW__NO_SLOT) ask[k++] = id;
+    unsigned char *got = NULL;
+    st = vw__mpi_fetch_records(w, st, ask, nask, &got, msg, len);
+    if (st == VW_OK) {
+        /* Nothing can fail from here: every process now has what it keeps. */
+        size_t s = 0, k = 0;
+        for (size_t id = 0; id < n; id++) {
+            if (!keep[id]) {
+                w->slot[id] = VW__NO_SLOT;
+                continue;
+            }
+            const unsigned char *src =
+                w->slot[id] != VW__NO_SLOT ? w->objects + w->slot[id] * osz : got + osz * k++;
+            memcpy(store + s * osz, src, osz);
+            w->slot[id] = s++;
+        }
+        free(w->objects);
+        w->objects = store;
+        w->nslots = w->capslots = nkeep;
+        store = NULL;
+    }
+    free(got);
+    free(store);
+    free(ask);
+    free(held);
+    free(keep);
+    return st;
 }
 
 static vw_status place_object(vw_world *w, size_t id)
@@ -517,6 +663,19 @@ static vw_status place_object(vw_world *w, size_t id)
     return st;
 }
 
+/* Under MPI: object id's record given (add, update): its bounds kept, the record kept
+   or not (keep_record), and the object placed. */
+static vw_status place_record(vw_world *w, size_t id, const void *record)
+{
+    w->m->object_bounds(record, &w->bounds[id], w->user);
+    int *cells;
+    int n = object_cells(w, id, &cells);
+    if (n < 0) return VW_E_NOMEM;
+    vw_status st = keep_record(w, id, record, cells, n);
+    free(cells);
+    return st == VW_OK ? place_object(w, id) : st;
+}
+
 static vw_status add_objects(vw_world *w, const void *objects, size_t n)
 {
     if (n && !objects)
@@ -530,17 +689,30 @@ static vw_status add_objects(vw_world *w, const void *objects, size_t n)
     /* The records' bytes must fit a size_t: a count near SIZE_MAX wrapped the capacity
        to a small allocation and the copy ran past it. */
     if (n > SIZE_MAX / osz - w->nobjects) return VW_E_NOMEM;
-    if (w->nobjects + n > w->capobjects) {
-        size_t cap = w->capobjects ? w->capobjects : 64;
-        while (cap < w->nobjects + n) cap = cap > SIZE_MAX / osz / 2 ? w->nobjects + n : 2 * cap;
-        unsigned char *o = realloc(w->objects, cap * osz);
-        if (!o) return VW_E_NOMEM;
-        w->objects = o;
-        w->capobjects = cap;
-    }
-    memcpy(w->objects + w->nobjects * osz, objects, n * osz);
     size_t first = w->nobjects;
+    if (w->nprocs > 1) {
+        /* Every object's bounds and slot; its record only where it is kept. */
+        size_t total = first + n;
+        if (total > SIZE_MAX / sizeof(vw_box)) return VW_E_NOMEM;
+        vw_box *b = realloc(w->bounds, total * sizeof *b);
+        if (b) w->bounds = b;
+        size_t *sl = b ? realloc(w->slot, total * sizeof *sl) : NULL;
+        if (sl) w->slot = sl;
+        if (!b || !sl) return VW_E_NOMEM;
+        for (size_t i = first; i < total; i++) w->slot[i] = VW__NO_SLOT;
+        w->nobjects = total;
+        const unsigned char *rec = objects;
+        for (size_t i = 0; i < n; i++) {
+            vw_status st = place_record(w, first + i, rec + i * osz);
+            if (st != VW_OK) return st;
+        }
+        w->committed = 0;
+        return VW_OK;
+    }
+    if (!reserve_slots(w, n)) return VW_E_NOMEM;
+    memcpy(w->objects + w->nobjects * osz, objects, n * osz);
     w->nobjects += n;
+    w->nslots = w->nobjects;
     for (size_t i = first; i < w->nobjects; i++) {
         vw_status st = place_object(w, i);
         if (st != VW_OK) return st;
@@ -574,8 +746,13 @@ static vw_status update_object(vw_world *w, size_t id, const void *object)
             }
     }
     free(cells);
-    memcpy(w->objects + id * w->m->object_size, object, w->m->object_size);
-    vw_status st = place_object(w, id);
+    vw_status st;
+    if (w->slot) {
+        st = place_record(w, id, object);
+    } else {
+        memcpy(w->objects + id * w->m->object_size, object, w->m->object_size);
+        st = place_object(w, id);
+    }
     w->committed = 0;
     return st;
 }
@@ -630,7 +807,7 @@ static uint64_t world_fingerprint(const vw_world *w)
     h = vw__fnv1a(h, &n, sizeof n);
     for (size_t i = 0; i < w->nobjects; i++) {
         vw_box b;
-        w->m->object_bounds(w->objects + i * w->m->object_size, &b, w->user);
+        object_box(w, i, &b);
         h = vw__fnv1a(h, &b, sizeof b);
     }
     return h;
@@ -656,11 +833,19 @@ vw_status vw_world_commit(vw_world *w)
     if (st != VW_OK)
         snprintf(msg, sizeof msg, "listing each worker's cells and copies: %s",
                  vw_status_message(st));
-    else if ((st = vw__runtime_build(w, &cell, &rep)) != VW_OK && rep)
-        snprintf(msg, sizeof msg, "building copy %d of cell %d failed: %s", rep, cell,
-                 vw_status_message(st));
-    else if (st != VW_OK)
-        snprintf(msg, sizeof msg, "building cell %d failed: %s", cell, vw_status_message(st));
+    /* Under MPI the records of the cells to build come first: collective, and agreed
+       (a failure before it too), so that msg says why on every process. */
+    if (w->nprocs > 1 && w->m->object_size) {
+        st = share_records(w, st, msg, sizeof msg);
+        if (st != VW_OK) return vw__world_error(w, st, "%s", msg);
+    }
+    if (st == VW_OK && (st = vw__runtime_build(w, &cell, &rep)) != VW_OK) {
+        if (rep)
+            snprintf(msg, sizeof msg, "building copy %d of cell %d failed: %s", rep, cell,
+                     vw_status_message(st));
+        else
+            snprintf(msg, sizeof msg, "building cell %d failed: %s", cell, vw_status_message(st));
+    }
     /* Under MPI every process builds only its own cells; they agree before anyone runs,
        so a cell that fails on one process fails the commit everywhere, naming the cell
        and (vw_world_agree's "rank R: ") the lowest failing process. */
@@ -1233,6 +1418,15 @@ int vw__mpi_first_differing(vw_world *w, uint64_t v)
 {
     (void)w, (void)v;
     return -1;
+}
+
+vw_status vw__mpi_fetch_records(vw_world *w, vw_status local, const uint64_t *ask,
+                                size_t nask, unsigned char **got, char *msg, size_t len)
+{
+    /* One process keeps every record: nothing is ever asked. */
+    (void)w, (void)ask, (void)msg, (void)len;
+    *got = NULL;
+    return local == VW_OK && nask ? VW_E_STATE : local;
 }
 
 int vw_engine_launched(void) { return 0; }

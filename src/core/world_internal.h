@@ -182,6 +182,7 @@ typedef struct vw__worker_stats {
     uint64_t msgs_remote, bytes_remote; /* that crossed a process boundary */
     uint64_t turns_remote;              /* turns made of copies on other processes */
     uint64_t peak_rss;                  /* of the worker's process */
+    uint64_t records;                   /* object records its process keeps (vw_world.nslots) */
 } vw__worker_stats;
 
 /* How packets leave this process (the MPI engine); NULL for the threads engine.
@@ -221,8 +222,20 @@ struct vw_world {
     vw__cell *cells;
     int *cell_worker;          /* cell -> global worker */
     vw__worker *workers;       /* this process's workers */
-    unsigned char *objects;    /* all object records, object_size each */
-    size_t nobjects, capobjects;
+    /* The objects. Ids 0 .. nobjects-1, in the order added. On one process every
+       record is kept, record id at objects + id * object_size (slot and bounds NULL).
+       Under MPI (nprocs > 1) a process keeps only its share (DESIGN.md: "a worker holds
+       only its cells' share"): the records of the objects its cells and copies hold
+       (an object no cell holds, by its home process id % nprocs, so that every record
+       is kept somewhere); slot[id] is the record's place in objects, or VW__NO_SLOT,
+       and bounds[id] every object's bounds, which the placement reads. The commit
+       fetches what a process lacks from a process that keeps it and then drops what it
+       no longer needs (share_records, world.c). */
+    unsigned char *objects;
+    size_t nobjects;           /* objects added */
+    size_t nslots, capslots;   /* records in objects, and room for */
+    size_t *slot;
+    vw_box *bounds;
     double pad;                /* placement padding (world units) */
     int committed;
     /* The workers' unit lists (vw__worker.cells) lag the copies of duplicated cells:
@@ -378,12 +391,28 @@ uint64_t vw__peak_rss(void);
    other processes of the host (vw__mpi_core_share). */
 int vw__host_cores_given(void);
 
+/* The records a process keeps (vw_world.objects): NULL for one it does not. */
+#define VW__NO_SLOT SIZE_MAX
+static inline const unsigned char *vw__world_record(const vw_world *w, size_t id)
+{
+    size_t s = w->slot ? w->slot[id] : id;
+    return s == VW__NO_SLOT ? NULL : w->objects + s * w->m->object_size;
+}
+
 /* transport/mpi.c (stubs in world.c without MPI). vw__mpi_attach decides the engine at
    create: it sets rank, nprocs and w->transport when the world runs under MPI. */
 vw_status vw__mpi_attach(vw_world *w);
 /* Collective over the world's processes: the lowest rank whose v differs from rank 0's,
    or -1 when all agree (always -1 without MPI). */
 int vw__mpi_first_differing(vw_world *w, uint64_t v);
+/* Collective: the records a process lacks (share_records, world.c). First agrees on
+   `local` (msg: why it failed); then, unless no process asks for any, finds the lowest
+   process that keeps each record (one MPI_Allreduce of an int an object), and each
+   process asks its records of those (vw__world_record answers). On VW_OK *got
+   holds the nask records whose ids are ask[], in that order (the caller frees it).
+   Every failure is agreed, with its message in msg. */
+vw_status vw__mpi_fetch_records(vw_world *w, vw_status local, const uint64_t *ask,
+                                size_t nask, unsigned char **got, char *msg, size_t len);
 /* vw_world_agree without its guard (engine.h): the runtime's own agreements, one of
    which (the end of a run) is made while w->in_callbacks still says a run. The public
    vw_world_agree (world.c) refuses a call from a callback, then calls this: the MPI

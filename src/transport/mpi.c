@@ -123,6 +123,119 @@ int vw__mpi_first_differing(vw_world *w, uint64_t v)
     return first < w->nprocs ? first : -1;
 }
 
+vw_status vw__mpi_fetch_records(vw_world *w, vw_status local, const uint64_t *ask,
+                                size_t nask, unsigned char **got, char *msg, size_t len)
+{
+    *got = NULL;
+    MPI_Comm c = vw__mpi_world_comm(w);
+    int P = w->nprocs;
+    size_t osz = w->m->object_size, n = w->nobjects;
+    int *holder = NULL;
+    uint64_t *req = NULL, *sorted = NULL;
+    unsigned char *answer = NULL, *in = NULL, *mine = NULL;
+    int *sn = calloc((size_t)P, sizeof *sn), *sat = calloc((size_t)P, sizeof *sat);
+    int *rn = calloc((size_t)P, sizeof *rn), *rat = calloc((size_t)P, sizeof *rat);
+    int *next = calloc((size_t)P, sizeof *next);
+    vw_status st = local;
+    if (st == VW_OK && !(sn && sat && rn && rat && next)) {
+        st = VW_E_NOMEM;
+        snprintf(msg, len, "out of memory fetching object records");
+    }
+    if (st == VW_OK && nask > INT_MAX) {
+        st = VW_E_LIMIT;
+        snprintf(msg, len, "fetching object records: %zu at a time (at most %d)", nask, INT_MAX);
+    }
+    /* Each agreement comes before a collective: a process that failed alone must not
+       leave the others waiting in it. */
+    if ((st = vw__mpi_agree(c, st, msg, len)) != VW_OK) goto done;
+    unsigned long long mine_n = nask, total = 0;
+    MPI_Allreduce(&mine_n, &total, 1, MPI_UNSIGNED_LONG_LONG, MPI_SUM, c);
+    if (total == 0) goto done; /* (the same answer everywhere) */
+    /* Which process sends each record: the lowest that keeps it. One int an object,
+       reduced in pieces (MPI counts in int). */
+    holder = malloc(sizeof *holder * (n ? n : 1));
+    if (!holder) {
+        st = VW_E_NOMEM;
+        snprintf(msg, len, "out of memory fetching object records");
+    }
+    if ((st = vw__mpi_agree(c, st, msg, len)) != VW_OK) goto done;
+    for (size_t id = 0; id < n; id++) holder[id] = vw__world_record(w, id) ? w->rank : P;
+    for (size_t off = 0; off < n; off += (size_t)1 << 28) {
+        size_t k = n - off < (size_t)1 << 28 ? n - off : (size_t)1 << 28;
+        MPI_Allreduce(MPI_IN_PLACE, holder + off, (int)k, MPI_INT, MPI_MIN, c);
+    }
+    /* How many this process asks of each holder. */
+    for (size_t i = 0; i < nask && st == VW_OK; i++) {
+        int h = ask[i] < n ? holder[ask[i]] : P;
+        if (h == P) {
+            st = VW_E_STATE;
+            snprintf(msg, len, "needs the record of object %llu, which no process keeps",
+                     (unsigned long long)ask[i]);
+        } else {
+            sn[h]++;
+        }
+    }
+    if ((st = vw__mpi_agree(c, st, msg, len)) != VW_OK) goto done;
+    size_t nreq = 0;
+    MPI_Alltoall(sn, 1, MPI_INT, rn, 1, MPI_INT, c);
+    for (int p = 0; p < P; p++) {
+        sat[p] = p ? sat[p - 1] + sn[p - 1] : 0;
+        rat[p] = (int)nreq;
+        nreq += (size_t)rn[p];
+    }
+    if (nreq > INT_MAX) {
+        st = VW_E_LIMIT;
+        snprintf(msg, len, "fetching object records: %zu asked of one process (at most %d)",
+                 nreq, INT_MAX);
+    }
+    if (st == VW_OK) {
+        req = malloc(sizeof *req * (nreq ? nreq : 1));
+        sorted = malloc(sizeof *sorted * (nask ? nask : 1));
+        answer = malloc(osz * (nreq ? nreq : 1));
+        in = malloc(osz * (nask ? nask : 1));
+        mine = malloc(osz * (nask ? nask : 1));
+        if (!req || !sorted || !answer || !in || !mine) {
+            st = VW_E_NOMEM;
+            snprintf(msg, len, "out of memory fetching object records");
+        }
+    }
+    if ((st = vw__mpi_agree(c, st, msg, len)) != VW_OK) goto done;
+    /* The asks by holder, each holder's in ascending ids (as ask is). */
+    for (size_t i = 0; i < nask; i++) {
+        int h = holder[ask[i]];
+        sorted[sat[h] + next[h]++] = ask[i];
+    }
+    MPI_Alltoallv(sorted, sn, sat, MPI_UINT64_T, req, rn, rat, MPI_UINT64_T, c);
+    /* A holder keeps what it was asked for: it said so in the reduction. */
+    for (size_t i = 0; i < nreq; i++) memcpy(answer + i * osz, vw__world_record(w, (size_t)req[i]), osz);
+    MPI_Datatype rec;
+    MPI_Type_contiguous((int)osz, MPI_BYTE, &rec);
+    MPI_Type_commit(&rec);
+    MPI_Alltoallv(answer, rn, rat, rec, in, sn, sat, rec, c);
+    MPI_Type_free(&rec);
+    /* Back into the order asked. */
+    memset(next, 0, sizeof *next * (size_t)P);
+    for (size_t i = 0; i < nask; i++) {
+        int h = holder[ask[i]];
+        memcpy(mine + osz * i, in + osz * (size_t)(sat[h] + next[h]++), osz);
+    }
+    *got = mine;
+    mine = NULL;
+done:
+    free(mine);
+    free(in);
+    free(answer);
+    free(sorted);
+    free(req);
+    free(holder);
+    free(next);
+    free(rat);
+    free(rn);
+    free(sat);
+    free(sn);
+    return st;
+}
+
 static void fatal(vw_world *w, const char *what)
 {
     char msg[600];
@@ -570,6 +683,9 @@ static vw_status tp_run(vw_world *w)
    the last sync, so a sum where only the host contributes gives the host's figures.
    The copies of duplicated cells follow the cells, as rows of their own (every process
    knows the same copies, so the layout agrees), each contributed by its own host. */
+/* The integers of a worker's figures (vw__worker_stats) in the sync. */
+#define SYNC_WORKER_WORDS 8
+
 static vw_status tp_sync(vw_world *w)
 {
     mpi_tp *t = tp_of(w);
@@ -577,7 +693,7 @@ static vw_status tp_sync(vw_world *w)
     size_t nu = (size_t)w->ncells + (size_t)vw__replica_total(w); /* cells, then copies */
     size_t ni = nu * (size_t)(1 + nc), nd = nu * 2;
     size_t nw = (size_t)w->gworkers;
-    int64_t *iv = calloc(ni + 7 * nw, sizeof *iv);
+    int64_t *iv = calloc(ni + SYNC_WORKER_WORDS * nw, sizeof *iv);
     double *dv = calloc(nd + nw, sizeof *dv);
     if (!iv || !dv) {
         free(iv);
@@ -607,7 +723,7 @@ static vw_status tp_sync(vw_world *w)
     int64_t *wv = iv + ni;
     for (int i = 0; i < w->nworkers; i++) {
         const vw__worker_stats *s = &w->wstats[w->workers[i].global];
-        int64_t *row = wv + 7 * (size_t)w->workers[i].global;
+        int64_t *row = wv + SYNC_WORKER_WORDS * (size_t)w->workers[i].global;
         row[0] = (int64_t)s->msgs_sent;
         row[1] = (int64_t)s->bytes_sent;
         row[2] = (int64_t)s->packets_sent;
@@ -615,9 +731,10 @@ static vw_status tp_sync(vw_world *w)
         row[4] = (int64_t)s->bytes_remote;
         row[5] = (int64_t)s->peak_rss;
         row[6] = (int64_t)s->turns_remote;
+        row[7] = (int64_t)s->records;
         dv[nd + (size_t)w->workers[i].global] = s->busy_s;
     }
-    MPI_Allreduce(MPI_IN_PLACE, iv, (int)(ni + 7 * nw), MPI_INT64_T, MPI_SUM, t->comm);
+    MPI_Allreduce(MPI_IN_PLACE, iv, (int)(ni + SYNC_WORKER_WORDS * nw), MPI_INT64_T, MPI_SUM, t->comm);
     MPI_Allreduce(MPI_IN_PLACE, dv, (int)(nd + nw), MPI_DOUBLE, MPI_SUM, t->comm);
     for (int c = 0; c < w->ncells; c++) {
         vw__cell *cl = &w->cells[c];
@@ -639,7 +756,7 @@ static vw_status tp_sync(vw_world *w)
         }
     for (size_t g = 0; g < nw; g++) {
         vw__worker_stats *s = &w->wstats[g];
-        const int64_t *row = wv + 7 * g;
+        const int64_t *row = wv + SYNC_WORKER_WORDS * g;
         s->msgs_sent = (uint64_t)row[0];
         s->bytes_sent = (uint64_t)row[1];
         s->packets_sent = (uint64_t)row[2];
@@ -647,6 +764,7 @@ static vw_status tp_sync(vw_world *w)
         s->bytes_remote = (uint64_t)row[4];
         s->peak_rss = (uint64_t)row[5];
         s->turns_remote = (uint64_t)row[6];
+        s->records = (uint64_t)row[7];
         s->busy_s = dv[nd + g];
     }
     free(iv);

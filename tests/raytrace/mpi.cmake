@@ -2,6 +2,7 @@
 # without farming, must write the very PNG bytes the threads engine writes; the files are
 # written by rank 0 only. Variables: VWALLS, SCENE, WORK, MPIRUN, NPFLAG, PREFLAGS
 # (PREFLAGS with '|' between flags).
+cmake_policy(SET CMP0057 NEW)
 file(REMOVE_RECURSE ${WORK})
 file(MAKE_DIRECTORY ${WORK})
 string(REPLACE "|" ";" pre "${PREFLAGS}")
@@ -57,6 +58,27 @@ foreach(case "2;2x2x2;1;none" "2;4x1x2;2;none" "3;2x2;1;none" "2;1;1;idle" "3;1;
   string(FIND "${json}" "\"processes\": ${np}" at)
   if(at LESS 0)
     message(FATAL_ERROR "stats JSON does not say ${np} processes")
+  endif()
+  # Each process keeps its cells' share of the object records (at most all), and
+  # together they keep at least all.
+  string(JSON nobj GET "${json}" objects)
+  string(JSON nw LENGTH "${json}" workers)
+  math(EXPR last "${nw} - 1")
+  set(kept_sum 0)
+  set(seen_procs "")
+  foreach(g RANGE ${last})
+    string(JSON proc GET "${json}" workers ${g} process)
+    string(JSON kept GET "${json}" workers ${g} records)
+    if(kept GREATER nobj)
+      message(FATAL_ERROR "--farm ${farm}: process ${proc} keeps ${kept} of ${nobj} records")
+    endif()
+    if(NOT proc IN_LIST seen_procs)
+      list(APPEND seen_procs ${proc})
+      math(EXPR kept_sum "${kept_sum} + ${kept}")
+    endif()
+  endforeach()
+  if(kept_sum LESS nobj)
+    message(FATAL_ERROR "--farm ${farm}: the processes keep ${kept_sum} records of ${nobj}")
   endif()
   if(check)
     string(JSON p0 GET "${json}" workers 0 counters pixels)
@@ -117,3 +139,33 @@ foreach(ask "" "--progress")
   endif()
 endforeach()
 message(STATUS "raytrace_mpi: identical to the threads engine")
+
+# Spheres spread over the world box, cells without copies on 3 processes: each process
+# keeps only its cells' share of the records (a third or so, and the spheres on its
+# cells' walls), and the image is the threads engine's.
+execute_process(COMMAND ${VWALLS} gen spheres --count 300 --seed 3
+                OUTPUT_FILE ${WORK}/spread.nff RESULT_VARIABLE rc)
+execute_process(COMMAND ${VWALLS} render ${WORK}/spread.nff -o ${WORK}/spread_ref.png --size 64x48
+                        --quiet RESULT_VARIABLE rc2)
+execute_process(COMMAND ${MPIRUN} ${NPFLAG} 3 ${pre} ${VWALLS} render ${WORK}/spread.nff
+                        -o ${WORK}/spread.png --size 64x48 --cells 3x2x1 --farm none --workers 1
+                        --quiet --stats ${WORK}/spread.json
+                RESULT_VARIABLE rc3 ERROR_VARIABLE err TIMEOUT 60)
+if(NOT rc EQUAL 0 OR NOT rc2 EQUAL 0 OR NOT rc3 EQUAL 0)
+  message(FATAL_ERROR "spread scene: gen ${rc}, render ${rc2}, mpirun ${rc3}: ${err}")
+endif()
+execute_process(COMMAND ${CMAKE_COMMAND} -E compare_files ${WORK}/spread_ref.png ${WORK}/spread.png
+                RESULT_VARIABLE same)
+if(NOT same EQUAL 0)
+  message(FATAL_ERROR "spread scene under mpirun -np 3 --farm none: PNG differs")
+endif()
+file(READ ${WORK}/spread.json json)
+string(JSON nobj GET "${json}" objects)
+foreach(g 0 1 2)
+  string(JSON kept GET "${json}" workers ${g} records)
+  math(EXPR limit "${nobj} / 2")
+  if(kept GREATER limit OR kept LESS 1)
+    message(FATAL_ERROR "spread scene, 3x2x1 cells on 3 processes: process ${g} keeps ${kept} "
+                        "of ${nobj} records, not its cells' share")
+  endif()
+endforeach()

@@ -50,3 +50,9 @@ foreach(t outputs help args info)
                    ${CMAKE_CURRENT_BINARY_DIR}/io_cli_${t})
   set_tests_properties(io_cli_${t} PROPERTIES TIMEOUT 60)
 endforeach()
+
+# The command-line robustness sweep's cases (tests/io/cli_sweep.sh says what it checks).
+add_test(NAME io_cli_sweep
+         COMMAND sh ${PROJECT_SOURCE_DIR}/tests/io/cli_sweep.sh $<TARGET_FILE:vwalls_tool>
+                 ${CMAKE_CURRENT_BINARY_DIR}/io_cli_sweep)
+set_tests_properties(io_cli_sweep PROPERTIES TIMEOUT 120)

@@ -7,6 +7,7 @@
 #include <errno.h>
 #include <sys/stat.h>
 #include <float.h>
+#include <limits.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -45,7 +46,10 @@ int vw_cli_int(const char *cmd, const char *opt, const char *s, long lo, long hi
     char *end;
     errno = 0;
     long v = strtol(s ? s : "", &end, 10);
-    if (!s || !*s || *end || errno || v < lo || v > hi) {
+    /* strtol also skips white space and takes a '+': " 3" and "+3" were a number here
+       and not in --seed or --cells. Digits, after a '-' for a negative number. */
+    const char *d = s && *s == '-' ? s + 1 : s;
+    if (!s || !(*d >= '0' && *d <= '9') || *end || errno || v < lo || v > hi) {
         vw_cli_error(cmd, "%s: bad value '%s' (expected a whole number from %ld to %ld)", opt,
                      s ? s : "", lo, hi);
         return -1;
@@ -125,12 +129,14 @@ int vw_cli_size(const char *cmd, const char *opt, const char *s, int *w, int *h)
     char *end;
     errno = 0;
     a = strtol(s ? s : "", &end, 10);
-    if (s && *s && (*end == 'x' || *end == 'X') && !errno) {
+    /* Digits on both sides of the x (strtol also took " 8x 8" and "+8x+8"). */
+    if (s && *s >= '0' && *s <= '9' && (*end == 'x' || *end == 'X') && !errno) {
         const char *q = end + 1;
         b = strtol(q, &end, 10);
         /* The ray tracer's limit (rt_job_create), for every command: a size it accepts
            here and refuses later told the user two different maxima. */
-        if (*q && !*end && !errno && a >= 1 && b >= 1 && a <= 16384 && b <= 16384) {
+        if (*q >= '0' && *q <= '9' && !*end && !errno && a >= 1 && b >= 1 && a <= 16384 &&
+            b <= 16384) {
             *w = (int)a;
             *h = (int)b;
             return 0;
@@ -472,6 +478,83 @@ int vw_cli_check_files(const char *cmd, const char *const *inputs, const char *c
     if (st == VW_OK) return VW_EXIT_OK;
     if (vw_cli_is_output()) vw_cli_error(cmd, "%s", err);
     return st == VW_E_INPUT ? VW_EXIT_USAGE : VW_EXIT_FAIL;
+}
+
+int vw_cli_check_scene_files(const char *cmd, const vw_scene *scene, const char *const *opts,
+                             const char *const *paths, int n)
+{
+    /* Each file once, however many materials it defines (a PLY gives one a face): at
+       most nstrings of them. Out of memory, the libraries go unchecked (the scene file
+       itself was checked before it was read). */
+    const char **in = NULL;
+    if (vw_cli_is_output()) {
+        char *seen = calloc(scene->nstrings + 1, 1);
+        in = calloc(scene->nstrings + 1, sizeof *in);
+        size_t k = 0;
+        for (size_t m = 0; seen && in && m < scene->nmaterials; m++) {
+            int f = scene->materials[m].file;
+            if (f > 0 && (size_t)f <= scene->nstrings && !seen[f] && vw_scene_string(scene, f)) {
+                seen[f] = 1;
+                in[k++] = vw_scene_string(scene, f);
+            }
+        }
+        if (!seen) free(in), in = NULL;
+        free(seen);
+    }
+    int rc = vw_cli_check_files(cmd, in, opts, paths, n);
+    free(in);
+    return rc;
+}
+
+int vw_cli_frame_file(const char *pattern, const char *path, int *frame)
+{
+    file_id out;
+    if (!pattern || !path || !file_identify(path, &out)) return 0;
+    /* The frame number is written into the name in decimal, zero-padded or not, and the
+       pattern's own text may have digits around it ("f1%d.png"): every run of digits of
+       the name, and 0 (which "%.0d" writes as nothing), is a candidate. */
+    size_t len = strlen(path);
+    int found = 0;
+    for (size_t i = 0; !found && i <= len; i++) {
+        for (size_t j = i; !found && j <= len && j - i <= 10; j++) {
+            if (j > i && (path[j - 1] < '0' || path[j - 1] > '9')) break;
+            if (j == i && i > 0) continue; /* the candidate 0 once */
+            long n = 0;
+            for (size_t k = i; k < j; k++) n = 10 * n + (path[k] - '0');
+            if (n > INT_MAX) break;
+            char name[4096];
+            file_id id;
+            /* The pattern has exactly one integer conversion (vw_cli_frame_pattern). */
+            int w = snprintf(name, sizeof name, pattern, (int)n);
+            if (w < 0 || (size_t)w >= sizeof name || !file_identify(name, &id)) continue;
+            if (file_same(&out, &id)) {
+                found = 1;
+                if (frame) *frame = (int)n;
+            }
+            free(id.path);
+        }
+    }
+    free(out.path);
+    return found;
+}
+
+int vw_cli_check_frames(const char *cmd, const char *pattern, const char *const *opts,
+                        const char *const *paths, int n)
+{
+    char err[1024] = "";
+    vw_status st = VW_OK;
+    for (int k = 0; pattern && k < n && st == VW_OK && vw_cli_is_output(); k++) {
+        int frame;
+        if (paths[k] && vw_cli_frame_file(pattern, paths[k], &frame)) {
+            snprintf(err, sizeof err, "%s %s: frame %d of -o %s: one would overwrite the other",
+                     opts[k], paths[k], frame, pattern);
+            st = VW_E_INPUT;
+        }
+    }
+    st = vw_engine_agree(st, err, sizeof err);
+    if (st == VW_OK) return VW_EXIT_OK;
+    if (vw_cli_is_output()) vw_cli_error(cmd, "%s", err);
+    return VW_EXIT_USAGE;
 }
 
 int vw_cli_check_outputs(const char *cmd, const char *const *opts, const char *const *paths, int n)

@@ -89,6 +89,23 @@ int vw_cli_check_outputs(const char *cmd, const char *const *opts, const char *c
 int vw_cli_check_files(const char *cmd, const char *const *inputs, const char *const *opts,
                        const char *const *paths, int n);
 
+/* vw_cli_check_files after the scene is read, with the files it was read from as the
+   inputs: its material libraries (an OBJ's mtllib, named by its materials), which
+   "render x.obj --stats x.mtl" replaced. Collective under MPI (every process calls it
+   with its own copy of the scene; the output process checks). */
+int vw_cli_check_scene_files(const char *cmd, const vw_scene *scene, const char *const *opts,
+                             const char *const *paths, int n);
+/* Is path one of the frame files of pattern (animate's and edit's -o, valid by
+   vw_cli_frame_pattern): the same file as the pattern's name for some frame number? 1
+   and the number in *frame, else 0. Devices are nobody's frames (0). */
+int vw_cli_frame_file(const char *pattern, const char *path, int *frame);
+/* The outputs other than the frames (--log, --stats) against the frame files of
+   pattern (NULL: none): VW_EXIT_OK, or VW_EXIT_USAGE on every process with "vwalls CMD:
+   OPT PATH: frame N of -o PATTERN: one would overwrite the other" printed once.
+   Collective under MPI. */
+int vw_cli_check_frames(const char *cmd, const char *pattern, const char *const *opts,
+                        const char *const *paths, int n);
+
 /* Is this process the one that prints (rank 0, or no MPI)? Valid after vw_cli_engine_init. */
 int vw_cli_is_output(void);
 /* Workers of the whole job: --workers W (0: the world's default, one per core, and under

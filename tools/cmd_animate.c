@@ -610,6 +610,9 @@ int vw_anim_main(const char *cmd, int argc, char **argv)
         const char *paths[] = {s->pattern, stats, log_path};
         const char *inputs[] = {scene_path, edits_path, NULL};
         int crc = vw_cli_check_files(cmd, inputs, opts, paths, 3);
+        /* ... and neither is one of the frames: --log f00.png with -o f%02d.png
+           replaced frame 0 by the log at the end. */
+        if (crc == VW_EXIT_OK) crc = vw_cli_check_frames(cmd, s->pattern, opts + 1, paths + 1, 2);
         if (crc != VW_EXIT_OK) {
             rc = crc;
             goto done;
@@ -641,6 +644,17 @@ int vw_anim_main(const char *cmd, int argc, char **argv)
     if (vw_cli_scene_size(scene_path, &scene->camera, p.width)) { /* as render's */
         vw_scene_free(scene);
         goto done;
+    }
+    {
+        /* The scene's material libraries are inputs too (--log x.mtl replaced x.obj's). */
+        const char *opts[] = {"--stats", "--log"};
+        const char *paths[] = {stats, log_path};
+        int crc = vw_cli_check_scene_files(cmd, scene, opts, paths, 2);
+        if (crc != VW_EXIT_OK) {
+            rc = crc;
+            vw_scene_free(scene);
+            goto done;
+        }
     }
     vw_status st = rt_anim_create(scene, &p, &s->anim, err, sizeof err);
     if (st != VW_OK) {

@@ -74,7 +74,8 @@ static void help(void)
            "  --resume FILE        continue from a checkpoint: the same scene, --cells,\n"
            "                       --patch-size, --elements, --hemicube, --subdivide, --max-level\n"
            "                       and --neighbourhood as the run that wrote it (--sf may change)\n"
-           "  --max-rounds N       stop after N rounds without writing outputs (tests: a kill)\n"
+           "  --max-rounds N       stop after N rounds as if killed: only --checkpoint is\n"
+           "                       written (tests)\n"
            "  --progress           the progress bar even when stderr is no terminal (mpirun)\n"
            "  --quiet              no progress bar and no summary\n"
            "  --help               this text\n"
@@ -396,6 +397,11 @@ int vw_cmd_radiosity(int argc, char **argv)
         const char *paths[] = {r.out, r.csv, r.image, r.stats, trace, o.checkpoint};
         const char *const inputs[] = {scene_path, NULL};
         int crc = vw_cli_check_files(CMD, inputs, opts, paths, 6);
+        /* The checkpoint resumed from is an input of every output but --checkpoint,
+           which may name it (the run goes on where it left off, replacing it
+           atomically): --stats CK replaced it, and a failed run could not resume. */
+        const char *const resumed[] = {o.resume, NULL};
+        if (crc == VW_EXIT_OK && o.resume) crc = vw_cli_check_files(CMD, resumed, opts, paths, 5);
         if (crc != VW_EXIT_OK) return crc;
     }
 
@@ -430,6 +436,16 @@ int vw_cmd_radiosity(int argc, char **argv)
     if (vw_cli_same_scene(CMD, sc)) {
         vw_scene_free(sc);
         return VW_EXIT_USAGE;
+    }
+    {
+        /* The scene's material libraries are inputs too (--csv x.mtl replaced x.obj's). */
+        const char *opts[] = {"-o", "--csv", "--image", "--stats", "--trace", "--checkpoint"};
+        const char *paths[] = {r.out, r.csv, r.image, r.stats, trace, o.checkpoint};
+        int crc = vw_cli_check_scene_files(CMD, sc, opts, paths, 6);
+        if (crc != VW_EXIT_OK) {
+            vw_scene_free(sc);
+            return crc;
+        }
     }
     /* Every process makes its own cells and mesh from its own copy of the scene, and
        checks the picture's size against that copy's camera: all agree before the

@@ -311,6 +311,10 @@ int vw_cmd_render(int argc, char **argv)
             if (!(speeds_s = vw_cli_value(CMD, argc, argv, &i))) return VW_EXIT_USAGE;
         } else if (!strcmp(a, "--slow")) {
             if (!(slow_s = vw_cli_value(CMD, argc, argv, &i))) return VW_EXIT_USAGE;
+            if (!*slow_s) { /* the parse below reads no worker from it, and slowed none */
+                vw_cli_error(CMD, "--slow: bad value '' (expected W:K,... with K from 1 to 1000)");
+                return VW_EXIT_USAGE;
+            }
         } else if (!strcmp(a, "--overlay-by")) {
             if (!(v = vw_cli_value(CMD, argc, argv, &i))) return VW_EXIT_USAGE;
             if (strcmp(v, "load") && strcmp(v, "worker")) {
@@ -435,7 +439,8 @@ int vw_cmd_render(int argc, char **argv)
             long wk = strtol(q, &end, 10);
             double k = 0;
             if (end != q && *end == ':') k = strtod(end + 1, &end);
-            if (wk < 0 || wk >= gw || !(k >= 1) || k > 1000 || (*end && *end != ',') ||
+            if (!(*q >= '0' && *q <= '9') || wk >= gw || !(k >= 1) || k > 1000 ||
+                (*end && *end != ',') ||
                 (*end == ',' && !end[1])) {
                 rc = vw_cli_fail(CMD, VW_EXIT_USAGE, err, sizeof err, "--slow: bad value '%s' "
                                  "(expected W:K,... with worker W < %d and K from 1 to 1000)",
@@ -515,6 +520,18 @@ int vw_cmd_render(int argc, char **argv)
         vw_scene_free(scene);
         free(speeds), free(slowdown);
         return VW_EXIT_USAGE;
+    }
+    {
+        /* The material libraries the scene named are inputs too: a --stats x.mtl
+           replaced the library of x.obj. Known only now that the scene is read. */
+        const char *opts[] = {"-o", "--overlay", "--stats"};
+        const char *paths[] = {out, overlay, stats};
+        int crc = vw_cli_check_scene_files(CMD, scene, opts, paths, 3);
+        if (crc != VW_EXIT_OK) {
+            vw_scene_free(scene);
+            free(speeds), free(slowdown);
+            return crc;
+        }
     }
 
     rt_params p;

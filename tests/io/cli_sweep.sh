@@ -1,0 +1,146 @@
+#!/bin/sh
+# cli_sweep.sh VWALLS TMPDIR - what a robustness sweep of the command line found: an output
+# naming a material library the scene read (render --stats x.mtl replaced x.obj's
+# library), the checkpoint radiosity resumes from (--stats CK replaced it; --checkpoint CK
+# stays allowed), or one of animate's or edit's frames (--log f01.png with -o f%02d.png
+# replaced frame 1); an empty --slow, and numbers with white space or a '+' before them
+# (" 2", "+8x8"), which strtol took. Each is refused with status 2 before anything is
+# written. Then every numeric option of every command with values that are not numbers
+# or out of range: status 2 and a message naming the option and the value.
+set -u
+V=$1 T=$2
+D=$(cd "$(dirname "$0")/../data" && pwd) || exit 1
+rm -rf "$T" && mkdir -p "$T" && cd "$T" || exit 1
+fail() { echo "FAIL: $*"; exit 1; }
+# refused STATUS MESSAGE ARGS...: the run exits STATUS and says MESSAGE (a grep -e
+# pattern) on stderr.
+refused() {
+  want=$1 msg=$2
+  shift 2
+  "$V" "$@" > out 2> err < /dev/null; rc=$?
+  [ $rc -eq "$want" ] || fail "$*: status $rc, expected $want ($(cat err))"
+  grep -q -e "$msg" err || fail "$*: message: $(cat err)"
+}
+# clean: no output and no temporary file in the directory besides the fixtures.
+clean() {
+  left=$(ls -A | grep -v -x -e cube.obj -e cube.mtl -e mtl.orig -e s.nff -e script.txt \
+         -e ck -e ck.orig -e out -e err)
+  [ -z "$left" ] || fail "$*: left behind: $left"
+}
+
+cp "$D/good/cube.obj" "$D/good/cube.mtl" . && cp cube.mtl mtl.orig || exit 1
+"$V" gen spheres --count 20 -o s.nff || fail "gen"
+printf 'frame\nframe\n' > script.txt || exit 1
+R="--size 8x8 --quiet"
+
+# 1. A material library is an input: refused, the library intact, nothing written.
+# shellcheck disable=SC2086
+{
+refused 2 "^vwalls render: --stats cube.mtl: is the input file ./cube.mtl: it would be overwritten" \
+  render cube.obj -o o.png --stats cube.mtl $R
+cmp -s cube.mtl mtl.orig || fail "render --stats cube.mtl: the library was changed"
+clean "render --stats cube.mtl"
+refused 2 "^vwalls radiosity: --csv ./cube.mtl: is the input file ./cube.mtl" \
+  radiosity cube.obj -o o.ply --csv ./cube.mtl --max-shots 3 --quiet
+cmp -s cube.mtl mtl.orig || fail "radiosity --csv cube.mtl: the library was changed"
+clean "radiosity --csv cube.mtl"
+refused 2 "^vwalls animate: --log cube.mtl: is the input file ./cube.mtl" \
+  animate cube.obj script.txt -o 'f%02d.png' --log cube.mtl $R
+cmp -s cube.mtl mtl.orig || fail "animate --log cube.mtl: the library was changed"
+clean "animate --log cube.mtl"
+# The same scene with other outputs still works.
+"$V" render cube.obj -o o.png --stats o.json $R || fail "render cube.obj: status $?"
+rm -f o.png o.json
+}
+
+# 2. The checkpoint resumed from is an input of every output but --checkpoint.
+"$V" radiosity cube.obj --checkpoint ck --max-shots 3 --quiet && cp ck ck.orig ||
+  fail "radiosity --checkpoint ck: status $?"
+for o in --stats --trace --csv; do
+  refused 2 "^vwalls radiosity: $o ./ck: is the input file ck: it would be overwritten" \
+    radiosity cube.obj --resume ck $o ./ck --max-shots 6 --quiet
+  cmp -s ck ck.orig || fail "radiosity --resume ck $o ./ck: the checkpoint was changed"
+  clean "radiosity --resume ck $o ./ck"
+done
+"$V" radiosity cube.obj --resume ck --checkpoint ck --max-shots 6 --quiet ||
+  fail "radiosity --resume ck --checkpoint ck: status $?"
+rm -f ck ck.orig
+
+# 3. A frame file is the frames' own: --log or --stats naming one is refused.
+# shellcheck disable=SC2086
+{
+refused 2 "^vwalls animate: --log f01.png: frame 1 of -o f%02d.png: one would overwrite the other" \
+  animate s.nff script.txt -o 'f%02d.png' --log f01.png $R
+clean "animate --log f01.png"
+refused 2 "^vwalls animate: --stats ./f0.png: frame 0 of -o f%d.png" \
+  animate s.nff script.txt -o 'f%d.png' --stats ./f0.png $R
+clean "animate --stats ./f0.png"
+refused 2 "^vwalls animate: --stats f15.png: frame 5 of -o f1%d.png" \
+  animate s.nff script.txt -o 'f1%d.png' --stats f15.png $R
+refused 2 "^vwalls edit: --log f00.png: frame 0 of -o f%02d.png" \
+  edit s.nff -o 'f%02d.png' --log f00.png $R
+clean "edit --log f00.png"
+# A name that only looks like one is not: f0.png is no frame of f%02d.png.
+"$V" animate s.nff script.txt -o 'f%02d.png' --stats f0.png $R > /dev/null ||
+  fail "animate -o f%02d.png --stats f0.png: status $?"
+[ -s f00.png ] && [ -s f01.png ] && [ -s f0.png ] || fail "f%02d.png --stats f0.png: $(ls)"
+rm -f f00.png f01.png f0.png
+}
+
+# 4. An empty --slow, and white space or '+' before a number.
+# shellcheck disable=SC2086
+{
+refused 2 "^vwalls render: --slow: bad value ''" render s.nff -o o.png --workers 2 --slow '' $R
+refused 2 "^vwalls render: --slow: bad value ' 0:2'" render s.nff -o o.png --workers 2 --slow ' 0:2' $R
+refused 2 "^vwalls render: --workers: bad value ' 2'" render s.nff -o o.png --workers ' 2' $R
+refused 2 "^vwalls render: --depth: bad value '+3'" render s.nff -o o.png --depth +3 $R
+refused 2 "^vwalls render: --size: bad value '+8x8'" render s.nff -o o.png --size +8x8 --quiet
+refused 2 "^vwalls render: --size: bad value '8x 8'" render s.nff -o o.png --size '8x 8' --quiet
+refused 2 "^vwalls gen: --count: bad value ' 5'" gen spheres --count ' 5'
+clean "white space"
+"$V" render s.nff -o o.png --workers 2 --slow 1:2 --depth 3 --size 8X8 --quiet ||
+  fail "--slow 1:2 --depth 3 --size 8X8: status $?"
+rm -f o.png
+}
+
+# 5. Every numeric option, with values that are no numbers or out of range.
+# bad CMD OPTION VALUE ARGS...: status 2, "vwalls CMD: OPTION: bad value 'VALUE'".
+bad() {
+  c=$1 o=$2 v=$3
+  shift 3
+  refused 2 "^vwalls $c: $o: bad value '$v'" "$c" "$@" "$o" "$v"
+}
+for v in 0 -1 nan 1e999 '' 9223372036854775808 1.5 0x10 inf; do
+  for o in --workers --depth --balance-iters --prepass; do
+    bad render $o "$v" s.nff -o o.png --quiet
+  done
+  for o in --workers --depth; do
+    bad animate $o "$v" s.nff script.txt -o 'f%d.png' --quiet
+  done
+  for o in --workers --hemicube --elements --per-round --max-shots --stall-shots \
+           --max-rounds --snapshot-every; do
+    bad radiosity $o "$v" cube.obj -o o.ply --quiet
+  done
+  for o in --spheres --workers; do
+    [ "$o$v" = --spheres0 ] && continue # no spheres, no pairs: a fine question
+    bad example-pairs $o "$v" --quiet
+    bad example-components $o "$v" --quiet
+  done
+  bad gen --count "$v" spheres
+done
+for v in nan 1e999 '' -1 inf 1e400 abc 1,2; do
+  for o in --sf --patch-size --neighbourhood --subdivide --checkpoint-every; do
+    bad radiosity $o "$v" cube.obj -o o.ply --quiet
+  done
+  bad render --angle "$v" s.nff -o o.png --quiet
+  bad animate --threshold "$v" s.nff script.txt -o 'f%d.png' --quiet
+  bad animate --margin "$v" s.nff script.txt -o 'f%d.png' --quiet
+  bad example-pairs --radius "$v" --quiet
+  bad gen --cluster "$v" spheres
+done
+for v in 0x2 2x 2x2x2x2 -1 '' 33x33x33 x; do
+  refused 2 "^vwalls render: --cells: layout '$v'" render s.nff -o o.png --cells "$v" --quiet
+  refused 2 "^vwalls radiosity: --cells: layout '$v'" radiosity cube.obj -o o.ply --cells "$v"
+done
+clean "numeric options"
+echo "cli_sweep: all passed"

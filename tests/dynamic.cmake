@@ -36,3 +36,13 @@ if(VW_HAVE_MPI AND MPIEXEC_EXECUTABLE)
                          ENVIRONMENT "${VW_MPI_ENV}")
   endforeach()
 endif()
+
+# The parser's messages show the script's words printable (binary scripts, escapes).
+add_executable(test_edit_shown ${PROJECT_SOURCE_DIR}/tests/dynamic/test_edit_shown.c)
+target_include_directories(test_edit_shown PRIVATE ${PROJECT_SOURCE_DIR}/tests)
+target_link_libraries(test_edit_shown PRIVATE vwalls_static m)
+add_test(NAME dynamic_edit_shown COMMAND test_edit_shown)
+add_test(NAME dynamic_cli_shown
+         COMMAND sh ${PROJECT_SOURCE_DIR}/tests/dynamic/cli_shown.sh $<TARGET_FILE:vwalls_tool>
+                 ${CMAKE_CURRENT_BINARY_DIR}/dynamic_cli_shown)
+set_tests_properties(dynamic_cli_shown PROPERTIES TIMEOUT 60)

@@ -56,3 +56,14 @@ add_test(NAME io_cli_sweep
          COMMAND sh ${PROJECT_SOURCE_DIR}/tests/io/cli_sweep.sh $<TARGET_FILE:vwalls_tool>
                  ${CMAKE_CURRENT_BINARY_DIR}/io_cli_sweep)
 set_tests_properties(io_cli_sweep PROPERTIES TIMEOUT 120)
+
+# What the OBJ and MTL readers take as text: binary bytes refused at their line, UTF-8,
+# Latin-1 and a byte order mark accepted; one warning per file for unknown keywords.
+add_executable(test_io_obj_input ${PROJECT_SOURCE_DIR}/tests/io/test_io_obj_input.c)
+target_include_directories(test_io_obj_input PRIVATE ${PROJECT_SOURCE_DIR}/tests)
+target_link_libraries(test_io_obj_input PRIVATE vwalls_static m)
+add_test(NAME io_obj_input COMMAND test_io_obj_input)
+add_test(NAME io_cli_obj_input
+         COMMAND sh ${PROJECT_SOURCE_DIR}/tests/io/cli_obj_input.sh $<TARGET_FILE:vwalls_tool>
+                 ${CMAKE_CURRENT_BINARY_DIR}/io_cli_obj_input)
+set_tests_properties(io_cli_obj_input PROPERTIES TIMEOUT 60)

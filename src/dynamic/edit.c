@@ -30,6 +30,15 @@ static vw_status fail(char *err, size_t errlen, const char *name, int line, cons
     return VW_E_INPUT;
 }
 
+/* A word of the script shown in a message: the script may be any file (binary data,
+   escape sequences), and the terminal must get printable text, as from the scene
+   readers. */
+#define SHOWN_BUF (VW_SHOWN_NAME + 8)
+static const char *shown(const char *w, char buf[SHOWN_BUF])
+{
+    return vw_text_shown(w, strlen(w), VW_SHOWN_NAME, buf, SHOWN_BUF);
+}
+
 /* A finite number, the whole word. */
 static int number(const char *w, double *out)
 {
@@ -99,7 +108,8 @@ vw_status vw_edit_parse(const char *line, const char *name, int lineno, vw_edit 
     const cmd *c = NULL;
     for (size_t i = 0; i < sizeof cmds / sizeof cmds[0]; i++)
         if (!strcmp(w[0], cmds[i].name)) c = &cmds[i];
-    if (!c) return fail(err, errlen, name, lineno, "unknown command '%s'", w[0]);
+    char sb[SHOWN_BUF];
+    if (!c) return fail(err, errlen, name, lineno, "unknown command '%s'", shown(w[0], sb));
     if (n - 1 < c->min || n - 1 > c->max)
         return fail(err, errlen, name, lineno, "expected '%s'", c->usage);
     out->op = c->op;
@@ -109,11 +119,11 @@ vw_status vw_edit_parse(const char *line, const char *name, int lineno, vw_edit 
     case VW_EDIT_ROTATE:
     case VW_EDIT_REMOVE: {
         if (!object_id(w[1], &out->id))
-            return fail(err, errlen, name, lineno, "bad object id '%s'", w[1]);
+            return fail(err, errlen, name, lineno, "bad object id '%s'", shown(w[1], sb));
         for (int k = 2; k < n; k++)
             if (!number(w[k], &out->v[k - 2]))
-                return fail(err, errlen, name, lineno, "bad number '%s' (expected '%s')", w[k],
-                            c->usage);
+                return fail(err, errlen, name, lineno, "bad number '%s' (expected '%s')",
+                            shown(w[k], sb), c->usage);
         if (c->op == VW_EDIT_ROTATE &&
             !(out->v[0] != 0 || out->v[1] != 0 || out->v[2] != 0))
             return fail(err, errlen, name, lineno, "rotation axis is zero");
@@ -121,14 +131,15 @@ vw_status vw_edit_parse(const char *line, const char *name, int lineno, vw_edit 
     }
     case VW_EDIT_ADD:
         if (strcmp(w[1], "sphere"))
-            return fail(err, errlen, name, lineno, "can only add a sphere, not '%s'", w[1]);
+            return fail(err, errlen, name, lineno, "can only add a sphere, not '%s'",
+                        shown(w[1], sb));
         for (int k = 2; k < 6; k++)
             if (!number(w[k], &out->v[k - 2]))
-                return fail(err, errlen, name, lineno, "bad number '%s' (expected '%s')", w[k],
-                            c->usage);
+                return fail(err, errlen, name, lineno, "bad number '%s' (expected '%s')",
+                            shown(w[k], sb), c->usage);
         if (!(out->v[3] > 0)) return fail(err, errlen, name, lineno, "sphere radius must be > 0");
         if (n == 7 && !object_id(w[6], &out->material))
-            return fail(err, errlen, name, lineno, "bad material index '%s'", w[6]);
+            return fail(err, errlen, name, lineno, "bad material index '%s'", shown(w[6], sb));
         break;
     case VW_EDIT_CHECK:
     case VW_EDIT_SWEEP:

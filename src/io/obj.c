@@ -8,6 +8,14 @@
  * ignored. OBJ has no camera and no lights: camera.valid is 0. A material library
  * that cannot be read and a usemtl name no library defines are warnings (once each),
  * and the faces get the default material, as in common OBJ tools.
+ *
+ * Both files must be text: a line holding a NUL byte or another control character
+ * (anything below 0x20 but tab, LF, VT, FF and CR, and DEL) is an error, so binary data
+ * named as an OBJ is refused instead of read as nothing. Bytes from 0x80 up are text
+ * (UTF-8 or a legacy code page in comments and names). A keyword the format does not
+ * define (a vendor extension, or text that is not OBJ at all) is ignored with one
+ * warning per file, naming its first such line. A file with no faces is a scene with
+ * no objects, as an NFF with only its 'v' block is.
  */
 #include <errno.h>
 #include <float.h>
@@ -391,15 +399,94 @@ static int next_line(obj *O, const char **p, const char *end, span *line)
     return 1;
 }
 
+/* Is the byte one a text file cannot hold? NUL and the control characters but the
+   blanks (tab, VT, FF) and the line ends (LF, CR); DEL too. Bytes from 0x80 up are
+   accepted unjudged: UTF-8 names and comments must read, and so must the Latin-1 or
+   Windows code page text of older exporters, which is not valid UTF-8. */
+static int is_binary(unsigned char c)
+{
+    return (c < 0x20 && c != '\t' && c != '\n' && c != '\v' && c != '\f' && c != '\r') ||
+           c == 0x7f;
+}
+
+/* Refuses a statement (its continued lines too, comments included) that holds a byte
+   no text holds, naming the physical line of that byte; kind is "OBJ" or "MTL". */
+static vw_status check_text(obj *O, span line, const char *kind)
+{
+    int at = O->line;
+    for (size_t i = 0; i < line.n; i++) {
+        unsigned char c = (unsigned char)line.s[i];
+        if (c == '\n' || (c == '\r' && !(i + 1 < line.n && line.s[i + 1] == '\n')))
+            at++;   /* a continuation's line end: CRLF counts at its LF */
+        else if (is_binary(c)) {
+            O->line = at;
+            if (!c)
+                return fail(O, "a NUL byte: binary data, not %s text", kind);
+            return fail(O, "control character 0x%02x: binary data, not %s text", c, kind);
+        }
+    }
+    return VW_OK;
+}
+
+/* A UTF-8 byte order mark (Windows editors write one) is not part of the first line:
+   left there, it would make the first keyword unknown. */
+static size_t bom_length(const char *text, size_t len)
+{
+    return len >= 3 && !memcmp(text, "\xEF\xBB\xBF", 3) ? 3 : 0;
+}
+
+/* Warns about an unknown keyword once per file (the file's first one): a vendor's
+   extension is no reason to refuse a mesh, but text that is not OBJ at all, read as
+   nothing, must not pass unnoticed. */
+static vw_status unknown_keyword(obj *O, span key, const char *kind)
+{
+    char sb[48];
+    span file = {O->name, strlen(O->name)};
+    vw_status st = warn_once(O, "keyword", file, "unknown keyword '%s' (not an %s statement): "
+                             "ignored, as are any others in this file", show(key, sb), kind);
+    return st == VW_OK ? VW_OK : fail_status(O, st);
+}
+
+/* Is key one of the words of list[0..n)? */
+static int span_in(span key, const char *const *list, size_t n)
+{
+    for (size_t i = 0; i < n; i++)
+        if (span_is(key, list[i]))
+            return 1;
+    return 0;
+}
+
+/* The MTL statements vwalls ignores without a word: the rest of the MTL specification
+   (ambient colour, transmission filter, sharpness, maps) and the extensions exporters
+   commonly write (Blender's map_Bump, the physically based Pr, Pm, Ps, Pc, Pcr, aniso,
+   anisor, norm and their maps). The ones read are in parse_mtl's own list. */
+static const char *const mtl_ignored[] = {
+    "Ka", "Tf", "sharpness", "map_Ka", "map_Kd", "map_Ks", "map_Ke", "map_Ns", "map_d",
+    "map_Tr", "map_aat", "disp", "decal", "bump", "map_bump", "map_Bump", "refl",
+    "Pr", "Pm", "Ps", "Pc", "Pcr", "aniso", "anisor", "norm", "map_Pr", "map_Pm", "map_Ps",
+};
+
+/* Every statement of the OBJ specification (version 3.0) that parse_obj does not read:
+   texture, free-form geometry, grouping and display statements, accepted and ignored. */
+static const char *const obj_ignored[] = {
+    "vp", "l", "p", "g", "o", "s", "mg", "call", "csh", "cstype", "deg", "bmat", "step",
+    "curv", "curv2", "surf", "parm", "trim", "hole", "scrv", "sp", "end", "con", "lod",
+    "maplib", "usemap", "c_interp", "d_interp", "shadow_obj", "trace_obj", "bevel",
+    "ctech", "stech",
+};
+
 static vw_status parse_mtl(obj *O, const char *text, size_t len)
 {
-    const char *p = text, *end = text + len;
+    const char *p = text + bom_length(text, len), *end = text + len;
     vw_material *m = NULL;
     int illum = -1;   /* m's illumination model; -1 until an illum statement gives one */
     O->line = 0;
     O->next_no = 1;
     span line, key;
     while (next_line(O, &p, end, &line)) {
+        vw_status st = check_text(O, line, "MTL");
+        if (st != VW_OK)
+            return st;
         if (!next_tok(O, &line, &key))
             continue;
         if (span_is(key, "newmtl")) {
@@ -417,7 +504,7 @@ static vw_status parse_mtl(obj *O, const char *text, size_t len)
                 O->mat_wait[i] = 0;
                 m = &O->b.s->materials[O->mat_ids[i]];
             } else {
-                vw_status st = add_named_material(O, name, 0);
+                st = add_named_material(O, name, 0);
                 if (st != VW_OK)
                     return st;
                 m = &O->b.s->materials[O->b.s->nmaterials - 1];
@@ -432,11 +519,15 @@ static vw_status parse_mtl(obj *O, const char *text, size_t len)
         for (size_t i = 0; i < sizeof known / sizeof known[0]; i++)
             if (span_is(key, known[i]))
                 k = known[i];
+        if (!k && !span_in(key, mtl_ignored, sizeof mtl_ignored / sizeof mtl_ignored[0])) {
+            if ((st = unknown_keyword(O, key, "MTL")) != VW_OK)
+                return st;
+            continue;
+        }
         if (!k)
             continue;   /* Ka, Tf, maps...: not used by vwalls */
         if (!m)
             return fail(O, "'%s' before any 'newmtl'", k);
-        vw_status st;
         float v;
         if (!strcmp(k, "illum")) {
             if ((st = mtl_illum(O, &line, &illum)) != VW_OK)
@@ -632,12 +723,14 @@ static vw_status parse_face(obj *O, span *line)
 
 static vw_status parse_obj(obj *O, const char *text, size_t len, const char *dir)
 {
-    const char *p = text, *end = text + len;
+    const char *p = text + bom_length(text, len), *end = text + len;
     span line, key;
     while (next_line(O, &p, end, &line)) {
+        vw_status st = check_text(O, line, "OBJ");
+        if (st != VW_OK)
+            return st;
         if (!next_tok(O, &line, &key))
             continue;
-        vw_status st = VW_OK;
         double v[3];
         if (span_is(key, "v")) {
             int vi;
@@ -688,8 +781,10 @@ static vw_status parse_obj(obj *O, const char *text, size_t len, const char *dir
             while (next_tok(O, &line, &fname))
                 if ((st = load_mtllib(O, dir, fname)) != VW_OK)
                     return st;
+        } else if (!span_in(key, obj_ignored, sizeof obj_ignored / sizeof obj_ignored[0])) {
+            if ((st = unknown_keyword(O, key, "OBJ")) != VW_OK)
+                return st;
         }
-        /* o, g, s, l, p and the free-form geometry keys are ignored. */
     }
     for (size_t i = 0; i < O->nnames; i++)
         if (O->mat_wait[i]) {

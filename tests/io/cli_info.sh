@@ -15,7 +15,7 @@ has() { grep -Fqx -e "$2" "$1" || { cat "$1"; fail "$1 lacks: $2"; }; }
 
 printf '# the first library\nnewmtl red\nNs 10\nKd 1.25 0 0\nnewmtl grey\nNs 10\n' > lib/a.mtl
 printf 'newmtl white\nKd 1 1 1\nnewmtl lamp\nKd 1 1 1\nKe 5 5 5\n' > b.mtl
-printf "newmtl it's\\001odd and a name longer than forty bytes\\nKd 0.5 0.5 0.5\\n" >> b.mtl
+printf "newmtl it's\\351odd and a name longer than forty bytes\\nKd 0.5 0.5 0.5\\n" >> b.mtl
 cat > s.obj <<'END'
 # two libraries
 mtllib lib/a.mtl

@@ -49,7 +49,5 @@ set_tests_properties(balance_cli PROPERTIES LABELS "balance;mpi" TIMEOUT 300 PRO
 
 # divide stops when an uncuttable cell alone sets lambda on a fastest worker (no cut can
 # lower it), and goes on where, with speeds or company on its worker, cuts still can.
-add_executable(vw_test_divide_stop ${PROJECT_SOURCE_DIR}/tests/balance/divide_stop.c)
-target_link_libraries(vw_test_divide_stop PRIVATE vwalls_apps)
-add_test(NAME balance_divide_stop COMMAND vw_test_divide_stop)
+add_test(NAME balance_divide_stop COMMAND vw_test_balance divide_stop)
 set_tests_properties(balance_divide_stop PROPERTIES LABELS "balance")

@@ -1034,8 +1034,9 @@ static int t_thin(void)
 /* Divides d on field f for gw workers (max_extra 0: the default), expecting success and
    every point of f in a cell of the result (what names the case). Returns the result
    (NULL on failure); *lam its lambda by the mapping divide made, *cells its count. */
-static vw_decomp *divide_checked(const vw_decomp *d, vw_load_field *f, int gw, int max_extra,
-                                 const char *what, double *lam, int *cells)
+static vw_decomp *divide_checked(const vw_decomp *d, vw_load_field *f, int gw,
+                                 const double *speeds, int max_extra, const char *what,
+                                 double *lam, int *cells)
 {
     double *loads = malloc(sizeof(double) * VW_MAX_CELLS);
     int *map = malloc(sizeof(int) * VW_MAX_CELLS);
@@ -1044,6 +1045,7 @@ static vw_decomp *divide_checked(const vw_decomp *d, vw_load_field *f, int gw, i
     vw_balance_params_init(&p);
     p.strategy = VW_BALANCE_DIVIDE;
     p.gworkers = gw;
+    p.speeds = speeds;
     p.max_extra = max_extra;
     vw_decomp *nd = NULL;
     vw_status st = vw_balance_decompose(d, f, &p, &nd, map);
@@ -1053,7 +1055,7 @@ static vw_decomp *divide_checked(const vw_decomp *d, vw_load_field *f, int gw, i
     if (nd) {
         *cells = cells_ok(nd, what);
         vw_load_field_cell_loads(f, nd, loads);
-        *lam = vw_balance_imbalance(loads, map, *cells, gw, NULL);
+        *lam = vw_balance_imbalance(loads, map, *cells, gw, speeds);
         int lost = 0;
         for (size_t i = 0; i < f->n; i++) lost += vw_decomp_locate(nd, f->p[i], NULL) < 0;
         EXPECT(lost == 0, "%s: %d of %zu points in no cell", what, lost, f->n);
@@ -1104,7 +1106,7 @@ static double divide_far(const vw_box *world, const int dims[3], const double *F
         }
     for (size_t i = 0; i < f->n; i++) CHECK(vw_decomp_locate(d, f->p[i], NULL) >= 0);
     double lam;
-    vw_decomp *nd = divide_checked(d, f, 8, 0, "divide far from the origin", &lam, cells);
+    vw_decomp *nd = divide_checked(d, f, 8, NULL, 0, "divide far from the origin", &lam, cells);
     *cut = 0;
     for (int c = 0; c < *cells; c++) {
         vw_box b = vw_decomp_cell_box(nd, c);
@@ -1168,13 +1170,15 @@ static int t_divide_thin(void)
 
 /* World [1, 2]^3 on 2x2x2 cells, each axis's wall one double past 1: the cell at the
    origin corner is one double wide on every side, no wall fits in it, and it holds a
-   point of load 10. The other load is spread: `line` on a line along x in the cell one
-   double wide on y and z (cuttable on x only), `bulk` on an 8x8x8 grid of points in the
-   cell [w, 2]^3. gw workers, at most 32 extra cells. Divide stopped ("break") as soon as
-   the heaviest cell could not be cut, with the other cells still overloading a worker.
-   Returns lambda of the result by divide's mapping; *cells its cell count; *hot_whole 1
+   point of load hot_load. The other load is spread: `line` on a line along x in the cell
+   one double wide on y and z (cuttable on x only), `bulk` on an 8x8x8 grid of points in
+   the cell [w, 2]^3. gw workers of the given speeds (NULL: equal), at most max_extra
+   extra cells (0: divide's default). Divide stopped ("break") as soon as the heaviest
+   cell could not be cut, with the other cells still overloading a worker (divide_hot;
+   divide_stop for when it must stop). Returns lambda of the result by divide's mapping; *cells its cell count; *hot_whole 1
    when the hot point's cell is the uncuttable corner, unchanged. */
-static double divide_hot(int gw, double line, double bulk, int *cells, int *hot_whole)
+static double divide_hot_corner(int gw, const double *speeds, int max_extra, double hot_load,
+                                double line, double bulk, int *cells, int *hot_whole)
 {
     const double w = nextafter(1.0, 2.0);
     vw_box world = {{1, 1, 1}, {2, 2, 2}};
@@ -1185,7 +1189,7 @@ static double divide_hot(int gw, double line, double bulk, int *cells, int *hot_
     vw_load_field *f;
     CHECK(vw_load_field_create(&f) == VW_OK);
     const double hot[3] = {1, 1, 1};
-    CHECK(vw_load_field_add_point(f, hot, 10) == VW_OK);
+    CHECK(vw_load_field_add_point(f, hot, hot_load) == VW_OK);
     for (int i = 0; line > 0 && i < 16; i++) {
         const double q[3] = {1.1 + 0.05 * i, 1, 1};
         CHECK(vw_load_field_add_point(f, q, line / 16) == VW_OK);
@@ -1198,7 +1202,8 @@ static double divide_hot(int gw, double line, double bulk, int *cells, int *hot_
     vw_box hb = vw_decomp_cell_box(d, vw_decomp_locate(d, hot, NULL));
     CHECK(hb.hi[0] == w && hb.hi[1] == w && hb.hi[2] == w);
     double lam;
-    vw_decomp *nd = divide_checked(d, f, gw, 32, "divide with a hot cell", &lam, cells);
+    vw_decomp *nd = divide_checked(d, f, gw, speeds, max_extra, "divide with a hot cell", &lam,
+                                   cells);
     *hot_whole = 0;
     int hc = nd ? vw_decomp_locate(nd, hot, NULL) : -1;
     if (hc >= 0) {
@@ -1210,6 +1215,12 @@ static double divide_hot(int gw, double line, double bulk, int *cells, int *hot_
     vw_decomp_free(d);
     vw_load_field_free(f);
     return lam;
+}
+
+/* divide_hot_corner with the point's load 10, equal speeds and 32 extra cells at most. */
+static double divide_hot(int gw, double line, double bulk, int *cells, int *hot_whole)
+{
+    return divide_hot_corner(gw, NULL, 32, 10, line, bulk, cells, hot_whole);
 }
 
 static int t_divide_hot(void)
@@ -1314,10 +1325,93 @@ static int t_concurrent(void)
     return vw_test_failures ? 1 : 0;
 }
 
+/* divide_hot_corner's world (as divide_hot's): the corner cell at (1, 1, 1) is one double wide on every side,
+   so no wall fits in it, and it holds a point of load `hot`. `bulk` is spread on an
+   8x8x8 grid of points in the cell [w, 2]^3, `line` on a line along x in the cell one
+   double wide on y and z. When the hot cell alone is the work of a fastest worker and
+   that worker's time is the largest, no cut can lower lambda: wherever the mapping puts
+   the hot cell, its worker takes at least that long, and the total does not change.
+   Divide went on cutting the bulk up to max_extra all the same (40 cells for 8, lambda
+   unchanged). It must still cut where the hot cell sits on a slower worker (pieces of
+   the bulk let the mapper give it the fast one) and where the hot cell's worker holds
+   more than it (pieces let the mapper move the rest off). */
+typedef struct stop_outcome {
+    int cells;  /* cells of the result */
+    double lam; /* lambda by speed of the mapping divide made */
+    int whole;  /* the hot cell is the uncuttable corner, unchanged */
+} stop_outcome;
+
+static stop_outcome divide_stop_run(int gw, const double *speeds, int max_extra, double hot,
+                                    double line, double bulk)
+{
+    stop_outcome o;
+    o.lam = divide_hot_corner(gw, speeds, max_extra, hot, line, bulk, &o.cells, &o.whole);
+    return o;
+}
+
+static int t_divide_stop(void)
+{
+    stop_outcome o;
+    /* Equal speeds, 2 workers: the hot cell 10 on one, the bulk 4 on the other, lambda
+       10 / 7 = 1.429 whatever is cut. Divide cut the bulk 32 times (40 cells). */
+    o = divide_stop_run(2, NULL, 32, 10, 0, 4);
+    printf("divide_stop: 2 workers, hot 10, bulk 4: %d cells, lambda %.4f\n", o.cells, o.lam);
+    EXPECT(o.cells == 8 && fabs(o.lam - 10.0 / 7) < 1e-12 && o.whole,
+           "hot alone sets lambda: %d cells (want 8), lambda %.6f (want %.6f), hot whole %d",
+           o.cells, o.lam, 10.0 / 7, o.whole);
+    /* The same with max_extra 0 (4 * gworkers): 16 cells before. */
+    o = divide_stop_run(2, NULL, 0, 10, 0, 4);
+    printf("divide_stop: 2 workers, default max_extra: %d cells, lambda %.4f\n", o.cells, o.lam);
+    EXPECT(o.cells == 8 && fabs(o.lam - 10.0 / 7) < 1e-12,
+           "default max_extra: %d cells (want 8), lambda %.6f", o.cells, o.lam);
+
+    /* Speeds 1 and 2: the hot cell on the fast worker (10 / 1), the bulk on the slow one
+       (4 / 0.5 = 8), lambda 10 / (14 / 1.5) = 1.071. No cut can lower it: 8 cells (40
+       before). */
+    static const double slow_fast[2] = {1, 2};
+    o = divide_stop_run(2, slow_fast, 32, 10, 0, 4);
+    printf("divide_stop: speeds 1,2, hot 10 on the fast worker, bulk 4: %d cells, lambda %.4f\n",
+           o.cells, o.lam);
+    EXPECT(o.cells == 8 && fabs(o.lam - 10 / (14 / 1.5)) < 1e-12 && o.whole,
+           "speeds 1,2: %d cells (want 8), lambda %.6f (want %.6f)", o.cells, o.lam,
+           10 / (14 / 1.5));
+
+    /* Speeds 2 and 1, bulk 12: the bulk goes to the fast worker first, the hot cell to
+       the slow one, 10 / 0.5 = 20, lambda 20 / (22 / 1.5) = 1.364: the most loaded worker
+       holds only the hot cell, yet halving the bulk lets the mapper put the hot cell on
+       the fast worker (10 + 6 | 6 / 0.5: 16). Divide must go on. */
+    static const double fast_slow[2] = {2, 1};
+    o = divide_stop_run(2, fast_slow, 32, 10, 0, 12);
+    printf("divide_stop: speeds 2,1, hot 10 on the slow worker, bulk 12: %d cells, lambda %.4f\n",
+           o.cells, o.lam);
+    EXPECT(o.cells > 8 && o.lam <= 1.10 && o.whole,
+           "speeds 2,1: %d cells, lambda %.4f (want <= 1.10, was 1.364 on 8 cells)", o.cells,
+           o.lam);
+
+    /* Equal speeds, hot 10, bulk 10, line 5: the line joins the hot cell (a tie, the lower
+       worker), 15 | 10, lambda 1.2. That worker holds more than the uncuttable cell:
+       pieces of the bulk and the line let the rest move off. Divide must go on. */
+    o = divide_stop_run(2, NULL, 32, 10, 5, 10);
+    printf("divide_stop: 2 workers, hot 10 with line 5, bulk 10: %d cells, lambda %.4f\n",
+           o.cells, o.lam);
+    EXPECT(o.cells > 8 && o.lam <= 1.05 && o.whole,
+           "hot shares its worker: %d cells, lambda %.4f (want <= 1.05, was 1.2)", o.cells,
+           o.lam);
+
+    /* 4 workers, hot 10, bulk 24: the bulk cut into pieces until three workers hold 8
+       each, lambda 10 / 8.5 = 1.176 with the hot cell alone on the fourth; then stop. */
+    o = divide_stop_run(4, NULL, 32, 10, 0, 24);
+    printf("divide_stop: 4 workers, hot 10, bulk 24: %d cells, lambda %.4f\n", o.cells, o.lam);
+    EXPECT(o.cells > 8 && o.cells < 40 && fabs(o.lam - 10 / 8.5) < 1e-12 && o.whole,
+           "4 workers: %d cells (want some, fewer than 40), lambda %.6f (want %.6f)", o.cells,
+           o.lam, 10 / 8.5);
+    TEST_DONE();
+}
+
 int main(int argc, char **argv)
 {
     if (argc < 2) {
-        fprintf(stderr, "usage: bal_test identical|conserve|staggered8|divide16|rotate|map|duplicate|field|concurrent|thin|divide_thin|divide_hot [...]\n");
+        fprintf(stderr, "usage: bal_test identical|conserve|staggered8|divide16|rotate|map|duplicate|field|concurrent|thin|divide_thin|divide_hot|divide_stop [...]\n");
         return 2;
     }
     const char *cmd = argv[1];
@@ -1333,6 +1427,7 @@ int main(int argc, char **argv)
     if (!strcmp(cmd, "thin")) return t_thin();
     if (!strcmp(cmd, "divide_thin")) return t_divide_thin();
     if (!strcmp(cmd, "divide_hot")) return t_divide_hot();
+    if (!strcmp(cmd, "divide_stop")) return t_divide_stop();
     fprintf(stderr, "bal_test: unknown test '%s'\n", cmd);
     return 2;
 }

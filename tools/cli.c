@@ -58,12 +58,22 @@ int vw_cli_int(const char *cmd, const char *opt, const char *s, long lo, long hi
     return 0;
 }
 
-/* strtod, with errno 0 for a number too small to hold, which it rounds to a
-   denormal or to zero ("1e-320"): that is a fine value, not an error. An overflow
-   keeps its ERANGE. */
-static double cli_strtod(const char *s, char **end)
+int vw_cli_hex_number(const char *s)
+{
+    while (*s == ' ' || (*s >= '\t' && *s <= '\r')) s++; /* strtod's white space */
+    if (*s == '+' || *s == '-') s++;
+    return s[0] == '0' && (s[1] == 'x' || s[1] == 'X');
+}
+
+double vw_cli_strtod(const char *s, char **end)
 {
     errno = 0;
+    /* strtod also reads C99's hexadecimal floats: --angle 0x10 was 16 degrees. No
+       conversion, as for any other text that is not a number. */
+    if (vw_cli_hex_number(s)) {
+        *end = (char *)s;
+        return 0;
+    }
     double v = strtod(s, end);
     if (errno == ERANGE && fabs(v) <= DBL_MIN) errno = 0;
     return v;
@@ -72,7 +82,7 @@ static double cli_strtod(const char *s, char **end)
 int vw_cli_double(const char *cmd, const char *opt, const char *s, double lo, double hi, double *out)
 {
     char *end;
-    double v = cli_strtod(s ? s : "", &end);
+    double v = vw_cli_strtod(s ? s : "", &end);
     if (!s || !*s || *end || errno || !isfinite(v) || v < lo || v > hi) {
         vw_cli_error(cmd, "%s: bad value '%s' (expected a number from %g to %g)", opt, s ? s : "",
                      lo, hi);
@@ -90,7 +100,7 @@ int vw_cli_fov_ok(double deg)
 int vw_cli_angle(const char *cmd, const char *opt, const char *s, double *out)
 {
     char *end;
-    double v = cli_strtod(s ? s : "", &end);
+    double v = vw_cli_strtod(s ? s : "", &end);
     if (!s || !*s || *end || errno || !vw_cli_fov_ok(v)) {
         vw_cli_error(cmd, "%s: bad value '%s' (expected degrees above 0 and below 180)", opt,
                      s ? s : "");
@@ -107,7 +117,7 @@ int vw_cli_numbers(const char *cmd, const char *opt, const char *s, const char *
     const char *p = s ? s : "";
     for (;;) {
         char *end;
-        double v = cli_strtod(p, &end);
+        double v = vw_cli_strtod(p, &end);
         if (end == p || errno || !(fabs(v) <= FLT_MAX) || k == max) break;
         out[k++] = v;
         if (!*end) {

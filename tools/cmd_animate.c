@@ -337,10 +337,11 @@ static void help(const char *cmd)
            "  --farm F         auto (default) | all | idle | none, as for render: auto is all\n"
            "                   (every worker holds every cell), or idle with --balance\n"
            "  --margin F       the world box is the scene bounds grown by F x diagonal on\n"
-           "                   every side (default 0.25); objects cannot leave it\n"
-           "  --keep-going     (animate) report bad lines and go on instead of stopping\n"
-           "                   (the exit status is still 2)\n"
-           "  --log FILE       every edit's outcome, one line each\n"
+           "                   every side (default 0.25); objects cannot leave it\n");
+    if (strcmp(cmd, "edit")) /* edit answers every line and goes on */
+        printf("  --keep-going     report bad lines and go on instead of stopping\n"
+               "                   (the exit status is still 2)\n");
+    printf("  --log FILE       every edit's outcome, one line each\n"
            "  --stats FILE     the stats JSON, with an \"animation\" member (per frame)\n"
            "  --full-rebuild   rebuild every cell at every frame (the benchmark's baseline)\n"
            "  --brute-force    decide with the O(n^2) reference instead of the cells\n"
@@ -562,7 +563,9 @@ int vw_anim_main(const char *cmd, int argc, char **argv)
             if (!(v = vw_cli_value(cmd, argc, argv, &i)) || vw_cli_double(cmd, a, v, 0, 100, &s->threshold)) goto done;
         } else if (!strcmp(a, "--margin")) {
             if (!(v = vw_cli_value(cmd, argc, argv, &i)) || vw_cli_double(cmd, a, v, 1e-6, 100, &p.margin)) goto done;
-        } else if (!strcmp(a, "--keep-going")) {
+        } else if (!strcmp(a, "--keep-going") && !s->interactive) {
+            /* animate's alone: edit answers every line and goes on, so it takes the
+               option no more than any other it has no use for (an unknown option). */
             s->keep_going = 1;
         } else if (!strcmp(a, "--log")) {
             if (!(log_path = vw_cli_output(cmd, argc, argv, &i))) goto done;

@@ -246,6 +246,8 @@ int vw_cmd_radiosity(int argc, char **argv)
     memset(&r, 0, sizeof r);
     const char *scene_path = NULL, *view = NULL, *trace = NULL;
     int W = 0, H = 0, cells_given = 0;
+    /* Options given that only another one uses (warned about below, as render does). */
+    int level_given = 0, ck_every_given = 0, snapshot_given = 0;
     long lv;
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i], *v;
@@ -301,6 +303,7 @@ int vw_cmd_radiosity(int argc, char **argv)
             VALUE();
             if (vw_cli_int(CMD, a, v, 0, RAD_MAX_LEVEL, &lv)) return VW_EXIT_USAGE;
             o.max_level = (int)lv;
+            level_given = 1;
         } else if (!strcmp(a, "--max-shots")) {
             VALUE();
             if (vw_cli_int(CMD, a, v, 1, 0x7fffffffL, &lv)) return VW_EXIT_USAGE;
@@ -329,6 +332,7 @@ int vw_cmd_radiosity(int argc, char **argv)
             VALUE();
             if (vw_cli_int(CMD, a, v, 1, 0x7fffffffL, &lv)) return VW_EXIT_USAGE;
             r.snapshot_every = lv;
+            snapshot_given = 1;
         } else if (!strcmp(a, "--stats")) {
             OUTPUT();
             r.stats = v;
@@ -341,6 +345,7 @@ int vw_cmd_radiosity(int argc, char **argv)
         } else if (!strcmp(a, "--checkpoint-every")) {
             VALUE();
             if (vw_cli_double(CMD, a, v, 0, 1e9, &o.checkpoint_every)) return VW_EXIT_USAGE;
+            ck_every_given = 1;
         } else if (!strcmp(a, "--resume")) {
             VALUE();
             o.resume = v;
@@ -403,6 +408,25 @@ int vw_cmd_radiosity(int argc, char **argv)
         const char *const resumed[] = {o.resume, NULL};
         if (crc == VW_EXIT_OK && o.resume) crc = vw_cli_check_files(CMD, resumed, opts, paths, 5);
         if (crc != VW_EXIT_OK) return crc;
+    }
+    /* An option whose only user is absent changes nothing: a warning, as render gives
+       for --overlay-by without --overlay (not an error: the run is what was asked,
+       less a detail), so that "--size 64x64" without --image does not pass for a
+       picture asked for. --max-level is kept (and compared by --resume) only with
+       --subdivide. */
+    if (vw_cli_is_output()) {
+        const struct { int given, used; const char *opt, *without; } unused[] = {
+            {W > 0, r.image != NULL, "--size", "--image"},
+            {view != NULL, r.image != NULL, "--view", "--image"},
+            {ck_every_given, o.checkpoint != NULL, "--checkpoint-every", "--checkpoint"},
+            {level_given, o.subdivide > 0, "--max-level", "--subdivide"},
+            {snapshot_given, r.out || r.csv || r.image, "--snapshot-every",
+             "-o, --csv or --image (the outputs it rewrites)"},
+        };
+        for (size_t k = 0; k < sizeof unused / sizeof unused[0]; k++)
+            if (unused[k].given && !unused[k].used)
+                fprintf(stderr, "vwalls radiosity: warning: %s has no effect without %s\n",
+                        unused[k].opt, unused[k].without);
     }
 
     /* A radiosity cell cannot be shared by workers (a shot's bitmaps depend on the order

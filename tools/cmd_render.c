@@ -438,7 +438,7 @@ int vw_cmd_render(int argc, char **argv)
             char *end;
             long wk = strtol(q, &end, 10);
             double k = 0;
-            if (end != q && *end == ':') k = strtod(end + 1, &end);
+            if (end != q && *end == ':') k = vw_cli_strtod(end + 1, &end);
             if (!(*q >= '0' && *q <= '9') || wk >= gw || !(k >= 1) || k > 1000 ||
                 (*end && *end != ',') ||
                 (*end == ',' && !end[1])) {

@@ -60,8 +60,9 @@ VW_API vw_status vw_map_weighted(const vw_decomp *d, const double *cell_load, in
 VW_API vw_status vw_map_compute(vw_map_kind kind, const vw_decomp *d, const double *cell_load,
                                 int nprocs, int wpp, const double *speeds, int *cell_worker);
 
-/* "1,1,2,4" -> speeds (exactly n entries separated by commas, each > 0 and finite);
-   VW_E_INVAL otherwise (an empty list, an empty entry, a trailing comma, a bad number). */
+/* "1,1,2,4" -> speeds (exactly n entries separated by commas, each > 0 and finite,
+   decimal with or without an exponent); VW_E_INVAL otherwise (an empty list, an empty
+   entry, a trailing comma, a bad number, a hexadecimal one such as "0x2"). */
 VW_API vw_status vw_map_parse_speeds(const char *s, double *speeds, int n);
 
 /* Re-maps the world's cells onto workers between runs (cells move with their objects

@@ -9,6 +9,7 @@
 #include "core/world_internal.h"
 #include "vwalls/map.h"
 
+#include <ctype.h>
 #include <limits.h>
 #include <math.h>
 #include <stdio.h>
@@ -42,6 +43,12 @@ vw_status vw_map_parse_speeds(const char *s, double *speeds, int n)
     int k = 0;
     const char *q = s;
     while (*q) {
+        /* Decimal numbers (and exponents) only: strtod also reads C99's hexadecimal
+           floats, and "0x2" was a speed of 2. */
+        const char *t = q;
+        while (isspace((unsigned char)*t)) t++;
+        if (*t == '+' || *t == '-') t++;
+        if (t[0] == '0' && (t[1] == 'x' || t[1] == 'X')) return VW_E_INVAL;
         char *end;
         double v = strtod(q, &end);
         if (end == q || !(v > 0) || !isfinite(v) || k >= n) return VW_E_INVAL;

@@ -700,10 +700,13 @@ static int t_map(void)
         EXPECT(vw_map_parse_speeds("1,2.5", sp, 2) == VW_OK && sp[0] == 1 && sp[1] == 2.5,
                "'1,2.5': %g %g", sp[0], sp[1]);
         static const char *const bad[] = {"1,2,", "1,2,,", ",1,2", "1,,2", "1,2,3", "1", "",
-                                          "1,0", "1,-2", "1,nan", "1,inf", "1;2", "1,2x", "1, "};
+                                          "1,0", "1,-2", "1,nan", "1,inf", "1;2", "1,2x", "1, ",
+                                          "0x1,2", "1,0X2", "1, 0x2", "1,+0x2", "1,2e0x"};
         for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++)
             EXPECT(vw_map_parse_speeds(bad[i], sp, 2) == VW_E_INVAL, "'%s' accepted", bad[i]);
         EXPECT(vw_map_parse_speeds("1,2,", sp, 3) == VW_E_INVAL, "'1,2,' for 3 workers");
+        EXPECT(vw_map_parse_speeds("1e0,2.5E-1", sp, 2) == VW_OK && sp[1] == 0.25,
+               "'1e0,2.5E-1': %g %g", sp[0], sp[1]);
     }
     return vw_test_failures ? 1 : 0;
 }

@@ -6,7 +6,13 @@
 # replaced frame 1); an empty --slow, and numbers with white space or a '+' before them
 # (" 2", "+8x8"), which strtol took. Each is refused with status 2 before anything is
 # written. Then every numeric option of every command with values that are not numbers
-# or out of range: status 2 and a message naming the option and the value.
+# or out of range: status 2 and a message naming the option and the value, hexadecimal
+# numbers among them ("--angle 0x10", which strtod read as 16 degrees). Then what the
+# next sweep found: radiosity took options it had no use for without a word (--size or
+# --view without --image, --checkpoint-every without --checkpoint, --max-level without
+# --subdivide, --snapshot-every without an output it rewrites), now a warning each, as
+# render warns; edit took animate's --keep-going, now an unknown option (status 2); and
+# hexadecimal numbers in the lists of reals (--from, --light, --view, --speeds, --slow).
 set -u
 V=$1 T=$2
 D=$(cd "$(dirname "$0")/../data" && pwd) || exit 1
@@ -128,7 +134,8 @@ for v in 0 -1 nan 1e999 '' 9223372036854775808 1.5 0x10 inf; do
   done
   bad gen --count "$v" spheres
 done
-for v in nan 1e999 '' -1 inf 1e400 abc 1,2; do
+# 0x1p-4 is 0.0625 and -0x0 is 0: in range for each of them, had they been decimal.
+for v in nan 1e999 '' -1 inf 1e400 abc 1,2 0x1p-4 0X.1 -0x0 ' 0x1p-4'; do
   for o in --sf --patch-size --neighbourhood --subdivide --checkpoint-every; do
     bad radiosity $o "$v" cube.obj -o o.ply --quiet
   done
@@ -143,4 +150,77 @@ for v in 0x2 2x 2x2x2x2 -1 '' 33x33x33 x; do
   refused 2 "^vwalls radiosity: --cells: layout '$v'" radiosity cube.obj -o o.ply --cells "$v"
 done
 clean "numeric options"
+
+# 6. radiosity: an option whose only user is absent is a warning (render's words for
+# --overlay-by), the run goes on; with its user, no warning.
+# warned OPTION WITHOUT ARGS...: status 0, "vwalls radiosity: warning: OPTION has no
+# effect without WITHOUT" on stderr, and the mesh written.
+warned() {
+  o=$1 without=$2
+  shift 2
+  "$V" radiosity cube.obj -o o.ply --max-shots 3 --quiet "$@" > out 2> err < /dev/null ||
+    fail "radiosity $*: status $? ($(cat err))"
+  grep -q -x -e "vwalls radiosity: warning: $o has no effect without $without" err ||
+    fail "radiosity $*: no warning about $o: $(cat err)"
+  [ -s o.ply ] || fail "radiosity $*: no mesh"
+  rm -f o.ply ck
+}
+warned --size --image --size 8x8
+warned --view --image --view 0,0,5,0,0,0
+warned --checkpoint-every --checkpoint --checkpoint-every 5
+warned --max-level --subdivide --max-level 2
+"$V" radiosity cube.obj --stats o.json --snapshot-every 2 --max-shots 3 --quiet > out 2> err ||
+  fail "radiosity --stats --snapshot-every: status $?"
+grep -q -x -e "vwalls radiosity: warning: --snapshot-every has no effect without -o, --csv or --image (the outputs it rewrites)" err ||
+  fail "radiosity --stats --snapshot-every: no warning: $(cat err)"
+[ -s o.json ] || fail "radiosity --stats --snapshot-every: no stats"
+rm -f o.json
+warned --size --image --size 8x8 --view 0,0,5,0,0,0 --checkpoint ck --subdivide 0.1
+grep -q -e "--view has no effect" err || fail "--size and --view: one warning each: $(cat err)"
+grep -q -e "--checkpoint\|--max-level" err && fail "unasked-for warning: $(cat err)"
+"$V" radiosity cube.obj -o o.ply --image o.png --size 8x8 --view 0,0,5,0,0,0 --checkpoint ck \
+  --checkpoint-every 5 --subdivide 0.1 --max-level 2 --snapshot-every 2 --max-shots 3 \
+  --quiet > out 2> err < /dev/null || fail "radiosity, every option used: status $?"
+grep -q "warning" err && fail "radiosity, every option used: $(cat err)"
+[ -s o.ply ] && [ -s o.png ] && [ -s ck ] || fail "radiosity, every option used: $(ls)"
+rm -f o.ply o.png ck
+
+# 7. --keep-going is animate's: edit refuses it as any option it does not take, before
+# reading a line; its help does not list it, animate's does.
+echo frame > in.txt
+"$V" edit s.nff --keep-going --quiet > out 2> err < in.txt; rc=$?
+[ $rc -eq 2 ] || fail "edit --keep-going: status $rc, expected 2 ($(cat err))"
+grep -q "^vwalls edit: unknown option '--keep-going'" err || fail "edit --keep-going: $(cat err)"
+[ -s out ] && fail "edit --keep-going: answered: $(cat out)"
+rm -f in.txt
+"$V" edit --help | grep -q -e "^  --keep-going  " && fail "edit --help lists --keep-going"
+"$V" animate --help | grep -q -e "^  --keep-going  " || fail "animate --help: no --keep-going"
+
+# 8. Hexadecimal numbers in the lists of real numbers; decimal and exponent forms stay.
+# shellcheck disable=SC2086
+{
+refused 2 "^vwalls render: --from: bad value '0,0x1p-4,5'" render s.nff -o o.png --from 0,0x1p-4,5 $R
+refused 2 "^vwalls render: --light: bad value '1,1,1,0X.8,1,1'" render s.nff -o o.png \
+  --light 1,1,1,0X.8,1,1 $R
+refused 2 "^vwalls radiosity: --view: bad value '0,0,5,0,0,0,0x10'" radiosity cube.obj -o o.ply \
+  --image o.png --view 0,0,5,0,0,0,0x10 --quiet
+refused 2 "^vwalls render: --speeds: bad value '1,0x2'" render s.nff -o o.png --workers 2 \
+  --speeds 1,0x2 $R
+refused 2 "^vwalls render: --speeds: bad value ' 0x1,1'" render s.nff -o o.png --workers 2 \
+  --speeds ' 0x1,1' $R
+refused 2 "^vwalls render: --slow: bad value '1:0x2'" render s.nff -o o.png --workers 2 \
+  --slow 1:0x2 $R
+clean "hexadecimal lists"
+"$V" render s.nff -o o.png --angle 2.5E1 --from 1e-3,0,5 --at 0,0,0 --up 0,1E0,0 \
+  --light 1,1,1,5e-1,.5,0.5 --workers 2 --speeds 1,2.5E0 --slow 1:2e0 $R ||
+  fail "render, decimal and exponent forms: status $?"
+"$V" radiosity cube.obj -o o.ply --sf 1E-3 --patch-size 2.5e0 --subdivide 1e-1 \
+  --checkpoint ck --checkpoint-every 1e2 --max-shots 3 --quiet ||
+  fail "radiosity, decimal and exponent forms: status $?"
+"$V" animate s.nff script.txt -o 'f%d.png' --threshold 1e-1 --margin 2.5E-1 $R > /dev/null ||
+  fail "animate, decimal and exponent forms: status $?"
+"$V" gen spheres --count 3 --cluster 5E-1 -o g.nff || fail "gen --cluster 5E-1: status $?"
+rm -f o.png o.ply ck f0.png f1.png g.nff
+}
+clean "unused options"
 echo "cli_sweep: all passed"

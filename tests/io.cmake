@@ -67,3 +67,14 @@ add_test(NAME io_cli_obj_input
          COMMAND sh ${PROJECT_SOURCE_DIR}/tests/io/cli_obj_input.sh $<TARGET_FILE:vwalls_tool>
                  ${CMAKE_CURRENT_BINARY_DIR}/io_cli_obj_input)
 set_tests_properties(io_cli_obj_input PROPERTIES TIMEOUT 60)
+
+# What the NFF reader takes as text, as the OBJ reader does: a NUL or control byte
+# anywhere (comments included) refused at its line, blanks and bytes from 0x80 up accepted.
+add_executable(test_io_nff_input ${PROJECT_SOURCE_DIR}/tests/io/test_io_nff_input.c)
+target_include_directories(test_io_nff_input PRIVATE ${PROJECT_SOURCE_DIR}/tests)
+target_link_libraries(test_io_nff_input PRIVATE vwalls_static m)
+add_test(NAME io_nff_input COMMAND test_io_nff_input)
+add_test(NAME io_cli_nff_input
+         COMMAND sh ${PROJECT_SOURCE_DIR}/tests/io/cli_nff_input.sh $<TARGET_FILE:vwalls_tool>
+                 ${CMAKE_CURRENT_BINARY_DIR}/io_cli_nff_input)
+set_tests_properties(io_cli_nff_input PROPERTIES TIMEOUT 60)

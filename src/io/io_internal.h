@@ -87,6 +87,17 @@ vw_status vw__sb_polygon_end(vw__sb *b, int material, int has_normals);
 /* Convenience: a polygon from its own fresh vertices (no normals). */
 vw_status vw__sb_add_polygon(vw__sb *b, int material, int n, const double (*v)[3]);
 
+/* Is the byte one a text file cannot hold? NUL and the control characters but the
+   blanks (tab, VT, FF) and the line ends (LF, CR); DEL too. Bytes from 0x80 up are
+   accepted unjudged: UTF-8 names and comments must read, and so must the Latin-1 or
+   Windows code page text of older exporters, which is not valid UTF-8. The OBJ, MTL
+   and NFF readers refuse such a byte as binary data, at its line. */
+static inline int vw__is_binary(unsigned char c)
+{
+    return (c < 0x20 && c != '\t' && c != '\n' && c != '\v' && c != '\f' && c != '\r') ||
+           c == 0x7f;
+}
+
 /* Reads a whole file into a NUL-terminated buffer (the NUL is not counted in *len). */
 vw_status vw__read_whole_file(const char *path, char **text, size_t *len, char *err,
                               size_t errlen);

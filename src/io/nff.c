@@ -8,6 +8,12 @@
  * the specular colour (and mirror weight), the mirror weight alone and the emission of
  * the current material (see vw_scene_write_nff), which other NFF readers ignore. NFF's
  * own Ks weights both the highlight and the mirror ray.
+ *
+ * The file must be text, as an OBJ must: a NUL byte or another control character
+ * (anything below 0x20 but tab, LF, VT, FF and CR, and DEL) anywhere, a comment
+ * included, is an error at the byte's line, so binary data named as an NFF is refused
+ * as such instead of as its first odd token. Bytes from 0x80 up are text (UTF-8 or a
+ * legacy code page in comments).
  */
 #include <float.h>
 #include <limits.h>
@@ -53,9 +59,13 @@ static int is_space(char c)
     return c == ' ' || c == '\t' || c == '\n' || c == '\r' || c == '\v' || c == '\f';
 }
 
-/* Next token, or 0 at the end of the text. Comments are skipped, except that a
-   "#vw" comment is returned as an extension token when want_ext is set (only where
-   an entity may start; elsewhere it is an ordinary comment). */
+/* Next token: 1, or 0 at the end of the text, or -1 at a byte no text holds
+   (vw__is_binary), with lx->p left on it and lx->line its line. Comments are skipped,
+   except that a "#vw" comment is returned as an extension token when want_ext is set
+   (only where an entity may start; elsewhere it is an ordinary comment). The check
+   adds next to nothing to the token loop, which the whole file goes through: a byte
+   up to ' ' ends a token anyway, being a blank, a line end or binary; DEL is the one
+   more byte to stop at, and only where a token stops is the byte looked at again. */
 static int lex_next(lexer *lx, token *t, int want_ext)
 {
     for (;;) {
@@ -71,9 +81,12 @@ static int lex_next(lexer *lx, token *t, int want_ext)
             return 0;
         if (*lx->p == '#') {
             const char *q = lx->p, *eol = q;
-            while (eol < lx->end && *eol != '\n' && *eol != '\r')
+            while (eol < lx->end && *eol != '\n' && *eol != '\r' &&
+                   !vw__is_binary((unsigned char)*eol))
                 eol++;
             lx->p = eol;
+            if (eol < lx->end && vw__is_binary((unsigned char)*eol))
+                return -1;
             if (want_ext && eol - q >= 4 && memcmp(q, "#vw", 3) == 0 && is_space(q[3])) {
                 t->s = q + 3;
                 t->n = (size_t)(eol - (q + 3));
@@ -83,9 +96,15 @@ static int lex_next(lexer *lx, token *t, int want_ext)
             }
             continue;
         }
+        /* A token ends at a blank, a line end, a '#', or a byte no text holds: every
+           byte up to ' ', and DEL. (From 0x80 up, bytes are token bytes.) */
         const char *start = lx->p;
-        while (lx->p < lx->end && !is_space(*lx->p) && *lx->p != '#')
+        unsigned char c;
+        while (lx->p < lx->end && (c = (unsigned char)*lx->p) > ' ' && c != '#' &&
+               c != 0x7f)
             lx->p++;
+        if (lx->p < lx->end && vw__is_binary((unsigned char)*lx->p))
+            return -1;
         t->s = start;
         t->n = (size_t)(lx->p - start);
         t->line = lx->line;
@@ -132,6 +151,15 @@ static vw_status fail(nff *P, int line, const char *fmt, ...)
     return st;
 }
 
+/* The lexer stopped at a byte no text holds (lex_next returned -1). */
+static vw_status binary(nff *P, const lexer *lx)
+{
+    unsigned char c = (unsigned char)*lx->p;
+    if (!c)
+        return fail(P, lx->line, "a NUL byte: binary data, not NFF text");
+    return fail(P, lx->line, "control character 0x%02x: binary data, not NFF text", c);
+}
+
 static vw_status fail_status(nff *P, vw_status st)
 {
     if (st == VW_E_NOMEM) {
@@ -152,7 +180,10 @@ static vw_status read_num(nff *P, double *out)
 {
     token t;
     char sb[48];
-    if (!lex_next(&P->lx, &t, 0))
+    int got = lex_next(&P->lx, &t, 0);
+    if (got < 0)
+        return binary(P, &P->lx);
+    if (!got)
         return fail(P, P->entity_line, "file ends in the middle of '%s'", P->entity);
     int r = parse_double(&t, out);
     /* Every number must fit a float, as OBJ's do: Embree keeps geometry in floats, and
@@ -208,7 +239,10 @@ static vw_status read_int(nff *P, const char *what, long lo, long hi, int *out)
 {
     token t;
     char sb[48];
-    if (!lex_next(&P->lx, &t, 0))
+    int got = lex_next(&P->lx, &t, 0);
+    if (got < 0)
+        return binary(P, &P->lx);
+    if (!got)
         return fail(P, P->entity_line, "file ends in the middle of '%s'", P->entity);
     long long vv;
     if (!vw__parse_int(t.s, t.n, 11, &vv)) {
@@ -249,7 +283,10 @@ static vw_status parse_view(nff *P)
     for (;;) {
         lexer save = P->lx;
         token t;
-        if (!lex_next(&P->lx, &t, 0))
+        int got = lex_next(&P->lx, &t, 0);
+        if (got < 0)
+            return binary(P, &P->lx);
+        if (!got)
             break;
         vw_status st;
         if (tok_is(&t, "from")) {
@@ -316,7 +353,10 @@ static vw_status parse_light(nff *P)
     lexer save = P->lx;
     token t;
     double dummy;
-    int has_color = lex_next(&P->lx, &t, 0) && parse_double(&t, &dummy) != 0;
+    int got = lex_next(&P->lx, &t, 0);
+    if (got < 0)
+        return binary(P, &P->lx);
+    int has_color = got && parse_double(&t, &dummy) != 0;
     P->lx = save;
     if (has_color && (st = read_floats(P, col, 3)) != VW_OK)
         return st;
@@ -363,12 +403,13 @@ static vw_status parse_fill(nff *P)
 
 static vw_status parse_ext(nff *P, const token *t)
 {
-    /* The extension line is tokenised on its own so it cannot run past its line. */
+    /* The extension line is tokenised on its own so it cannot run past its line. Its
+       bytes were checked as the comment was read: lex_next cannot return -1 here. */
     nff sub = *P;
     sub.lx.p = t->s;
     sub.lx.end = t->s + t->n;
     token key;
-    if (!lex_next(&sub.lx, &key, 0))
+    if (lex_next(&sub.lx, &key, 0) <= 0)
         return VW_OK;
     /* Ks is NFF's Ks per channel, so it sets the mirror weight too; Kr (written after
        it) the mirror weight alone. */
@@ -387,7 +428,7 @@ static vw_status parse_ext(nff *P, const token *t)
     if (st != VW_OK)
         return st;
     token extra;
-    if (lex_next(&sub.lx, &extra, 0))
+    if (lex_next(&sub.lx, &extra, 0) > 0)
         return fail(P, t->line, "wrong number of values for '%s'", sub.entity);
     memcpy(dst, col, sizeof col);
     if (dst == P->cur.specular)
@@ -473,7 +514,8 @@ static vw_status parse_all(nff *P)
     token t;
     char sb[48];
     const char *last = NULL;
-    while (lex_next(&P->lx, &t, 1)) {
+    int got;
+    while ((got = lex_next(&P->lx, &t, 1)) > 0) {
         vw_status st;
         if (t.ext) {
             st = parse_ext(P, &t);
@@ -519,6 +561,8 @@ static vw_status parse_all(nff *P)
             last = P->entity;
         /* After a 'v' block the last entity read was its last line, e.g. 'resolution'. */
     }
+    if (got < 0)
+        return binary(P, &P->lx);
     /* Named at the file's last line: after a final newline the lexer counts one more,
        a line no editor shows. */
     int last_line = P->lx.line;

@@ -399,16 +399,6 @@ static int next_line(obj *O, const char **p, const char *end, span *line)
     return 1;
 }
 
-/* Is the byte one a text file cannot hold? NUL and the control characters but the
-   blanks (tab, VT, FF) and the line ends (LF, CR); DEL too. Bytes from 0x80 up are
-   accepted unjudged: UTF-8 names and comments must read, and so must the Latin-1 or
-   Windows code page text of older exporters, which is not valid UTF-8. */
-static int is_binary(unsigned char c)
-{
-    return (c < 0x20 && c != '\t' && c != '\n' && c != '\v' && c != '\f' && c != '\r') ||
-           c == 0x7f;
-}
-
 /* Refuses a statement (its continued lines too, comments included) that holds a byte
    no text holds, naming the physical line of that byte; kind is "OBJ" or "MTL". */
 static vw_status check_text(obj *O, span line, const char *kind)
@@ -418,7 +408,7 @@ static vw_status check_text(obj *O, span line, const char *kind)
         unsigned char c = (unsigned char)line.s[i];
         if (c == '\n' || (c == '\r' && !(i + 1 < line.n && line.s[i + 1] == '\n')))
             at++;   /* a continuation's line end: CRLF counts at its LF */
-        else if (is_binary(c)) {
+        else if (vw__is_binary(c)) {
             O->line = at;
             if (!c)
                 return fail(O, "a NUL byte: binary data, not %s text", kind);

@@ -467,7 +467,8 @@ int main(int argc, char **argv)
                  "t.nff:6: unknown keyword 'q'");
     expect_error(VIEW "s 0 0 0 1\r\r\n\rs 0 0 0\r", "t.nff:5: file ends in the middle of 's'");
     expect_error(VIEW "s 0 0 0 1\n7\n", "t.nff:3: wrong number of values for 's'");
-    expect_error(VIEW "s 0 0 0 1\x01\n", "t.nff:2: bad number '1?' in 's'");
+    expect_error(VIEW "s 0 0 0 1\x01\n",
+                 "t.nff:2: control character 0x01: binary data, not NFF text");
 
     /* Every prefix of a valid file either parses or fails cleanly with "name:line:". */
     for (size_t cut = 0; cut <= len; cut++) {

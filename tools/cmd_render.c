@@ -548,6 +548,13 @@ int vw_cmd_render(int argc, char **argv)
     cfg.worker_speeds = speeds; /* the shares of farmed and duplicated cells' copies */
     cfg.steal = steal;
     p.config = &cfg;
+    farm = vw_cli_farm_resolve(farm, balance_given || map_given);
+    /* The initial mapping is the one rendered (no balancer, no new mapping): its copies
+       are made before the objects come, so under MPI each process keeps the records its
+       copies need as they come, and none is fetched at the commit. */
+    int balancing = strategy != VW_BALANCE_NONE || map != VW_MAP_BLOCK;
+    p.farm_first = !balancing && !map_given && !speeds;
+    p.farm = (rt_farm)farm;
     rt_job *job = NULL;
     vw_status st = rt_job_create(scene, &p, &job, err, sizeof err);
     size_t nobjects = vw_scene_count_objects(scene);
@@ -560,13 +567,11 @@ int vw_cmd_render(int argc, char **argv)
     vw_world *w = rt_job_world(job);
     /* The mapping of the initial cells (greedy and weighted refine it by load after the
        pre-pass, when there is one). */
-    int balancing = strategy != VW_BALANCE_NONE || map != VW_MAP_BLOCK;
     if (tuning && !balancing && vw_cli_is_output())
         fprintf(stderr, "vwalls render: warning: %s has no effect without a pre-pass (--balance "
                         "other than none, or --map greedy or weighted)\n", tuning);
     if (by_given && !overlay && vw_cli_is_output())
         fprintf(stderr, "vwalls render: warning: --overlay-by has no effect without --overlay\n");
-    farm = vw_cli_farm_resolve(farm, balance_given || map_given);
     rt_balance_result bi;
     memset(&bi, 0, sizeof bi);
     if ((map_given || speeds) && rt_job_map(job, map, NULL, speeds, err, sizeof err) != VW_OK) {
@@ -601,7 +606,9 @@ int vw_cmd_render(int argc, char **argv)
         free(speeds), free(slowdown);
         return rc;
     }
-    if (rt_job_farm(job, (rt_farm)farm, &farm_copies, err, sizeof err) != VW_OK ||
+    if (p.farm_first)
+        farm_copies = rt_job_farm_copies(job);
+    if ((!p.farm_first && rt_job_farm(job, (rt_farm)farm, &farm_copies, err, sizeof err) != VW_OK) ||
         rt_job_commit(job, err, sizeof err) != VW_OK) {
         vw_cli_error(CMD, "%s", err);
         rt_job_free(job);

@@ -136,6 +136,8 @@ vw_status rt_anim_create(vw_scene *s, const rt_anim_params *p, rt_anim **out, ch
     rp.scale = a->scale;
     rp.objects = rec;
     rp.nobjects = nrec;
+    rp.farm_first = 1; /* (the first frame's rt_job_farm then adds none) */
+    rp.farm = p->farm;
     st = rt_job_create(s, &rp, &a->job, err, errlen);
     a->rec = rec;
     a->nrec = a->caprec = nrec;

@@ -19,7 +19,10 @@ struct rt_job {
     int *owner_first, *owner_pixels; /* owner[] by cell (rt_shared.owner_first) */
     int64_t primary;     /* pixels with an owner */
     int ran;
+    int farm_copies;     /* the copies made before the objects (rt_params.farm_first) */
 };
+
+int rt_job_farm_copies(const rt_job *j) { return j ? j->farm_copies : 0; }
 
 void rt_job_free(rt_job *j)
 {
@@ -378,8 +381,13 @@ vw_status rt_job_create(const vw_scene *s, const rt_params *p, rt_job **out, cha
         rt_job_free(j);
         return st;
     }
-    st = p->objects ? vw_world_add_objects(j->world, p->objects, p->nobjects)
-                    : add_scene_objects(j->world, s, err, errlen);
+    /* The copies first, when the caller farms the initial mapping: then under MPI each
+       process keeps, as the objects come, the records its copies need (a copy of every
+       cell on every process: all of them), and the commit fetches none. */
+    if (p->farm_first) st = rt_job_farm(j, p->farm, &j->farm_copies, err, errlen);
+    if (st == VW_OK)
+        st = p->objects ? vw_world_add_objects(j->world, p->objects, p->nobjects)
+                        : add_scene_objects(j->world, s, err, errlen);
     if (st != VW_OK) {
         if (!err[0]) snprintf(err, errlen, "%s", vw_world_errmsg(j->world));
         rt_job_free(j);

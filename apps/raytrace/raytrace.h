@@ -170,6 +170,20 @@ extern const vw_module rt_module;
 
 /* ---- a whole render (what the command line and the tests drive) ------------------------- */
 
+/* Farming within a process: the workers of a process share its cells by holding copies
+   of them (vw_world_set_replicas). A ray then moves to another worker only when it
+   crosses into a cell of another process, and every copy takes eye-ray batches in
+   turns, then the turns a slower copy has not taken (vw_ctx_next_batch), so the
+   workers stay evenly loaded. The copies of a cell share one built Embree scene
+   (rt_geo_acquire). */
+typedef enum rt_farm {
+    RT_FARM_IDLE = 0, /* only workers that host no cell get copies (of all their
+                         process's cells): --cells 1 on 2 workers uses both */
+    RT_FARM_ALL,      /* every worker hosts every cell of its process */
+                      /* (a process that hosts no cell at all farms every cell) */
+    RT_FARM_NONE      /* no copies besides those a balancer made */
+} rt_farm;
+
 typedef struct rt_params {
     int width, height;   /* 0: the camera's resolution, else 512x512 */
     int depth;           /* 0: 5 */
@@ -183,6 +197,13 @@ typedef struct rt_params {
     double scale;              /* 0: the scene's diagonal; sets the epsilons */
     const rt_object *objects;  /* NULL: rt_objects_from_scene(); else these records, */
     size_t nobjects;           /* in this order (world object ids = their index) */
+    /* Nonzero: the cells' copies of mode `farm` (rt_job_farm) are made before the objects
+       are added, so that under MPI each process keeps the records its copies will be
+       built from as they come, instead of fetching them from the others at the commit
+       (docs/runtime.md, "Object records"). For a caller that farms the initial mapping
+       (no balancing, no new mapping first); rt_job_farm_copies tells how many. */
+    int farm_first;
+    rt_farm farm;
 } rt_params;
 
 /* The records of one scene object into out[0..n) (n = 1, or count-2 for a polygon),
@@ -293,25 +314,14 @@ vw_status rt_job_balance(rt_job *j, const rt_balance *b, rt_balance_result *out,
 /* Re-maps the cells (kind, loads or NULL, speeds or NULL) before or between runs. */
 vw_status rt_job_map(rt_job *j, vw_map_kind kind, const double *load, const double *speeds,
                      char *err, size_t errlen);
-/* Farming within a process: the workers of a process share its cells by holding copies
-   of them (vw_world_set_replicas). A ray then moves to another worker only when it
-   crosses into a cell of another process, and every copy takes eye-ray batches in
-   turns, then the turns a slower copy has not taken (vw_ctx_next_batch), so the
-   workers stay evenly loaded. The copies of a cell share one built Embree scene
-   (rt_geo_acquire). */
-typedef enum rt_farm {
-    RT_FARM_IDLE = 0, /* only workers that host no cell get copies (of all their
-                         process's cells): --cells 1 on 2 workers uses both */
-    RT_FARM_ALL,      /* every worker hosts every cell of its process */
-                      /* (a process that hosts no cell at all farms every cell) */
-    RT_FARM_NONE      /* no copies besides those a balancer made */
-} rt_farm;
 /* Parses "idle" | "all" | "none"; -1 if none of them. */
 int rt_farm_parse(const char *s);
 const char *rt_farm_name(rt_farm f);
 /* Adds the copies of mode f to the current mapping (after balancing, before commit).
    *copies gets the number of copies added (may be NULL). */
 vw_status rt_job_farm(rt_job *j, rt_farm f, int *copies, char *err, size_t errlen);
+/* The copies rt_job_create made (rt_params.farm_first), or 0. */
+int rt_job_farm_copies(const rt_job *j);
 
 /* lambda of the deterministic work (ray-cell visits, RT_C_SEGMENTS) over workers. */
 double rt_job_work_imbalance(const rt_job *j, const double *speeds);

@@ -53,6 +53,7 @@ void vw__stats_local(vw_world *w)
         ws->turns_remote = wk->turns_remote;
         ws->peak_rss = rss;
         ws->records = w->nslots;
+        ws->fetched = w->fetched;
     }
 }
 
@@ -148,10 +149,11 @@ static void write_body(vw_world *w, FILE *f, const char *command, const char *ex
         /* The worker's speed (vw_config.worker_speeds, 1 when none were given): with
            speeds lambda is the longest time against a split by speed, which a reader
            can recompute from busy_s only when the speeds are here. */
-        fprintf(f, "    {\"id\": %d, \"process\": %d, \"speed\": %.9g, \"busy_s\": %.6f, \"peak_rss_bytes\": %llu, \"records\": %llu, \"messages\": %llu, \"bytes\": %llu, \"remote_count\": %llu, \"remote_bytes\": %llu, \"remote_turns\": %llu",
+        fprintf(f, "    {\"id\": %d, \"process\": %d, \"speed\": %.9g, \"busy_s\": %.6f, \"peak_rss_bytes\": %llu, \"records\": %llu, \"records_fetched\": %llu, \"messages\": %llu, \"bytes\": %llu, \"remote_count\": %llu, \"remote_bytes\": %llu, \"remote_turns\": %llu",
                 g, vw__worker_process(w, g), num(w->speeds ? w->speeds[g] : 1.0),
                 num(vw_world_worker_busy(w, g)), (unsigned long long)rss,
                 (unsigned long long)(vw__worker_process(w, g) == w->rank ? w->nslots : ws->records),
+                (unsigned long long)(vw__worker_process(w, g) == w->rank ? w->fetched : ws->fetched),
                 (unsigned long long)ws->msgs_sent, (unsigned long long)ws->bytes_sent,
                 (unsigned long long)ws->msgs_remote, (unsigned long long)ws->bytes_remote,
                 (unsigned long long)ws->turns_remote);

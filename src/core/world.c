@@ -638,6 +638,7 @@ static vw_status share_records(vw_world *w, vw_status st, char *msg, size_t len)
         free(w->objects);
         w->objects = store;
         w->nslots = w->capslots = nkeep;
+        w->fetched += nask;
         store = NULL;
     }
     free(got);

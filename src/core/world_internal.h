@@ -183,6 +183,7 @@ typedef struct vw__worker_stats {
     uint64_t turns_remote;              /* turns made of copies on other processes */
     uint64_t peak_rss;                  /* of the worker's process */
     uint64_t records;                   /* object records its process keeps (vw_world.nslots) */
+    uint64_t fetched;                   /* and got from others (vw_world.fetched) */
 } vw__worker_stats;
 
 /* How packets leave this process (the MPI engine); NULL for the threads engine.
@@ -236,6 +237,7 @@ struct vw_world {
     size_t nslots, capslots;   /* records in objects, and room for */
     size_t *slot;
     vw_box *bounds;
+    uint64_t fetched;          /* records this process got from others, since created */
     double pad;                /* placement padding (world units) */
     int committed;
     /* The workers' unit lists (vw__worker.cells) lag the copies of duplicated cells:

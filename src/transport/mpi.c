@@ -684,7 +684,7 @@ static vw_status tp_run(vw_world *w)
    The copies of duplicated cells follow the cells, as rows of their own (every process
    knows the same copies, so the layout agrees), each contributed by its own host. */
 /* The integers of a worker's figures (vw__worker_stats) in the sync. */
-#define SYNC_WORKER_WORDS 8
+#define SYNC_WORKER_WORDS 9
 
 static vw_status tp_sync(vw_world *w)
 {
@@ -732,6 +732,7 @@ static vw_status tp_sync(vw_world *w)
         row[5] = (int64_t)s->peak_rss;
         row[6] = (int64_t)s->turns_remote;
         row[7] = (int64_t)s->records;
+        row[8] = (int64_t)s->fetched;
         dv[nd + (size_t)w->workers[i].global] = s->busy_s;
     }
     MPI_Allreduce(MPI_IN_PLACE, iv, (int)(ni + SYNC_WORKER_WORDS * nw), MPI_INT64_T, MPI_SUM, t->comm);
@@ -765,6 +766,7 @@ static vw_status tp_sync(vw_world *w)
         s->peak_rss = (uint64_t)row[5];
         s->turns_remote = (uint64_t)row[6];
         s->records = (uint64_t)row[7];
+        s->fetched = (uint64_t)row[8];
         s->busy_s = dv[nd + g];
     }
     free(iv);

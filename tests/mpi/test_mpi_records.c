@@ -240,12 +240,15 @@ int main(int argc, char **argv)
     CHECK_EQ_INT(vw_world_add_objects(w, objs + part, nobj - 2 * part), VW_OK);
     CHECK_EQ_INT(vw_world_add_objects(w, objs + nobj - part, part), VW_OK);
     commit(w, 1, "first commit");
+    /* Kept as they were added: nothing to fetch at the first commit. */
+    CHECK_EQ_INT(w->fetched, 0);
 
     /* Every cell to another worker (and so, for most, another process). */
     int map[MAX_CELLS];
     for (int c = 0; c < 8; c++) map[c] = (vw_world_cell_worker(w, c) + 1 + c) % G;
     CHECK_EQ_INT(vw_world_remap(w, map), VW_OK);
     commit(w, 1, "remap");
+    if (P > 1) CHECK(w->fetched > 0); /* every cell moved, most to another process */
 
     /* A larger world box: the objects outside the old one join cells. */
     int map2[MAX_CELLS];

@@ -69,6 +69,14 @@ foreach(case "2;2x2x2;1;none" "2;4x1x2;2;none" "3;2x2;1;none" "2;1;1;idle" "3;1;
   foreach(g RANGE ${last})
     string(JSON proc GET "${json}" workers ${g} process)
     string(JSON kept GET "${json}" workers ${g} records)
+    # Without --speeds the initial mapping is rendered, and its copies are made before
+    # the objects come (rt_params.farm_first): each process keeps what it needs as they
+    # come, and fetches nothing at the commit.
+    string(JSON fetched GET "${json}" workers ${g} records_fetched)
+    if(NOT "${flags}" MATCHES "--speeds" AND NOT fetched EQUAL 0)
+      message(FATAL_ERROR "--cells ${cells} --farm ${farm}: process ${proc} fetched ${fetched} "
+                          "records at the commit")
+    endif()
     if(kept GREATER nobj)
       message(FATAL_ERROR "--farm ${farm}: process ${proc} keeps ${kept} of ${nobj} records")
     endif()

@@ -57,24 +57,21 @@ add_test(NAME io_cli_sweep
                  ${CMAKE_CURRENT_BINARY_DIR}/io_cli_sweep)
 set_tests_properties(io_cli_sweep PROPERTIES TIMEOUT 120)
 
-# What the OBJ and MTL readers take as text: binary bytes refused at their line, UTF-8,
-# Latin-1 and a byte order mark accepted; one warning per file for unknown keywords.
-add_executable(test_io_obj_input ${PROJECT_SOURCE_DIR}/tests/io/test_io_obj_input.c)
-target_include_directories(test_io_obj_input PRIVATE ${PROJECT_SOURCE_DIR}/tests)
-target_link_libraries(test_io_obj_input PRIVATE vwalls_static m)
-add_test(NAME io_obj_input COMMAND test_io_obj_input)
-add_test(NAME io_cli_obj_input
-         COMMAND sh ${PROJECT_SOURCE_DIR}/tests/io/cli_obj_input.sh $<TARGET_FILE:vwalls_tool>
-                 ${CMAKE_CURRENT_BINARY_DIR}/io_cli_obj_input)
-set_tests_properties(io_cli_obj_input PROPERTIES TIMEOUT 60)
-
-# What the NFF reader takes as text, as the OBJ reader does: a NUL or control byte
-# anywhere (comments included) refused at its line, blanks and bytes from 0x80 up accepted.
-add_executable(test_io_nff_input ${PROJECT_SOURCE_DIR}/tests/io/test_io_nff_input.c)
-target_include_directories(test_io_nff_input PRIVATE ${PROJECT_SOURCE_DIR}/tests)
-target_link_libraries(test_io_nff_input PRIVATE vwalls_static m)
-add_test(NAME io_nff_input COMMAND test_io_nff_input)
-add_test(NAME io_cli_nff_input
-         COMMAND sh ${PROJECT_SOURCE_DIR}/tests/io/cli_nff_input.sh $<TARGET_FILE:vwalls_tool>
-                 ${CMAKE_CURRENT_BINARY_DIR}/io_cli_nff_input)
-set_tests_properties(io_cli_nff_input PROPERTIES TIMEOUT 60)
+# What a scene reader takes as text (KIND nff or obj): its C test test_io_KIND_input
+# and the command line's tests/io/cli_KIND_input.sh.
+function(vw_io_input_tests kind)
+  add_executable(test_io_${kind}_input ${PROJECT_SOURCE_DIR}/tests/io/test_io_${kind}_input.c)
+  target_include_directories(test_io_${kind}_input PRIVATE ${PROJECT_SOURCE_DIR}/tests)
+  target_link_libraries(test_io_${kind}_input PRIVATE vwalls_static m)
+  add_test(NAME io_${kind}_input COMMAND test_io_${kind}_input)
+  add_test(NAME io_cli_${kind}_input
+           COMMAND sh ${PROJECT_SOURCE_DIR}/tests/io/cli_${kind}_input.sh $<TARGET_FILE:vwalls_tool>
+                   ${CMAKE_CURRENT_BINARY_DIR}/io_cli_${kind}_input)
+  set_tests_properties(io_cli_${kind}_input PROPERTIES TIMEOUT 60)
+endfunction()
+# OBJ and MTL: binary bytes refused at their line, UTF-8, Latin-1 and a byte order mark
+# accepted; one warning per file for unknown keywords.
+vw_io_input_tests(obj)
+# NFF, as OBJ: a NUL or control byte anywhere (comments included) refused at its line,
+# blanks and bytes from 0x80 up accepted.
+vw_io_input_tests(nff)

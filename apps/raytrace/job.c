@@ -382,8 +382,9 @@ vw_status rt_job_create(const vw_scene *s, const rt_params *p, rt_job **out, cha
         return st;
     }
     /* The copies first, when the caller farms the initial mapping: then under MPI each
-       process keeps, as the objects come, the records its copies need (a copy of every
-       cell on every process: all of them), and the commit fetches none. */
+       process keeps, as the objects come, the records its copies need (those of its own
+       cells; a process that hosts no cell farms every cell, and keeps every record), and
+       the commit fetches none. */
     if (p->farm_first) st = rt_job_farm(j, p->farm, &j->farm_copies, err, errlen);
     if (st == VW_OK)
         st = p->objects ? vw_world_add_objects(j->world, p->objects, p->nobjects)

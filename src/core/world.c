@@ -835,8 +835,11 @@ vw_status vw_world_commit(vw_world *w)
         snprintf(msg, sizeof msg, "listing each worker's cells and copies: %s",
                  vw_status_message(st));
     /* Under MPI the records of the cells to build come first: collective, and agreed
-       (a failure before it too), so that msg says why on every process. */
-    if (w->nprocs > 1 && w->m->object_size) {
+       (a failure before it too), so that msg says why on every process. Only when the
+       world changed since it was last committed (every step that moves objects, cells
+       or copies uncommits it, alike on every process): a commit of an unchanged world
+       (an animation's every frame) need not scan the objects again. */
+    if (w->nprocs > 1 && w->m->object_size && !w->committed) {
         st = share_records(w, st, msg, sizeof msg);
         if (st != VW_OK) return vw__world_error(w, st, "%s", msg);
     }

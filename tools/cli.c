@@ -58,23 +58,11 @@ int vw_cli_int(const char *cmd, const char *opt, const char *s, long lo, long hi
     return 0;
 }
 
-int vw_cli_hex_number(const char *s)
-{
-    while (*s == ' ' || (*s >= '\t' && *s <= '\r')) s++; /* strtod's white space */
-    if (*s == '+' || *s == '-') s++;
-    return s[0] == '0' && (s[1] == 'x' || s[1] == 'X');
-}
-
 double vw_cli_strtod(const char *s, char **end)
 {
-    errno = 0;
-    /* strtod also reads C99's hexadecimal floats: --angle 0x10 was 16 degrees. No
-       conversion, as for any other text that is not a number. */
-    if (vw_cli_hex_number(s)) {
-        *end = (char *)s;
-        return 0;
-    }
-    double v = strtod(s, end);
+    /* Decimal notation only, and no white space or '+' before it, as in whole numbers:
+       strtod also read C99's hexadecimal floats (--angle 0x10 was 16 degrees). */
+    double v = vw_strtod_decimal(s, end, 0);
     if (errno == ERANGE && fabs(v) <= DBL_MIN) errno = 0;
     return v;
 }

@@ -17,17 +17,16 @@ void vw_cli_error(const char *cmd, const char *fmt, ...) __attribute__((format(p
 /* Option values: each returns 0 and stores the value, or prints
    "vwalls CMD: --opt: bad value 'x' (expected ...)" and returns -1. A real number is
    read as strtod reads it but in decimal only (with or without an exponent: "1e-3",
-   "2.5E2"): no hexadecimal float ("0x10", "-0X1p3"), which strtod also takes. */
+   "2.5E2"): no hexadecimal float ("0x10", "-0X1p3"), which strtod also takes, and,
+   as in whole numbers, no white space or '+' before it. */
 int vw_cli_int(const char *cmd, const char *opt, const char *s, long lo, long hi, long *out);
 int vw_cli_double(const char *cmd, const char *opt, const char *s, double lo, double hi,
                   double *out);
 int vw_cli_size(const char *cmd, const char *opt, const char *s, int *w, int *h);  /* WxH */
-/* strtod for the options' real numbers: no conversion (*end = s) for a hexadecimal
-   number, errno 0 for one too small to hold (rounded to a denormal or zero, a fine
-   value), ERANGE for an overflow. */
+/* strtod for the options' real numbers (vw_strtod_decimal: decimal notation, no white
+   space or '+' first; otherwise no conversion, *end = s), errno 0 for one too small to
+   hold (rounded to a denormal or zero, a fine value), ERANGE for an overflow. */
 double vw_cli_strtod(const char *s, char **end);
-/* Does s start with a hexadecimal number (after strtod's white space and a sign)? */
-int vw_cli_hex_number(const char *s);
 /* A field of view in degrees: above 0 and below 180, the range of an NFF 'angle'
    (src/io/nff.c), so an option takes every angle a scene file may give and no other. */
 int vw_cli_fov_ok(double deg);

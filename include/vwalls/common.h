@@ -60,6 +60,14 @@ VW_API int vw_test_fault(const char *name);
    calling thread; n above 64 runs every part there. */
 VW_API void vw_parallel(int n, void (*fn)(int i, void *user), void *user);
 
+/* strtod for numbers in decimal notation only, the one reading of a real number for the
+   command line, --speeds, the scene readers and the edit language: s must begin with a
+   digit, or with '-' or '.' before one (a '+' too when plus is nonzero: exporters write
+   one in data files; the command line refuses it, as it does in whole numbers). White
+   space first, C99 hexadecimal floats ("0x10" would be 16), "inf" and "nan" are no
+   conversion: *end = s and 0 is returned. Otherwise as strtod, errno included. */
+VW_API double vw_strtod_decimal(const char *s, char **end, int plus);
+
 /* A closed axis-aligned box [lo, hi]. */
 typedef struct vw_box {
     double lo[3], hi[3];

@@ -62,7 +62,8 @@ VW_API vw_status vw_map_compute(vw_map_kind kind, const vw_decomp *d, const doub
 
 /* "1,1,2,4" -> speeds (exactly n entries separated by commas, each > 0 and finite,
    decimal with or without an exponent); VW_E_INVAL otherwise (an empty list, an empty
-   entry, a trailing comma, a bad number, a hexadecimal one such as "0x2"). */
+   entry, a trailing comma, a bad number, a hexadecimal one such as "0x2", white space
+   or '+' before a number: vw_strtod_decimal). */
 VW_API vw_status vw_map_parse_speeds(const char *s, double *speeds, int n);
 
 /* Re-maps the world's cells onto workers between runs (cells move with their objects

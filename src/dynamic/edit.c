@@ -43,8 +43,7 @@ static const char *shown(const char *w, char buf[SHOWN_BUF])
 static int number(const char *w, double *out)
 {
     char *end;
-    errno = 0;
-    double v = strtod(w, &end);
+    double v = vw_strtod_decimal(w, &end, 1); /* decimal notation, as in scene files */
     if (end == w || *end || !isfinite(v)) return 0;
     *out = v;
     return 1;

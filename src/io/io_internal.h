@@ -10,6 +10,7 @@
 #include <stdarg.h>
 #include <stddef.h>
 #include <stdio.h>
+#include <string.h>
 #include "vwalls/scene.h"
 
 /* Writes a formatted message into err (NULL or errlen 0: nothing written). The
@@ -34,9 +35,11 @@ void vw__scene_warning(const char *name, int line, const char *fmt, va_list ap);
    (so it cannot overflow). Returns 1 and stores it, or 0 when the token is not one. */
 int vw__parse_int(const char *s, size_t n, size_t maxlen, long long *out);
 
-/* A whole token (n bytes, not NUL-terminated) as a number, exactly as strtod reads it:
-   1 and the value, 0 when it is not a number (or longer than 127 bytes), -1 when it is
-   NaN or infinite. Short decimals take an exact fast path (scene.c). */
+/* A whole token (n bytes, not NUL-terminated) as a number, exactly as strtod reads it
+   but in decimal notation only (vw_strtod_decimal, a leading '+' allowed): 1 and the
+   value, 0 when it is not a number (a hexadecimal float, or longer than 127 bytes), -1
+   when it is NaN or infinite ("nan", "inf", or a decimal beyond DBL_MAX). Short
+   decimals take an exact fast path (scene.c). */
 int vw__parse_double(const char *s, size_t n, double *out);
 
 /* The scene builder owns a scene under construction plus the capacities of its
@@ -96,6 +99,14 @@ static inline int vw__is_binary(unsigned char c)
 {
     return (c < 0x20 && c != '\t' && c != '\n' && c != '\v' && c != '\f' && c != '\r') ||
            c == 0x7f;
+}
+
+/* A UTF-8 byte order mark (Windows editors write one) is not part of the first line:
+   left there, it would make the first keyword unknown. The OBJ, MTL and NFF readers
+   start after it. */
+static inline size_t vw__bom_length(const char *text, size_t len)
+{
+    return len >= 3 && !memcmp(text, "\xEF\xBB\xBF", 3) ? 3 : 0;
 }
 
 /* Reads a whole file into a NUL-terminated buffer (the NUL is not counted in *len). */

@@ -594,8 +594,9 @@ VW_API vw_status vw_scene_read_nff(const char *name, const char *text, size_t le
     memset(&P, 0, sizeof P);
     P.name = name ? name : "<nff>";
     /* Offsetting a null pointer, even by zero, is undefined: use an empty text. */
-    P.lx.p = text ? text : "";
-    P.lx.end = P.lx.p + len;
+    const char *t = text ? text : "";
+    P.lx.p = t + vw__bom_length(t, len);
+    P.lx.end = t + len;
     P.lx.line = 1;
     P.err = err;
     P.errlen = errlen;

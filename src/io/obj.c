@@ -418,13 +418,6 @@ static vw_status check_text(obj *O, span line, const char *kind)
     return VW_OK;
 }
 
-/* A UTF-8 byte order mark (Windows editors write one) is not part of the first line:
-   left there, it would make the first keyword unknown. */
-static size_t bom_length(const char *text, size_t len)
-{
-    return len >= 3 && !memcmp(text, "\xEF\xBB\xBF", 3) ? 3 : 0;
-}
-
 /* Warns about an unknown keyword once per file (the file's first one): a vendor's
    extension is no reason to refuse a mesh, but text that is not OBJ at all, read as
    nothing, must not pass unnoticed. */
@@ -467,7 +460,7 @@ static const char *const obj_ignored[] = {
 
 static vw_status parse_mtl(obj *O, const char *text, size_t len)
 {
-    const char *p = text + bom_length(text, len), *end = text + len;
+    const char *p = text + vw__bom_length(text, len), *end = text + len;
     vw_material *m = NULL;
     int illum = -1;   /* m's illumination model; -1 until an illum statement gives one */
     O->line = 0;
@@ -713,7 +706,7 @@ static vw_status parse_face(obj *O, span *line)
 
 static vw_status parse_obj(obj *O, const char *text, size_t len, const char *dir)
 {
-    const char *p = text + bom_length(text, len), *end = text + len;
+    const char *p = text + vw__bom_length(text, len), *end = text + len;
     span line, key;
     while (next_line(O, &p, end, &line)) {
         vw_status st = check_text(O, line, "OBJ");

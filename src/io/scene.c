@@ -115,7 +115,15 @@ int vw__parse_double(const char *s, size_t n, double *out)
     memcpy(buf, s, n);
     buf[n] = '\0';
     char *endp;
-    double v = strtod(buf, &endp);
+    /* Decimal notation only: strtod read "0x10" in a scene as 16. */
+    double v = vw_strtod_decimal(buf, &endp, 1);
+    if (endp == buf) {
+        /* "inf", "nan": no numbers here either, but named as what they are */
+        const char *w = buf + (*buf == '+' || *buf == '-');
+        if ((*w | 32) != 'i' && (*w | 32) != 'n') return 0;
+        v = strtod(buf, &endp);
+        return endp == buf + n ? -1 : 0;
+    }
     if (endp != buf + n) return 0;
     if (!isfinite(v)) return -1;
     *out = v;

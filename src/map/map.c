@@ -9,7 +9,6 @@
 #include "core/world_internal.h"
 #include "vwalls/map.h"
 
-#include <ctype.h>
 #include <limits.h>
 #include <math.h>
 #include <stdio.h>
@@ -43,14 +42,10 @@ vw_status vw_map_parse_speeds(const char *s, double *speeds, int n)
     int k = 0;
     const char *q = s;
     while (*q) {
-        /* Decimal numbers (and exponents) only: strtod also reads C99's hexadecimal
-           floats, and "0x2" was a speed of 2. */
-        const char *t = q;
-        while (isspace((unsigned char)*t)) t++;
-        if (*t == '+' || *t == '-') t++;
-        if (t[0] == '0' && (t[1] == 'x' || t[1] == 'X')) return VW_E_INVAL;
+        /* Decimal notation only (strtod also read "0x2" as a speed of 2), and no white
+           space or '+', as the command line's numbers. */
         char *end;
-        double v = strtod(q, &end);
+        double v = vw_strtod_decimal(q, &end, 0);
         if (end == q || !(v > 0) || !isfinite(v) || k >= n) return VW_E_INVAL;
         speeds[k++] = v;
         /* A comma must be followed by a number: "1,2," is a list cut short, not two

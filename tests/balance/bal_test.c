@@ -693,15 +693,18 @@ static int t_map(void)
                    "imbalance, %s: %g (want %g)", cases[i].what, lam, cases[i].want);
         }
     }
-    /* Speed lists: exactly n positive numbers between commas. A trailing comma ("1,2,"
-       for 2 workers) used to pass as the two speeds before it. */
+    /* Speed lists: exactly n positive numbers between commas, in decimal notation with
+       no white space or '+' before them. A trailing comma ("1,2," for 2 workers) used to
+       pass as the two speeds before it. */
     {
         double sp[3] = {0};
         EXPECT(vw_map_parse_speeds("1,2.5", sp, 2) == VW_OK && sp[0] == 1 && sp[1] == 2.5,
                "'1,2.5': %g %g", sp[0], sp[1]);
         static const char *const bad[] = {"1,2,", "1,2,,", ",1,2", "1,,2", "1,2,3", "1", "",
                                           "1,0", "1,-2", "1,nan", "1,inf", "1;2", "1,2x", "1, ",
-                                          "0x1,2", "1,0X2", "1, 0x2", "1,+0x2", "1,2e0x"};
+                                          "0x1,2", "1,0X2", "1, 0x2", "1,+0x2", "1,2e0x",
+                                          /* as the command line's numbers */
+                                          " 1,2", "1, 2", "+1,2", "1,+2", "1,\t2"};
         for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++)
             EXPECT(vw_map_parse_speeds(bad[i], sp, 2) == VW_E_INVAL, "'%s' accepted", bad[i]);
         EXPECT(vw_map_parse_speeds("1,2,", sp, 3) == VW_E_INVAL, "'1,2,' for 3 workers");

@@ -33,6 +33,9 @@ int main(void)
         {"add \x9b" "cube 0 0 0 1", "s:3: can only add a sphere, not '?cube'"},
         {"add sphere 0 \x1b 0 1", "s:3: bad number '?' (expected 'add sphere x y z r [MATERIAL]')"},
         {"add sphere 0 0 0 1 \x1b]0;owned\x07", "s:3: bad material index '?]0;owned?'"},
+        /* Numbers in decimal notation only, as in scene files (strtod took "0x10"). */
+        {"move 1 0x10 0 0", "s:3: bad number '0x10' (expected 'move ID dx dy dz')"},
+        {"add sphere 0 0 0 -0X1p0", "s:3: bad number '-0X1p0' (expected 'add sphere x y z r [MATERIAL]')"},
         /* A long word is cut: a message stays one readable line. */
         {"xxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxx",
          "s:3: unknown command 'xxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxx...'"},
@@ -50,5 +53,7 @@ int main(void)
     CHECK(vw_edit_parse("bogus 1", "s", 1, &e, err, sizeof err) == VW_E_INPUT);
     CHECK(!strcmp(err, "s:1: unknown command 'bogus'"));
     CHECK(vw_edit_parse("move 2 1 2 3", "s", 1, &e, err, sizeof err) == VW_OK);
+    CHECK(vw_edit_parse("move 2 +1 -.5 2e-1", "s", 1, &e, err, sizeof err) == VW_OK);
+    CHECK(e.v[0] == 1 && e.v[1] == -0.5 && e.v[2] == 0.2);
     TEST_DONE();
 }

@@ -93,7 +93,7 @@ clean "edit --log f00.png"
 rm -f f00.png f01.png f0.png
 }
 
-# 4. An empty --slow, and white space or '+' before a number.
+# 4. An empty --slow, and white space or '+' before a number, whole or real.
 # shellcheck disable=SC2086
 {
 refused 2 "^vwalls render: --slow: bad value ''" render s.nff -o o.png --workers 2 --slow '' $R
@@ -103,6 +103,20 @@ refused 2 "^vwalls render: --depth: bad value '+3'" render s.nff -o o.png --dept
 refused 2 "^vwalls render: --size: bad value '+8x8'" render s.nff -o o.png --size +8x8 --quiet
 refused 2 "^vwalls render: --size: bad value '8x 8'" render s.nff -o o.png --size '8x 8' --quiet
 refused 2 "^vwalls gen: --count: bad value ' 5'" gen spheres --count ' 5'
+# Real numbers too, as whole numbers (strtod takes both).
+refused 2 "^vwalls render: --angle: bad value ' 45'" render s.nff -o o.png --angle ' 45' --quiet
+refused 2 "^vwalls render: --angle: bad value '+45'" render s.nff -o o.png --angle +45 --quiet
+refused 2 "^vwalls render: --from: bad value '0, 0,5'" render s.nff -o o.png --from '0, 0,5' \
+  --quiet
+refused 2 "^vwalls render: --from: bad value '+1,0,5'" render s.nff -o o.png --from +1,0,5 \
+  --quiet
+refused 2 "^vwalls render: --slow: bad value '1:+2'" render s.nff -o o.png --workers 2 \
+  --slow 1:+2 $R
+refused 2 "^vwalls render: --speeds: bad value '1, 2'" render s.nff -o o.png --workers 2 \
+  --speeds '1, 2' $R
+refused 2 "^vwalls render: --speeds: bad value '+1,2'" render s.nff -o o.png --workers 2 \
+  --speeds +1,2 $R
+refused 2 "^vwalls gen: --cluster: bad value ' 0.5'" gen spheres --cluster ' 0.5'
 clean "white space"
 "$V" render s.nff -o o.png --workers 2 --slow 1:2 --depth 3 --size 8X8 --quiet ||
   fail "--slow 1:2 --depth 3 --size 8X8: status $?"

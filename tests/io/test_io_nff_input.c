@@ -3,7 +3,8 @@
  * anywhere, a comment or a "#vw" line included, is refused at the byte's physical line
  * with the OBJ reader's words (a NUL in a comment used to pass unseen, one in a number
  * to read as a "bad number"); tab, VT, FF and every byte from 0x80 up (UTF-8, Latin-1)
- * stay accepted. An error earlier in the file is still the one reported.
+ * stay accepted. An error earlier in the file is still the one reported. A UTF-8 byte
+ * order mark before the first line is skipped; numbers are decimal (no "0x10").
  * Usage: test_io_nff_input (no data: every input is made here)
  */
 #define _GNU_SOURCE
@@ -128,6 +129,16 @@ static void text_bytes(void)
     /* Such a byte in a token is no binary data: the token is what is wrong (and is
        shown printable). */
     REFUSED(VIEW "s 0 0 0 1\xc3\xa9\n", "t.nff:2: bad number '1?" "?' in 's'");
+    /* A UTF-8 byte order mark (Notepad's) is not part of the first keyword, as in OBJ
+       (it was "unknown keyword '???v'"); anywhere else it is no blank. */
+    ACCEPTED("\xef\xbb\xbf" VIEW FILL "s 0 0 0 1\n", 1, 0);
+    ACCEPTED("\xef\xbb\xbf# comment\n" VIEW FILL "s 0 0 0 1\n", 1, 0);
+    REFUSED("\xef\xbb\xbf" VIEW "\xef\xbb\xbfs 0 0 0 1\n", "t.nff:2: unknown keyword '???s'");
+    /* Decimal notation only: strtod read "0x10" as 16; "nan" and "inf" keep their own
+       message. */
+    REFUSED(VIEW "s 0x10 0 0 1\n", "t.nff:2: bad number '0x10' in 's'");
+    REFUSED(VIEW "s 0 0 0 -0X1p0\n", "t.nff:2: bad number '-0X1p0' in 's'");
+    ACCEPTED(VIEW FILL "s +1 0 0 +.5e+0\n", 1, 0);
 }
 
 int main(void)

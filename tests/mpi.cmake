@@ -86,6 +86,13 @@ vw_mpi_script_test(mpi_print_once 3 print_once.sh 120
 vw_mpi_script_test(mpi_rank_input 2 rank_input.sh 240
                    $<TARGET_FILE:vwalls_tool> ${PROJECT_SOURCE_DIR}/tests/data/good/mixed.nff)
 
+# vwalls radiosity --resume reads the checkpoint on rank 0 alone, which wrote it, and
+# hands it to the others: it resumes where only rank 0's host has the file, and another
+# host's stale copy changes nothing.
+foreach(np 2 3)
+  vw_mpi_script_test(mpi_resume_rank0_np${np} ${np} resume_rank0.sh 240 $<TARGET_FILE:vwalls_tool>)
+endforeach()
+
 # The default worker count: processes of one host that may run on the same CPUs share
 # its cores (two unbound processes: half each, as their affinity masks overlap).
 vw_mpi_script_test(mpi_core_share 2 core_share.sh 120

@@ -282,13 +282,10 @@ static int ck_incompatible(const ck_head *c, const ck_head *mine, char *why, siz
     return 1;
 }
 
-/* Reads the whole file at s->opt.resume into *buf and checks that it can continue this
-   run. */
-static vw_status read_checkpoint(rad_solver *s, unsigned char **buf, size_t *len, ck_head *h,
-                                 char *err, size_t errlen)
+/* Reads the whole file at path into *buf (*len bytes; *buf NULL on failure). */
+static vw_status load_checkpoint(const char *path, unsigned char **buf, size_t *len, char *err,
+                                 size_t errlen)
 {
-    const char *path = s->opt.resume;
-    const rad_mesh *m = s->mesh;
     *buf = NULL;
     *len = 0;
     FILE *f = fopen(path, "rb");
@@ -308,13 +305,26 @@ static vw_status read_checkpoint(rad_solver *s, unsigned char **buf, size_t *len
     }
     int rerr = ferror(f);
     fclose(f);
-    if (!b) return VW_E_NOMEM;
+    if (!b) {
+        snprintf(err, errlen, "%s: out of memory reading the checkpoint", path);
+        return VW_E_NOMEM;
+    }
     if (rerr) {
         snprintf(err, errlen, "%s: cannot read checkpoint: %s", path, strerror(errno));
         free(b);
         return VW_E_IO;
     }
     *buf = b, *len = n;
+    return VW_OK;
+}
+
+/* Checks that the n bytes at b, the checkpoint s->opt.resume, can continue this run, and
+   reads its header into *h. */
+static vw_status check_checkpoint(rad_solver *s, const unsigned char *b, size_t n, ck_head *h,
+                                  char *err, size_t errlen)
+{
+    const char *path = s->opt.resume;
+    const rad_mesh *m = s->mesh;
 #define CORRUPT(...)                                                                     \
     do {                                                                                 \
         char what_[256];                                                                 \
@@ -512,12 +522,39 @@ vw_status rad_solver_create(const rad_mesh *m, const vw_decomp *d, const rad_opt
         return st;
     }
     if (o->resume) {
-        /* Every process reads the file; one that cannot must not leave the others
-           waiting in the run below. */
+        /* The output process alone reads the file and hands its bytes to the others:
+           it is the process that wrote it, on its host alone when the hosts share no
+           file system, and a copy that differed on another host (an older checkpoint of
+           the same scene) made that process resume from another state, which only the
+           energy ledger at the end of the whole solve found. Every process then checks
+           the same bytes against the same mesh, alike; each step ends in agreement, so
+           one that fails (a file rank 0 cannot read, memory another lacks) leaves none
+           waiting in a collective call. vw_engine_broadcast is MPI_COMM_WORLD's, the
+           communicator of this world (its vw_config names none). */
         unsigned char *buf = NULL;
         size_t len = 0;
         ck_head h;
-        st = vw_world_agree(s->w, read_checkpoint(s, &buf, &len, &h, err, errlen), err, errlen);
+        int out = vw_world_is_output(s->w);
+        st = vw_world_agree(s->w, out ? load_checkpoint(o->resume, &buf, &len, err, errlen) : VW_OK,
+                            err, errlen);
+        if (st == VW_OK && vw_world_processes(s->w) > 1) {
+            uint64_t n64 = len;
+            vw_engine_broadcast(&n64, sizeof n64);
+            vw_status local = VW_OK;
+            if (!out) {
+                buf = n64 < SIZE_MAX ? malloc(n64 ? (size_t)n64 : 1) : NULL;
+                len = (size_t)n64;
+                if (!buf) {
+                    local = VW_E_NOMEM;
+                    snprintf(err, errlen, "%s: out of memory for the checkpoint (%llu bytes)",
+                             o->resume, (unsigned long long)n64);
+                }
+            }
+            st = vw_world_agree(s->w, local, err, errlen);
+            if (st == VW_OK) vw_engine_broadcast(buf, len);
+        }
+        if (st == VW_OK)
+            st = vw_world_agree(s->w, check_checkpoint(s, buf, len, &h, err, errlen), err, errlen);
         if (st == VW_OK) {
             post_checkpoint(s, buf);
             s->round = h.round;

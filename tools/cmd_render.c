@@ -733,11 +733,11 @@ int vw_cmd_render(int argc, char **argv)
             vw_decomp_layout_string(vw_world_decomp(w), layout, sizeof layout);
             printf("render %s -> %s: %dx%d, depth %d, %zu objects\n", scene_path, out, W, H,
                    sh->max_depth, nobjects);
-            printf("cells %s (%d), workers %d x %d process%s, farm %s (%d copies), imbalance "
+            printf("cells %s (%d), workers %d x %d process%s, farm %s (%d cop%s), imbalance "
                    "lambda %.3f\n", layout, vw_decomp_cell_count(vw_world_decomp(w)),
                    vw_world_workers(w), vw_world_processes(w),
                    vw_world_processes(w) == 1 ? "" : "es", rt_farm_name((rt_farm)farm), farm_copies,
-                   vw_world_imbalance(w));
+                   farm_copies == 1 ? "y" : "ies", vw_world_imbalance(w));
             if (balancing)
                 printf("balance %s, map %s: lambda before %.3f, predicted %.3f, after %.3f "
                        "(work lambda %.3f); %llu objects migrated, %.3f s\n",

@@ -450,4 +450,15 @@ file(GLOB left ${WORK}/*.tmp.*)
 if(left)
   message(FATAL_ERROR "the output checks left temporary files: ${left}")
 endif()
+# The summary counts the farm's copies in English: "(1 copy)", not "(1 copies)".
+foreach(case "1;1 copy" "2;2 copies")
+  list(GET case 0 n)
+  list(GET case 1 want)
+  execute_process(COMMAND ${VWALLS} render ${SCENE} -o ${WORK}/copies.png --size 16x12
+                          --cells ${n} --workers 2 --farm all
+                  RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+  if(NOT rc EQUAL 0 OR NOT out MATCHES "farm all \\(${want}\\)")
+    message(FATAL_ERROR "--cells ${n} --workers 2: exit ${rc}, no '(${want})' in: ${out}${err}")
+  endif()
+endforeach()
 message(STATUS "raytrace_cli: all images identical")

@@ -17,6 +17,9 @@ add_test(NAME raytrace_view COMMAND vw_test_raytrace view)
 # shadow ray starts clear of its own surface by more than the doubles' rounding there
 # (eps, rt_float_frame_norm1).
 add_test(NAME raytrace_analytic_far COMMAND vw_test_raytrace analytic 1e10)
+# A small ball on a wide floor casts its shadow: a secondary ray's least t is set by the
+# float error, not by the scene's size (1e-4 of the diagonal skipped the ball).
+add_test(NAME raytrace_contact COMMAND vw_test_raytrace contact)
 # Rays aimed at the edges and vertices a mesh's triangles share do not slip through.
 add_test(NAME raytrace_watertight COMMAND vw_test_raytrace watertight)
 # MTL illum: Ks weights the mirror ray from illum 3 on (and without an illum), not for

@@ -301,11 +301,29 @@ static vw_status job_prepare(rt_job *j, const vw_scene *s, const rt_params *p, i
         return VW_E_INVAL;
     }
     sh->overlap = 1e-6 * 3 * m;
-    /* Secondary rays start this far from their surface: 1e-4 of the scene's size, far
-       below any feature a scene file means, and at least ten times Embree's float error
-       (1e-7 of the coordinates' magnitude, not of the scene's size: a scene far from the
-       origin, 1e4 times its size, otherwise shades its own shadow rays as occluded). */
-    sh->eps = fmax(1e-4 * diag, 1e-6 * m);
+    /* The least t of a search, what keeps a secondary ray off its own surface: ten times
+       Embree's float error (1e-7 of the coordinates measured in its frame, mrel) and at
+       least 16 half-units in the last place of the doubles' coordinates (mabs), which a
+       scene a billion units from the origin needs. Not relative to the scene's size:
+       1e-4 of the diagonal, as it was, skipped every surface closer than that to a ray's
+       origin, so a sphere 0.1 across on a floor 2000 wide cast no shadow and showed no
+       floor in its mirror, and the smallest spheres of `gen balls --size 5` (radius
+       0.002 under a floor 34 across: eps 0.0034) none of their neighbours. A ray leaving
+       its surface at a grazing angle starts farther off (shade(), ray_eps). */
+    double mrel = 0, mabs = 0;
+    for (int i = 0; i < 9; i++) {
+        double q[3];
+        for (int a = 0; a < 3; a++)
+            q[a] = i == 8 ? cam.from[a] : ((i >> a) & 1) ? world.hi[a] : world.lo[a];
+        double r = 0, s1 = 0;
+        for (int a = 0; a < 3; a++) {
+            r += fabs(q[a] - sh->ff.origin[a]);
+            s1 += fabs(q[a]);
+        }
+        mrel = fmax(mrel, r);
+        mabs = fmax(mabs, s1);
+    }
+    sh->eps = fmax(1e-6 * mrel, 0x1p-49 * mabs);
     sh->bpad = fmax(1e-6 * diag, 2 * sh->overlap);
     int dims[3];
     for (int a = 0; a < 3; a++) dims[a] = p->dims[a] > 0 ? p->dims[a] : 1;

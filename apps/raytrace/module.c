@@ -27,7 +27,10 @@ typedef struct rt_ray {
     double tmax;           /* end of the ray (INFINITY, or the light's distance); from
                               spawn() on, clipped to the world box (vw_decomp_clip) */
     double weight[3];      /* shadow ray: the contribution added if unoccluded */
-    int32_t pixel, depth, kind, pad;
+    int32_t pixel, depth, kind;
+    float eps_k;           /* its searches start at t = eps_k x sh->eps (ray_eps; 0 for
+                              eye rays): a factor, as a float has no room for the eps of
+                              a scene 1e-50 across */
 } rt_ray;
 
 /* Contributions travel in packages of up to RT_PKG_N entries. The runtime already
@@ -228,6 +231,18 @@ static void normals(const rt_hit *h, const double p[3], double ng[3], double ns[
     }
 }
 
+/* The least t of a ray leaving a surface at direction d, as a factor of sh->eps
+   (Embree's and the doubles' error in the hit point across the surface): 1 over the
+   cosine of d to the surface's normal ng (a ray that leaves at a grazing angle needs
+   that much farther to get as far off the surface), up to 64. A surface nearer than
+   that to a ray's origin is not seen by it; features of any size above the float error
+   cast their shadows and show in mirrors. */
+static float ray_eps(const double d[3], const double ng[3])
+{
+    double c = fabs(dot3(d, ng));
+    return (float)(1.0 / (c > 1.0 / 64 ? c : 1.0 / 64));
+}
+
 /* Whitted shading at a hit: shadow rays to the lights that face the surface, a mirror
    ray weighted by the material's reflect (NFF: Ks; MTL: Ks by illum) and a transmitted
    ray weighted by T. Reads only the ray, the hit
@@ -270,6 +285,8 @@ static void shade(vw_ctx *ctx, rt_cell *c, const rt_ray *r, const rt_hit *h)
         double ndl = dot3(ns, s.dir);
         /* No shadow ray toward a light behind the surface. */
         if (ndl <= 0 || dot3(ng, s.dir) <= 0) continue;
+        s.eps_k = ray_eps(s.dir, ng);
+        if (!(dist > s.eps_k * sh->eps)) continue; /* a light on the surface */
         double spec = 0;
         if (has_spec) {
             double rl = dot3(refl, s.dir);
@@ -286,7 +303,6 @@ static void shade(vw_ctx *ctx, rt_cell *c, const rt_ray *r, const rt_hit *h)
         s.pixel = r->pixel;
         s.depth = r->depth;
         s.kind = RT_SHADOW;
-        s.pad = 0;
         spawn(ctx, c, &s);
     }
     if (r->depth >= sh->max_depth) return;
@@ -300,7 +316,7 @@ static void shade(vw_ctx *ctx, rt_cell *c, const rt_ray *r, const rt_hit *h)
         s.pixel = r->pixel;
         s.depth = r->depth + 1;
         s.kind = RT_REFLECT;
-        s.pad = 0;
+        s.eps_k = ray_eps(refl, ng);
         spawn(ctx, c, &s);
     }
     if (m->transmit > 0) {
@@ -323,7 +339,7 @@ static void shade(vw_ctx *ctx, rt_cell *c, const rt_ray *r, const rt_hit *h)
         s.pixel = r->pixel;
         s.depth = r->depth + 1;
         s.kind = RT_REFRACT;
-        s.pad = 0;
+        s.eps_k = ray_eps(s.dir, ng);
         spawn(ctx, c, &s);
     }
 }
@@ -358,7 +374,8 @@ static int walk_ray(vw_ctx *ctx, rt_cell *c, rt_ray *r, vw_walk *w)
         c->tally[RT_C_SEGMENTS]++;
         /* max(eps, t0), as fmax gives it (eps for a NaN t0), without fmax's libm call:
            gcc keeps the call, whose NaN rules maxsd does not follow. */
-        double tn = r->t0 > c->sh->eps ? r->t0 : c->sh->eps;
+        double eps = r->eps_k * c->sh->eps;
+        double tn = r->t0 > eps ? r->t0 : eps;
         /* Past the far wall by the overlap (not past the ray's end): a hit on the wall
            is found here even when Embree's floats put it just beyond. */
         double tf = r->t1 + c->sh->overlap;
@@ -602,7 +619,7 @@ static int step(vw_ctx *ctx, void *state)
                 r.pixel = px;
                 r.depth = 1;
                 r.kind = RT_EYE;
-                r.pad = 0;
+                r.eps_k = 0.0f; /* it leaves no surface: what lies before the eye shows */
                 spawn(ctx, c, &r);
             }
             made += end - begin;

@@ -119,7 +119,8 @@ typedef struct rt_shared {
     int nlights;
     double background[3];
     int max_depth;   /* an eye ray has depth 1; rays of depth max_depth spawn no others */
-    double eps;      /* minimum t of a secondary ray: avoids self-intersection */
+    double eps;      /* float error across a surface: a secondary ray's searches start
+                        at eps / cos of its angle to the surface, up to 64 eps (job.c) */
     double bpad;     /* objects' bounds are widened by this before placement */
     double overlap;  /* a cell searches this far past its far wall (<= bpad / 2) */
     void *device;    /* RTCDevice, one per process, shared by every cell */

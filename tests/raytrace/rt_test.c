@@ -362,6 +362,61 @@ static int test_analytic(double off)
     return vw_test_failures ? 1 : 0;
 }
 
+/* A ball 0.2 across resting on a floor 2000 wide, the light straight above: the floor
+   just beside the point of contact lies in the ball's shadow, and the floor farther out
+   is lit by the formula; and the floor seen from 0.01 above. The least t of a shadow
+   ray was 1e-4 of the scene's diagonal (0.28 here), so the ray from the floor passed the
+   ball unseen and the ball cast no shadow at all (job.c, the eps). */
+static int test_contact(void)
+{
+    static const double at[2] = {0.05, 0.3}; /* in the shadow (radius 0.1), lit */
+    for (int k = 0; k < 2; k++) {
+        char nff[512];
+        int len = snprintf(nff, sizeof nff,
+                           "v\nfrom 1 0.2 0.3\nat %g 0 0\nup 0 0 1\nangle 20\nresolution 9 9\n"
+                           "b 0.1 0.2 0.3\nl 0 0 10\nf 1 1 1 0.8 0 0 0 1\n"
+                           "p 4 -1000 -1000 0 1000 -1000 0 1000 1000 0 -1000 1000 0\n"
+                           "f 1 0 0 0.8 0 0 0 1\ns 0 0 0.1 0.1\n", at[k]);
+        char err[256];
+        vw_scene *s;
+        if (vw_scene_read_nff("contact.nff", nff, (size_t)len, &s, err, sizeof err) != VW_OK) {
+            fprintf(stderr, "%s\n", err);
+            return 1;
+        }
+        int dims[3] = {2, 2, 1};
+        int64_t c[RT_NCOUNTERS];
+        int64_t *sums = render(s, 9, 9, dims, 2, c, NULL);
+        /* The centre pixel's ray goes through `at`, on the floor (z = 0). */
+        double ndl = 10 / sqrt(at[k] * at[k] + 100), want = k ? 0.8 * ndl : 0;
+        for (int a = 0; a < 3; a++) {
+            double got = (double)sums[(4 * 9 + 4) * 3 + a] / RT_FIX_ONE;
+            EXPECT(fabs(got - want) < 1e-6, "floor at (%g, 0, 0), channel %d: %.9g, expected "
+                   "%.9g (%s)", at[k], a, got, want, k ? "lit" : "in the ball's shadow");
+        }
+        free(sums);
+        vw_scene_free(s);
+    }
+    /* The eye 0.01 above that floor, looking down: an eye ray leaves no surface and
+       starts at the eye (it started at the eps, and the floor was not there). */
+    const char *low = "v\nfrom 5 0 0.01\nat 5 0 0\nup 0 1 0\nangle 20\nresolution 9 9\n"
+                      "b 0.1 0.2 0.3\nl 5 0 10\nf 1 1 1 0.8 0 0 0 1\n"
+                      "p 4 -1000 -1000 0 1000 -1000 0 1000 1000 0 -1000 1000 0\n";
+    char err[256];
+    vw_scene *s;
+    if (vw_scene_read_nff("low.nff", low, strlen(low), &s, err, sizeof err) != VW_OK) {
+        fprintf(stderr, "%s\n", err);
+        return 1;
+    }
+    int dims[3] = {1, 1, 1};
+    int64_t c[RT_NCOUNTERS];
+    int64_t *sums = render(s, 9, 9, dims, 1, c, NULL);
+    double got = (double)sums[(4 * 9 + 4) * 3] / RT_FIX_ONE;
+    EXPECT(fabs(got - 0.8) < 1e-6, "floor 0.01 below the eye: %.9g, expected 0.8", got);
+    free(sums);
+    vw_scene_free(s);
+    return vw_test_failures ? 1 : 0;
+}
+
 /* The field of view is the angle the file gives, for every angle the NFF reader
    accepts: angles from 179 on were once replaced by 45 degrees without a word. */
 static int test_view(void)
@@ -794,6 +849,7 @@ int main(int argc, char **argv)
     if (argc >= 3 && !strcmp(argv[1], "nff")) return write_nff(argv[2]);
     if (argc >= 3 && !strcmp(argv[1], "identical")) return test_identical(argv[2], argc > 3 ? argv[3] : NULL);
     if (argc >= 2 && !strcmp(argv[1], "analytic")) return test_analytic(argc > 2 ? atof(argv[2]) : 0);
+    if (argc >= 2 && !strcmp(argv[1], "contact")) return test_contact();
     if (argc >= 2 && !strcmp(argv[1], "cone")) return test_cone();
     if (argc >= 2 && !strcmp(argv[1], "scale")) return test_scale();
     if (argc >= 2 && !strcmp(argv[1], "view")) return test_view();

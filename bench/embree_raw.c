@@ -35,11 +35,22 @@ static void unit3(double v[3])
         for (int a = 0; a < 3; a++) v[a] /= l;
 }
 
-static void trace(bench *b, const double org[3], const double dir[3], int depth, double wsum)
+/* Where a ray leaving a surface of geometric normal n in direction d starts its search,
+   as the ray tracer's ray_eps makes it (apps/raytrace/module.c): eps over the cosine, at
+   most 64 eps, the factor rounded to a float as the ray carries it. */
+static double start(const bench *b, const double d[3], const double n[3])
+{
+    double c = fabs(dot3(d, n));
+    return (double)(float)(1.0 / (c > 1.0 / 64 ? c : 1.0 / 64)) * b->eps;
+}
+
+/* One ray from org, its search from t = tn (0 for an eye ray: it leaves no surface). */
+static void trace(bench *b, const double org[3], const double dir[3], double tn, int depth,
+                  double wsum)
 {
     rt_hit h;
     b->rays++;
-    if (!rt_cell_geo_intersect(&b->geo, org, dir, b->eps, INFINITY, &h)) return;
+    if (!rt_cell_geo_intersect(&b->geo, org, dir, tn, INFINITY, &h)) return;
     const rt_object *o = h.obj;
     const vw_material *m = &o->mat;
     double p[3], n[3];
@@ -70,15 +81,15 @@ static void trace(bench *b, const double org[3], const double dir[3], int depth,
         for (int a = 0; a < 3; a++) l[a] = b->lights[i].pos[a] - p[a];
         dist = sqrt(dot3(l, l));
         for (int a = 0; a < 3; a++) l[a] /= dist;
-        double ndl = dot3(n, l);
-        if (ndl <= 0) continue;
+        double ndl = dot3(n, l), ts = start(b, l, n);
+        if (ndl <= 0 || !(dist > ts)) continue;
         b->rays++;
-        if (!rt_cell_geo_occluded(&b->geo, p, l, b->eps, dist)) b->sink += wsum * ndl * m->diffuse[0];
+        if (!rt_cell_geo_occluded(&b->geo, p, l, ts, dist)) b->sink += wsum * ndl * m->diffuse[0];
     }
     if (depth >= b->max_depth) return;
     /* A mirror ray where the ray tracer makes one (shade, apps/raytrace/module.c). */
     if (m->reflect[0] > 0 || m->reflect[1] > 0 || m->reflect[2] > 0)
-        trace(b, p, refl, depth + 1, wsum * m->reflect[0]);
+        trace(b, p, refl, start(b, refl, n), depth + 1, wsum * m->reflect[0]);
     if (m->transmit > 0) {
         double ior = m->ior > 0 ? m->ior : 1.0, eta = entering ? 1.0 / ior : ior;
         double c1 = -dot3(dir, n), k2 = 1 - eta * eta * (1 - c1 * c1), t[3];
@@ -88,7 +99,7 @@ static void trace(bench *b, const double org[3], const double dir[3], int depth,
             for (int a = 0; a < 3; a++) t[a] = eta * dir[a] + (eta * c1 - sqrt(k2)) * n[a];
             unit3(t);
         }
-        trace(b, p, t, depth + 1, wsum * m->transmit);
+        trace(b, p, t, start(b, t, n), depth + 1, wsum * m->transmit);
     }
 }
 
@@ -141,7 +152,7 @@ int main(int argc, char **argv)
         for (int x = 0; x < W; x++) {
             double dir[3];
             rt_view_ray(&sh->view, x, y, dir);
-            trace(&b, sh->view.eye, dir, 1, 1.0);
+            trace(&b, sh->view.eye, dir, 0, 1, 1.0);
         }
     double t2 = now();
     printf("embree_raw: %dx%d depth %d: build %.6f s, trace %.6f s, rays %lld, %.3f Mrays/s "

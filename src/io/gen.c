@@ -205,32 +205,62 @@ static vw_status ground(vw__sb *b, int m, double half, double z)
 
 /* ---- balls: the sphereflake ----------------------------------------------------- */
 
-/* Each sphere of radius r carries nine children of radius r/3 touching it: six
-   around its equator (relative to the direction it grew in) and three higher up,
-   turned 30 degrees against the six. Level n thus has 9^n spheres. A child's whole
-   sub-flake stays within 2r/3 of its centre (r/3 + 2r/9 + ... < 2r/3), and child
-   centres lie 4r/3 from the parent's, so sub-flakes cannot meet when every two
-   children are at least 60 degrees apart. Elevation acos(1/sqrt 3) = 54.7 degrees is
-   the one angle that gives exactly 60 degrees both between the upper three and to
-   their nearest equatorial neighbours. */
-static vw_status flake(vw__sb *b, int m, const double c[3], double r, const double dir[3],
-                       int levels)
+/* Each sphere of radius r carries nine children of radius r/3 touching it (centres
+   4r/3 from the parent's), as in SPD's balls.c (Haines): six around its equator,
+   relative to the direction it grew in, 60 degrees apart, and three higher up, at
+   elevation asin(sqrt(2/3)) = 54.7 degrees, each midway in azimuth between two of the
+   six. SPD makes the nine directions once: the unit vectors (1,1,0), (1,0,-1) and
+   (0,1,-1) over sqrt 2, turned by asin(2/sqrt 6) about (1,-1,0), and that trio turned by
+   0, 120 and 240 degrees about z; a child's set is turned by the rotation taking +z to
+   its direction about z x direction. The same is done here, with the rotations' sines
+   and cosines from square roots (no libm angle of a computed argument), so the spheres
+   are SPD's, sphere for sphere. Level n has 9^n spheres. A child's whole sub-flake
+   stays within 2r/3 of its centre (r/3 + 2r/9 + ... < 2r/3), and every two children are
+   at least 60 degrees apart, so sub-flakes cannot meet. */
+/* v turned about the unit axis a by the angle of cosine c and sine s (Rodrigues). */
+static void turn(const double a[3], double c, double s, const double v[3], double out[3])
+{
+    double ax[3], d = a[0] * v[0] + a[1] * v[1] + a[2] * v[2];
+    cross(a, v, ax);
+    for (int k = 0; k < 3; k++) out[k] = v[k] * c + ax[k] * s + a[k] * d * (1 - c);
+}
+
+static void flake_make_dirs(double dirs[9][3])
+{
+    const double h = 1 / sqrt(2.0), q = 1 / sqrt(3.0);
+    const double trio[3][3] = {{h, h, 0}, {h, 0, -h}, {0, h, -h}};
+    const double axis[3] = {h, -h, 0}, z[3] = {0, 0, 1};
+    /* 120 and 240 degrees about z: cosine -1/2, sines +-sqrt(3)/2. */
+    const double c3[3] = {1, -0.5, -0.5}, s3[3] = {0, sqrt(3.0) / 2, -sqrt(3.0) / 2};
+    for (int i = 0; i < 3; i++) {
+        double t[3];
+        turn(axis, q, 2 / sqrt(6.0), trio[i], t); /* cos asin(2/sqrt 6) = 1/sqrt 3 */
+        for (int k = 0; k < 3; k++) turn(z, c3[k], s3[k], t, dirs[3 * k + i]);
+    }
+}
+
+static vw_status flake(vw__sb *b, int m, const double (*dirs)[3], const double c[3],
+                       double r, const double dir[3], int levels)
 {
     TRY(vw__sb_add_sphere(b, m, c, r));
     if (levels == 0)
         return VW_OK;
-    double u[3], v[3];
-    frame(dir, u, v);
+    /* The rotation taking +z to dir: about z x dir, by the angle of cosine dir[2]. */
+    double axis[3] = {-dir[1], dir[0], 0}, sn = sqrt(dir[0] * dir[0] + dir[1] * dir[1]);
+    double cs = dir[2];
+    if (sn > 0) {
+        axis[0] /= sn;
+        axis[1] /= sn;
+    } else { /* along z: none, or half a turn about y (SPD's choice) */
+        axis[1] = 1;
+        cs = cs < 0 ? -1 : 1;
+    }
     for (int i = 0; i < 9; i++) {
-        double az = i < 6 ? i * (M_PI / 3) : M_PI / 6 + (i - 6) * (2 * M_PI / 3);
-        double el = i < 6 ? 0.0 : acos(1 / sqrt(3.0));
         double d[3], cc[3];
-        for (int k = 0; k < 3; k++)
-            d[k] = cos(el) * (cos(az) * u[k] + sin(az) * v[k]) + sin(el) * dir[k];
-        normalize(d);
+        turn(axis, cs, sn, dirs[i], d);
         for (int k = 0; k < 3; k++)
             cc[k] = c[k] + d[k] * (r + r / 3);
-        TRY(flake(b, m, cc, r / 3, d, levels - 1));
+        TRY(flake(b, m, dirs, cc, r / 3, d, levels - 1));
     }
     return VW_OK;
 }
@@ -255,7 +285,9 @@ static vw_status gen_balls(vw__sb *b, const vw_gen_params *p)
     TRY(vw__sb_intern_material(b, &ball, &mball));
     TRY(ground(b, mground, 12, -0.5));
     const double c[3] = {0, 0, 0}, up[3] = {0, 0, 1};
-    return flake(b, mball, c, 0.5, up, n);
+    double dirs[9][3];
+    flake_make_dirs(dirs);
+    return flake(b, mball, (const double(*)[3])dirs, c, 0.5, up, n);
 }
 
 /* ---- rings: a pyramid of chain-mail rings ---------------------------------------- */

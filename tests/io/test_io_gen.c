@@ -125,6 +125,35 @@ int main(void)
         vw_scene_free(s);
     }
 
+    /* The sphereflake is SPD's balls (Haines), sphere for sphere: its first lines, as
+       balls.c prints them with 6 digits. The children were turned about their parent's
+       axis from SPD's (the same counts and sizes, other spheres). */
+    {
+        static const double spd[][4] = {
+            {0, 0, 0, 0.5},
+            {0.272166, 0.272166, 0.544331, 0.166667},
+            {0.420314, 0.420314, 0.618405, 0.0555556},
+            {0.461844, 0.304709, 0.43322, 0.0555556},
+            {0.304709, 0.461844, 0.43322, 0.0555556},
+            {0.230635, 0.38777, 0.729516, 0.0555556},
+            {0.115031, 0.4293, 0.544331, 0.0555556},
+            {0.082487, 0.239622, 0.655442, 0.0555556},
+            {0.38777, 0.230635, 0.729516, 0.0555556},
+            {0.239622, 0.082487, 0.655442, 0.0555556},
+            {0.4293, 0.115031, 0.544331, 0.0555556},
+            {0.643951, 0.172546, 0, 0.166667}};
+        vw_scene *s = gen("balls", 2, 0, 1, 0);
+        for (size_t i = 0; i < sizeof spd / sizeof spd[0]; i++) {
+            const vw_sphere *b = &s->spheres[i];
+            double d = fabs(b->radius - spd[i][3]);
+            for (int a = 0; a < 3; a++) d = fmax(d, fabs(b->center[a] - spd[i][a]));
+            EXPECT(d < 1e-6, "sphere %zu: %g %g %g %g, SPD has %g %g %g %g", i, b->center[0],
+                   b->center[1], b->center[2], b->radius, spd[i][0], spd[i][1], spd[i][2],
+                   spd[i][3]);
+        }
+        vw_scene_free(s);
+    }
+
     /* Every generator: deterministic, round-trips through NFF exactly, sane. */
     for (size_t g = 0; vw_gen_name(g); g++) {
         const char *name = vw_gen_name(g);

@@ -205,18 +205,6 @@ static vw_status ground(vw__sb *b, int m, double half, double z)
 
 /* ---- balls: the sphereflake ----------------------------------------------------- */
 
-/* Each sphere of radius r carries nine children of radius r/3 touching it (centres
-   4r/3 from the parent's), as in SPD's balls.c (Haines): six around its equator,
-   relative to the direction it grew in, 60 degrees apart, and three higher up, at
-   elevation asin(sqrt(2/3)) = 54.7 degrees, each midway in azimuth between two of the
-   six. SPD makes the nine directions once: the unit vectors (1,1,0), (1,0,-1) and
-   (0,1,-1) over sqrt 2, turned by asin(2/sqrt 6) about (1,-1,0), and that trio turned by
-   0, 120 and 240 degrees about z; a child's set is turned by the rotation taking +z to
-   its direction about z x direction. The same is done here, with the rotations' sines
-   and cosines from square roots (no libm angle of a computed argument), so the spheres
-   are SPD's, sphere for sphere. Level n has 9^n spheres. A child's whole sub-flake
-   stays within 2r/3 of its centre (r/3 + 2r/9 + ... < 2r/3), and every two children are
-   at least 60 degrees apart, so sub-flakes cannot meet. */
 /* v turned about the unit axis a by the angle of cosine c and sine s (Rodrigues). */
 static void turn(const double a[3], double c, double s, const double v[3], double out[3])
 {
@@ -225,6 +213,7 @@ static void turn(const double a[3], double c, double s, const double v[3], doubl
     for (int k = 0; k < 3; k++) out[k] = v[k] * c + ax[k] * s + a[k] * d * (1 - c);
 }
 
+/* SPD's nine child directions about +z (see flake). */
 static void flake_make_dirs(double dirs[9][3])
 {
     const double h = 1 / sqrt(2.0), q = 1 / sqrt(3.0);
@@ -239,6 +228,18 @@ static void flake_make_dirs(double dirs[9][3])
     }
 }
 
+/* Each sphere of radius r carries nine children of radius r/3 touching it (centres
+   4r/3 from the parent's), as in SPD's balls.c (Haines): six around its equator,
+   relative to the direction it grew in, 60 degrees apart, and three higher up, at
+   elevation asin(sqrt(2/3)) = 54.7 degrees, each midway in azimuth between two of the
+   six. SPD makes the nine directions once: the unit vectors (1,1,0), (1,0,-1) and
+   (0,1,-1) over sqrt 2, turned by asin(2/sqrt 6) about (1,-1,0), and that trio turned by
+   0, 120 and 240 degrees about z; a child's set is turned by the rotation taking +z to
+   its direction about z x direction. The same is done here, with the rotations' sines
+   and cosines from square roots (no libm angle of a computed argument), so the spheres
+   are SPD's, sphere for sphere. Level n has 9^n spheres. A child's whole sub-flake
+   stays within 2r/3 of its centre (r/3 + 2r/9 + ... < 2r/3), and every two children are
+   at least 60 degrees apart, so sub-flakes cannot meet. dirs: flake_make_dirs. */
 static vw_status flake(vw__sb *b, int m, const double (*dirs)[3], const double c[3],
                        double r, const double dir[3], int levels)
 {

@@ -63,7 +63,10 @@ if(VW_HAVE_MPI)
 endif()
 
 # The tutorial's code (docs/tutorial/): built against the shared library, as a user's
-# program would be, and run alone, with stress, and under mpirun.
+# program would be, and run alone, with stress, and under mpirun. Every run checks the
+# counts against a sequential reference and that each cell reported exactly once (its
+# neighbours' counts may all arrive before its own step: the module must not report
+# twice).
 add_executable(tutorial_hello_cells ${PROJECT_SOURCE_DIR}/docs/tutorial/hello_cells.c
                                     ${PROJECT_SOURCE_DIR}/docs/tutorial/hello_module.c)
 target_link_libraries(tutorial_hello_cells PRIVATE vwalls::vwalls)
@@ -78,6 +81,19 @@ endforeach()
 add_test(NAME tutorial_hello_stress COMMAND tutorial_hello_cells --points 20000 --cells 4x4x4 --workers 4)
 set_tests_properties(tutorial_hello_stress PROPERTIES LABELS "examples;threads"
                      ENVIRONMENT "VW_STRESS=3;VW_STRESS_SPLIT=1" PASS_REGULAR_EXPRESSION "\nok\n")
+# Its command line: a mistyped or incomplete option is a usage error (exit 2), not a run
+# with the defaults; a world vw_world_create refuses is reported with its reason
+# (vw_world_errmsg(NULL)), not with the bare status message.
+foreach(bad "--cell;4x4x4" "--workers" "--points;12x" "--workers;-3")
+  string(REGEX REPLACE "[^A-Za-z0-9]+" "_" tname "${bad}")
+  add_test(NAME tutorial_hello_bad${tname}
+           COMMAND sh -c "\"$0\" \"$@\"; test $? -eq 2" $<TARGET_FILE:tutorial_hello_cells> ${bad})
+  set_tests_properties(tutorial_hello_bad${tname} PROPERTIES LABELS "examples")
+endforeach()
+add_test(NAME tutorial_hello_create_errmsg
+         COMMAND sh -c "out=$(\"$0\" --workers 5000 2>&1); rc=$?; echo \"$out\"; test $rc -eq 1 && echo \"$out\" | grep -q '5000 workers (at most 1024)'"
+                 $<TARGET_FILE:tutorial_hello_cells>)
+set_tests_properties(tutorial_hello_create_errmsg PROPERTIES LABELS "examples")
 if(VW_HAVE_MPI)
   add_test(NAME tutorial_hello_mpi_np2
            COMMAND ${MPIEXEC_EXECUTABLE} ${MPIEXEC_NUMPROC_FLAG} 2 ${MPIEXEC_PREFLAGS}

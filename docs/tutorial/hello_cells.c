@@ -3,6 +3,7 @@
  * count, and prints counters and stats.
  *   usage: hello_cells [--points N] [--cells LAYOUT] [--workers W] [--stats FILE.json]
  */
+#include <limits.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -55,11 +56,21 @@ int main(int argc, char **argv)
     long npoints = 100000;
     int workers = 0;
     const char *layout = "2x2x2", *stats = NULL;
-    for (int i = 1; i + 1 < argc; i += 2) {
-        if (!strcmp(argv[i], "--points")) npoints = atol(argv[i + 1]);
-        else if (!strcmp(argv[i], "--cells")) layout = argv[i + 1];
-        else if (!strcmp(argv[i], "--workers")) workers = atoi(argv[i + 1]);
-        else if (!strcmp(argv[i], "--stats")) stats = argv[i + 1];
+    for (int i = 1; i < argc; i += 2) {
+        const char *opt = argv[i], *val = i + 1 < argc ? argv[i + 1] : "";
+        char *end;
+        long v = strtol(val, &end, 10);
+        int number = *val && !*end && v >= 0 && v <= INT_MAX;
+        if (!strcmp(opt, "--points") && number) npoints = v;
+        else if (!strcmp(opt, "--workers") && number) workers = (int)v;
+        else if (!strcmp(opt, "--cells") && *val) layout = val;
+        else if (!strcmp(opt, "--stats") && *val) stats = val;
+        else {   /* a typo must not run the defaults silently */
+            fprintf(stderr, "hello_cells: bad option '%s %s'\nusage: hello_cells [--points N] "
+                    "[--cells LAYOUT] [--workers W] [--stats FILE.json]\n", opt, val);
+            vw_engine_finish();
+            return 2;
+        }
     }
 
     /* 2. The decomposition: the unit cube cut by walls into a grid of cells. */
@@ -78,7 +89,7 @@ int main(int argc, char **argv)
     size_t n = npoints > 0 ? (size_t)npoints : 0;
     ex_point *pts = malloc(sizeof *pts * (n ? n : 1));
     ex_hello_result result = {ncells, calloc((size_t)ncells, sizeof(int64_t)),
-                              calloc((size_t)ncells, sizeof(int64_t))};
+                              calloc((size_t)ncells, sizeof(int64_t)), 0};
     if (!pts || !result.own || !result.neighbours) return 1;
     uint64_t seed = 42;
     for (size_t i = 0; i < n; i++)
@@ -95,7 +106,8 @@ int main(int argc, char **argv)
     if (st == VW_OK) st = vw_world_run(w);
     int rc = 0;
     if (st != VW_OK) {
-        fprintf(stderr, "hello_cells: %s\n", w ? vw_world_errmsg(w) : vw_status_message(st));
+        /* With w NULL, vw_world_errmsg says why vw_world_create made no world. */
+        fprintf(stderr, "hello_cells: %s\n", vw_world_errmsg(w));
         rc = 1;
     }
 
@@ -113,6 +125,11 @@ int main(int argc, char **argv)
             printf("cell %d (worker %d): %lld points, %lld around, %llu messages in\n", c,
                    cs.worker, (long long)result.own[c], (long long)result.neighbours[c],
                    (unsigned long long)cs.messages_in);
+        }
+        if (result.summaries != ncells) {
+            fprintf(stderr, "%lld summaries for %d cells: each cell must report once\n",
+                    (long long)result.summaries, ncells);
+            rc = 1;
         }
         if (vw_world_counter(w, EX_HELLO_CNT_POINTS) != (int64_t)n || check(d, pts, n, &result))
             rc = 1;

@@ -24,7 +24,7 @@ typedef struct ex_cell {
     int64_t own;              /* points whose owner is this cell */
     int64_t neighbours;       /* sum of the counts heard so far */
     int expected, heard;      /* face neighbours, and how many have told us */
-    int started;
+    int started, reported;
 } ex_cell;
 /* [state] */
 
@@ -63,10 +63,14 @@ static void cell_free(void *state, void *user)
 /* [build] */
 
 /* [step] Local work that needs no message. Return 1 when it did something: the runtime
-   calls it again until it returns 0, and again after the cell receives messages. */
+   calls it again until it returns 0, and again after the cell receives messages.
+   Both step and on_count may find the cell complete: when all neighbours' counts
+   arrive before the cell's own step runs, on_count reports, then step would again.
+   The `reported` flag makes the summary go out once. */
 static void report_if_complete(vw_ctx *ctx, ex_cell *c)
 {
-    if (c->heard < c->expected) return;
+    if (c->reported || c->heard < c->expected) return;
+    c->reported = 1;
     ex_summary_msg s = {vw_ctx_cell(ctx), c->own, c->neighbours};
     vw_send_output(ctx, MSG_SUMMARY, &s);
 }
@@ -104,6 +108,7 @@ static void on_summary(void *user, const void *msg)
     const ex_summary_msg *s = msg;
     r->own[s->cell] = s->own;
     r->neighbours[s->cell] = s->neighbours;
+    r->summaries++;
 }
 /* [handlers] */
 

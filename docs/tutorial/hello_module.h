@@ -19,6 +19,7 @@ typedef struct ex_hello_result {
     int ncells;
     int64_t *own;         /* points owned by the cell */
     int64_t *neighbours;  /* points owned by its face neighbours, summed */
+    int64_t summaries;    /* summaries received: one per cell, when all goes well */
 } ex_hello_result;
 
 /* The module's counters, summed over cells and processes after a run. */

@@ -38,7 +38,7 @@ int main(int argc, char **argv)
     enum { N = 20000 };
     ex_point *pts = malloc(sizeof *pts * N);
     ex_hello_result result = {ncells, calloc((size_t)ncells, sizeof(int64_t)),
-                              calloc((size_t)ncells, sizeof(int64_t))};
+                              calloc((size_t)ncells, sizeof(int64_t)), 0};
     char msg[256] = "";
     vw_status st = pts && result.own && result.neighbours ? VW_OK : VW_E_NOMEM;
     st = vw_config_agree(&cfg, st, msg, sizeof msg);
@@ -63,6 +63,7 @@ int main(int argc, char **argv)
         int64_t total = 0;
         for (int c = 0; c < ncells; c++) total += result.own[c];
         rc |= total != N || vw_world_counter(w, EX_HELLO_CNT_POINTS) != N;
+        rc |= result.summaries != ncells;     /* every cell reports once */
         printf("group %d: %d process(es), %d cells, %lld points: %s%s\n", group,
                vw_world_processes(w), ncells, (long long)total, rc ? "FAILED " : "ok", msg);
     } else if (!w) {

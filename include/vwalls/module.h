@@ -86,10 +86,13 @@ typedef struct vw_module {
     /* Optional: local work that needs no message (generate primary rays, shoot a patch).
        Every run calls it on every cell (and copy) at its start, also a run with nothing
        posted, so a cell that has nothing to do must return 0 at once (keep a flag in
-       the state). Return nonzero when it did some work; it is called again until it
-       returns 0, and again after the cell receives messages (not in a run that a
-       callback failed: vw_ctx_fail). A worker goes idle only after a pass in
-       which step() of every cell (and copy) it hosts returned 0, so a cell may keep
+       the state). "At its start" is no order: a cell's handlers may run before its
+       first step() of the run (a neighbour's message can arrive first, even with one
+       worker), so what step() and a handler may both do once (report a result) needs
+       a flag in the state too. Return nonzero when it did some work; it is called
+       again until it returns 0, and again after the cell receives messages (not in a
+       run that a callback failed: vw_ctx_fail). A worker goes idle only after a pass
+       in which step() of every cell (and copy) it hosts returned 0, so a cell may keep
        tallies or partial buffers between calls and hand them over here. */
     int (*step)(vw_ctx *ctx, void *state);
     /* Optional load estimate of a cell; otherwise measured busy time is used. */

@@ -71,7 +71,11 @@ foreach(case "send;sent message kind 1 to cell 0, but the kind has no handle"
              "reenter-commit;called vw_world_commit from a callback during the cells"
              "reenter-agree;called vw_world_agree from a callback during a run"
              "build-agree;called vw_world_agree from a callback during the cells"
-             "reenter-traffic;called vw_world_traffic from a callback during a run")
+             "reenter-traffic;called vw_world_traffic from a callback during a run"
+             "bad-kind;sent unknown message kind 7 (it has 2 kinds)"
+             "bad-cell;sent to cell 99, which does not exist (2 cells)"
+             "norestore-step;returned from step() of cell 0 in cell 1"
+             "norestore-handle;returned from its handler of a kind 0 message to cell 0 in another cell")
   list(GET case 0 m)
   list(GET case 1 want)
   add_test(NAME core_misuse_${m} COMMAND test_misuse ${m} ${want})

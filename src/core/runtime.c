@@ -287,10 +287,8 @@ static void enqueue(vw_ctx *ctx, int slot, int dest, int cell, int kind, const v
 {
     vw_world *w = ctx->w;
     vw__worker *wk = ctx->wk;
-    if (kind < 0 || kind >= w->m->nkinds) {
-        fprintf(stderr, "vwalls: module '%s' sent unknown message kind %d\n", w->m->name, kind);
-        abort();
-    }
+    if (kind < 0 || kind >= w->m->nkinds)
+        misuse(ctx, "sent unknown message kind %d (it has %d kinds)", kind, w->m->nkinds);
     /* cell_build and load run between runs: a packet opened there was flushed at the
        next run, to the worker that hosted the cell at the build (a remap since, and it
        received a message for a cell it no longer hosts). */
@@ -633,10 +631,8 @@ void vw_ctx_restore(vw_ctx *ctx, int cell, int replica)
 void vw_send_cell(vw_ctx *ctx, int cell, int kind, const void *msg)
 {
     vw_world *w = ctx->w;
-    if (cell < 0 || cell >= w->ncells) {
-        fprintf(stderr, "vwalls: module '%s' sent to cell %d of %d\n", w->m->name, cell, w->ncells);
-        abort();
-    }
+    if (cell < 0 || cell >= w->ncells)
+        misuse(ctx, "sent to cell %d, which does not exist (%d cells)", cell, w->ncells);
     if (kind >= 0 && kind < w->m->nkinds && !w->m->kinds[kind].handle)
         misuse(ctx, "sent message kind %d to cell %d, but the kind has no handle", kind, cell);
     int dest = w->cell_worker[cell];
@@ -750,9 +746,6 @@ static void handle_packet(vw__worker *wk, vw_ctx *ctx, vw__packet *p)
             vw__cell *c = &w->cells[cur];
             state = *unit_state(w, cur, rep);
             msgs_in = rep ? &c->reps[rep - 1].messages_in : &c->messages_in;
-        } else if (ctx->cell != cur || ctx->rep != rep) {
-            /* The last handler handed off inline and came back: this unit runs again. */
-            meter_note(wk, unit_busy(wk, cur, rep));
         }
         (*msgs_in)++;
         ctx->cell = ctx->home_cell = h->cell;
@@ -760,6 +753,11 @@ static void handle_packet(vw__worker *wk, vw_ctx *ctx, vw__packet *p)
         const vw_msg_kind *k = &w->m->kinds[h->kind];
         /* A failed run drops the module's work; the message still counts as handled. */
         if (k->handle && !dropping(w)) k->handle(ctx, state, p->data + off + sizeof *h);
+        /* A handler that handed off inline came back (vw_ctx_restore, which the meter
+           notes): the next message of this cell needs no switch. */
+        if (ctx->cell != ctx->home_cell || ctx->rep != ctx->home_rep)
+            misuse(ctx, "returned from its handler of a kind %d message to cell %d in another "
+                   "cell (vw_ctx_enter without vw_ctx_restore)", h->kind, h->cell);
         off += msg_stride(h->size);
     }
     meter_stop(wk);
@@ -782,6 +780,9 @@ static int run_step(vw__worker *wk, vw_ctx *ctx)
         ctx->rep = ctx->home_rep = rep;
         meter_start(wk, cell, rep);
         int did = w->m->step(ctx, *unit_state(w, cell, rep));
+        if (ctx->cell != cell || ctx->rep != rep)
+            misuse(ctx, "returned from step() of cell %d in cell %d (vw_ctx_enter without "
+                   "vw_ctx_restore)", cell, ctx->cell);
         meter_stop(wk);
         if (did) return 1;
     }

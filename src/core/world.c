@@ -304,6 +304,9 @@ vw_status vw_world_create(const vw_module *m, void *user, const vw_decomp *d, co
     if (m->abi != VW_MODULE_ABI)
         return create_failed(VW_E_INVAL, "module '%s': abi %d, the library's is %d (set .abi = "
                              "VW_MODULE_ABI and rebuild)", m->name ? m->name : "?", m->abi, VW_MODULE_ABI);
+    /* Every message about the module names it (runtime.c's misuse: a NULL for %s). */
+    if (!m->name || !m->name[0])
+        return create_failed(VW_E_INVAL, "vw_world_create: the module has no name (vw_module.name)");
     if (m->nkinds < 0 || m->nkinds > VW_MAX_KINDS || m->ncounters < 0 || m->ncounters > VW_MAX_COUNTERS)
         return create_failed(VW_E_INVAL, "module '%s': %d message kinds and %d counters (at most %d "
                              "and %d)", m->name ? m->name : "?", m->nkinds, m->ncounters, VW_MAX_KINDS,

@@ -17,8 +17,9 @@
  *            without a mapping, vw_world_traffic and vw_world_machines without room for
  *            their answer returned VW_E_INVAL and left "no error" or an older message)
  *   done     vw_world_done asks every cell's done(), and refuses what it cannot answer
- *   send | output | count | build-send | send-null | point-null   a module's bad send
- *            (also one from cell_build, one without its message) or count stops the
+ *   send | output | count | build-send | send-null | point-null | bad-kind | bad-cell
+ *            a module's bad send (also one from cell_build, one without its message, to
+ *            a kind or a cell that does not exist) or count stops the
  *            process (abort) with a message on stderr: run in a child, whose end and
  *            stderr are checked
  *   reenter-run | reenter-post | reenter-add | reenter-free | reenter-commit   a call
@@ -29,6 +30,9 @@
  *            cell_build, and vw_world_traffic from step(): collectives under MPI, made
  *            from a worker thread in the middle of a run or a commit (they were let
  *            through: a hang or a mixed-up agreement under MPI)
+ *   norestore-step | norestore-handle   a step() or a handler that hands off inline
+ *            (vw_ctx_enter) and returns without vw_ctx_restore stops the process, as
+ *            module.h requires the restore (it went unnoticed)
  * Usage: test_misuse MODE [EXPECTED-MESSAGE]
  */
 #include <signal.h>
@@ -50,9 +54,13 @@ static void bounds(const void *o, vw_box *b, void *user)
     for (int a = 0; a < 3; a++) b->lo[a] = b->hi[a] = x->p[a];
 }
 
+static const char *mode;
+
+/* norestore-handle: the message to cell 0 hands off to cell 1 and returns there. */
 static void handle(vw_ctx *ctx, void *state, const void *msg)
 {
-    (void)ctx, (void)state, (void)msg;
+    (void)state, (void)msg;
+    if (!strcmp(mode, "norestore-handle") && vw_ctx_cell(ctx) == 0) vw_ctx_enter(ctx, 1, 0);
 }
 
 static void output(void *user, const void *msg)
@@ -60,7 +68,6 @@ static void output(void *user, const void *msg)
     (void)user, (void)msg;
 }
 
-static const char *mode;
 static vw_world *the_world; /* for the callbacks that call back into it */
 
 /* The mistake of the mode, once, from cell 0. */
@@ -84,6 +91,11 @@ static int step(vw_ctx *ctx, void *state)
     if (!strcmp(mode, "output")) vw_send_output(ctx, 0, &x);  /* kind 0: no output */
     if (!strcmp(mode, "count")) vw_count(ctx, 5, 1);          /* one counter */
     if (!strcmp(mode, "face")) vw_send_face(ctx, 6, 0, &x);   /* faces 0..5 */
+    if (!strcmp(mode, "bad-kind")) vw_send_cell(ctx, 0, 7, &x);
+    if (!strcmp(mode, "bad-cell")) vw_send_cell(ctx, 99, 0, &x);
+    /* Both cells on one worker (see main): the hand-off succeeds, no restore follows. */
+    if (!strcmp(mode, "norestore-step")) vw_ctx_enter(ctx, 1, 0);
+    if (!strcmp(mode, "norestore-handle")) vw_send_cell(ctx, 0, 0, &x);
     return 1;
 }
 
@@ -188,6 +200,13 @@ int main(int argc, char **argv)
         bad.counters = unnamed;
         CHECK(vw_world_create(&bad, NULL, d, &cfg, &w) == VW_E_INVAL && !w);
         CHECK(strstr(vw_world_errmsg(NULL), "counter 0 has no name") != NULL);
+        /* Every message about a module names it: printf was given NULL for %s. */
+        bad = m;
+        bad.name = NULL;
+        CHECK(vw_world_create(&bad, NULL, d, &cfg, &w) == VW_E_INVAL && !w);
+        CHECK(strstr(vw_world_errmsg(NULL), "the module has no name") != NULL);
+        bad.name = "";
+        CHECK(vw_world_create(&bad, NULL, d, &cfg, &w) == VW_E_INVAL && !w);
         CHECK(vw_world_create(&m, NULL, d, &cfg, &w) == VW_OK);
         CHECK(!strcmp(vw_world_errmsg(NULL), "no world")); /* a success clears it */
     } else if (!strcmp(mode, "null")) {
@@ -219,6 +238,7 @@ int main(int argc, char **argv)
         CHECK_EQ_INT(vw_engine_workers(3), 3);
         CHECK_EQ_INT(vw_engine_workers(0), vw_host_cores());
     } else {
+        if (!strncmp(mode, "norestore", 9)) cfg.workers = 1; /* a hand-off needs both cells */
         CHECK(vw_world_create(&m, NULL, d, &cfg, &w) == VW_OK);
         the_world = w;
         obj o[2] = {{{0.25, 0.5, 0.5}}, {{0.75, 0.5, 0.5}}};

@@ -26,6 +26,14 @@ add_test(NAME dynamic_cli
   COMMAND sh ${PROJECT_SOURCE_DIR}/tests/dynamic/cli.sh $<TARGET_FILE:vwalls_tool>
           ${CMAKE_CURRENT_BINARY_DIR}/dynamic_cli ${PROJECT_SOURCE_DIR}/tests/data/edits)
 
+# One script's decisions and frames on cells 1, 2x2x1, 4x4x4 and workers 1, 2 against the
+# brute-force reference, on a scene made to stress the walls (touching across them, a
+# pane lying in one, a polygon that is a segment), with hand-checked outcomes.
+add_test(NAME dynamic_layouts
+  COMMAND sh ${PROJECT_SOURCE_DIR}/tests/dynamic/layouts.sh $<TARGET_FILE:vwalls_tool>
+          ${CMAKE_CURRENT_BINARY_DIR}/dynamic_layouts)
+set_tests_properties(dynamic_layouts PROPERTIES TIMEOUT 120)
+
 # Under mpirun -np 2 (launcher flags: cmake/mpi_launcher.cmake).
 if(VW_HAVE_MPI AND MPIEXEC_EXECUTABLE)
   foreach(t placement decisions frame)

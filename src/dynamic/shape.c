@@ -27,7 +27,9 @@ static double clamp01(double x) { return x < 0 ? 0 : x > 1 ? 1 : x; }
 
 /* Squared distance from p to triangle abc (Ericson, Real-Time Collision Detection 5.1.5:
    Voronoi regions of the vertices, edges and face). Degenerate triangles work too: the
-   face region is never chosen when the area is zero. */
+   face region is never chosen when the area is zero, and an edge region is taken only
+   when its edge has a length (a == b made the AB branch 0/0: a NaN distance, so a
+   sphere through a polygon whose first two corners coincide was never hit). */
 static double dist2_point_tri(const double p[3], const double a[3], const double b[3],
                               const double c[3])
 {
@@ -39,7 +41,7 @@ static double dist2_point_tri(const double p[3], const double a[3], const double
     double d3 = dot(ab, bp), d4 = dot(ac, bp);
     if (d3 >= 0 && d4 <= d3) return dot(bp, bp);
     double vc = d1 * d4 - d3 * d2;
-    if (vc <= 0 && d1 >= 0 && d3 <= 0) {
+    if (vc <= 0 && d1 >= 0 && d3 <= 0 && d1 - d3 > 0) {
         double v = d1 / (d1 - d3);
         for (int k = 0; k < 3; k++) q[k] = a[k] + v * ab[k];
         sub(p, q, t);
@@ -49,14 +51,14 @@ static double dist2_point_tri(const double p[3], const double a[3], const double
     double d5 = dot(ab, cp), d6 = dot(ac, cp);
     if (d6 >= 0 && d5 <= d6) return dot(cp, cp);
     double vb = d5 * d2 - d1 * d6;
-    if (vb <= 0 && d2 >= 0 && d6 <= 0) {
+    if (vb <= 0 && d2 >= 0 && d6 <= 0 && d2 - d6 > 0) {
         double w = d2 / (d2 - d6);
         for (int k = 0; k < 3; k++) q[k] = a[k] + w * ac[k];
         sub(p, q, t);
         return dot(t, t);
     }
     double va = d3 * d6 - d5 * d4;
-    if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) {
+    if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0 && (d4 - d3) + (d5 - d6) > 0) {
         double w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
         for (int k = 0; k < 3; k++) q[k] = b[k] + w * (c[k] - b[k]);
         sub(p, q, t);

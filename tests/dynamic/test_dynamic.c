@@ -62,6 +62,16 @@ static void test_primitives(void)
     CHECK(!vw_shape_collide(&end, NULL, &ground, tol));
     CHECK(vw_shape_collide(&far, d, &ground, tol));
     CHECK(vw_shape_collide(&ground, (double[3]){0, 0, 10}, &far, tol)); /* relative motion */
+    /* Grazing paths: passing at exactly the touching distance is free, a hair closer is
+       not (the ground; a sphere passed at the sum of the radii). */
+    vw_shape graze = sphere(-5, -5, 1, 1);
+    CHECK(!vw_shape_collide(&graze, (double[3]){10, 10, 0}, &ground, tol));
+    graze.p[0][2] = 1 - 1e-9;
+    CHECK(vw_shape_collide(&graze, (double[3]){10, 10, 0}, &ground, tol));
+    vw_shape pass = sphere(-5, 2, 0, 1);
+    CHECK(!vw_shape_collide(&pass, (double[3]){10, 0, 0}, &a, tol));
+    pass.p[0][1] = 2 - 1e-9;
+    CHECK(vw_shape_collide(&pass, (double[3]){10, 0, 0}, &a, tol));
     /* Triangles: crossing, touching at an edge, coplanar overlapping, coplanar apart. */
     const double h0[3] = {0, 0, -1}, h1[3] = {0, 0, 1}, h2[3] = {1, 0, 0};
     vw_shape cross_t = tri(h0, h1, h2);
@@ -84,6 +94,17 @@ static void test_primitives(void)
     CHECK(!vw_shape_collide(&mover, NULL, &wall, tol));
     CHECK(vw_shape_collide(&mover, (double[3]){10, 0, 0}, &wall, tol));
     CHECK(!vw_shape_collide(&mover, (double[3]){0, 10, 0}, &wall, tol));
+    /* A degenerate triangle whose first two corners coincide (a polygon with a repeated
+       vertex) is the segment to its third: a sphere on it collides, at rest and swept
+       through it (the distance was 0/0, a NaN, so neither was ever a hit). */
+    const double s0[3] = {-2, 0, 0}, s2[3] = {2, 0, 0};
+    vw_shape seg = tri(s0, s0, s2);
+    vw_shape on = sphere(0, 0, 0.2, 0.5), over = sphere(0.5, 0, 3, 0.1);
+    CHECK(vw_shape_collide(&on, NULL, &seg, tol));
+    CHECK(vw_shape_collide(&seg, NULL, &on, tol));
+    CHECK(vw_shape_collide(&over, (double[3]){0, 0, -6}, &seg, tol));
+    CHECK(vw_shape_collide(&seg, (double[3]){0, 0, 6}, &over, tol));
+    CHECK(!vw_shape_collide(&over, (double[3]){0, 0, -2}, &seg, tol));
     /* Boxes (cones) conservatively. */
     vw_shape box;
     memset(&box, 0, sizeof box);

@@ -74,10 +74,15 @@ typedef struct vw_collider vw_collider;
 
 /* What a probe asks. The object `start` (all of whose shapes carry id) moves to `end`.
    VW_PROBE_END: test `end` against the others. VW_PROBE_SWEEP: also test the volume
-   `start` sweeps along d (end must then be start translated by d); an obstacle that
+   `start` sweeps along d (end must then be start translated by d). An obstacle that
    already interpenetrates `start` does not count for the sweep (so a resting object
-   can be lifted off what it rests on), only for the end test. */
-enum { VW_PROBE_END = 1, VW_PROBE_SWEEP = 2 };
+   can be lifted off what it rests on), only for the end test: its contact says
+   VW_PROBE_START instead. The rule is the object's: a sweep that meets one shape of an
+   obstacle whose other shape `start` interpenetrates (a floor of two triangles, the
+   mover sunk in one) is no sweep hit either; the contacts of one tag and obstacle are
+   merged (their bits or'ed), so a caller counts a sweep hit where a contact has
+   VW_PROBE_SWEEP and not VW_PROBE_START. */
+enum { VW_PROBE_END = 1, VW_PROBE_SWEEP = 2, VW_PROBE_START = 4 };
 typedef struct vw_probe {
     vw_shape start, end;
     double d[3];
@@ -88,7 +93,7 @@ typedef struct vw_probe {
 typedef struct vw_contact {
     int32_t tag;       /* the probe's tag */
     int32_t obstacle;  /* the id of the object hit */
-    int32_t how;       /* VW_PROBE_END and/or VW_PROBE_SWEEP */
+    int32_t how;       /* VW_PROBE_END, VW_PROBE_SWEEP, VW_PROBE_START, or'ed */
     int32_t pad;
 } vw_contact;
 

@@ -118,9 +118,10 @@ int vw__probe_test(const vw_probe *p, const vw_shape *o, double tol)
     if (o->kind == VW_SHAPE_NONE || o->id == p->start.id) return 0;
     int how = 0;
     if ((p->flags & VW_PROBE_END) && vw_shape_collide(&p->end, NULL, o, tol)) how |= VW_PROBE_END;
-    if ((p->flags & VW_PROBE_SWEEP) && vw_shape_collide(&p->start, p->d, o, tol) &&
-        !vw_shape_collide(&p->start, NULL, o, tol))
-        how |= VW_PROBE_SWEEP;
+    /* The swept volume holds the start, so a start that interpenetrates o sweeps into
+       it too: START, not SWEEP (the caller applies the rule per object). */
+    if ((p->flags & VW_PROBE_SWEEP) && vw_shape_collide(&p->start, p->d, o, tol))
+        how |= vw_shape_collide(&p->start, NULL, o, tol) ? VW_PROBE_START : VW_PROBE_SWEEP;
     return how;
 }
 

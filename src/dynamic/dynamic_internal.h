@@ -7,8 +7,8 @@
 #include "vwalls/engine.h"
 
 /* The test of one probe against one obstacle shape, as a cell runs it: VW_PROBE_END
-   and/or VW_PROBE_SWEEP bits, 0 for no hit. The brute-force reference uses it too, so
-   both decide by one rule. */
+   and/or VW_PROBE_SWEEP or VW_PROBE_START bits (dynamic.h), 0 for no hit. The
+   brute-force reference uses it too, so both decide by one rule. */
 int vw__probe_test(const vw_probe *p, const vw_shape *o, double tol);
 
 #endif

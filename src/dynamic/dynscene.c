@@ -505,6 +505,13 @@ static int boxes_overlap(const vw_box *a, const vw_box *b, double pad)
     return 1;
 }
 
+/* Whether an obstacle's merged contact bits make a sweep hit: the mover's path meets
+   it and the mover did not already interpenetrate it at its start (dynamic.h). */
+static int sweep_hits(int how)
+{
+    return (how & VW_PROBE_SWEEP) && !(how & VW_PROBE_START);
+}
+
 /* Contacts by brute force: every probe against every slot (the reference). */
 static vw_status brute_contacts(vw_dynscene *ds, const batch *b, vw_contact **out, size_t *nout)
 {
@@ -761,12 +768,13 @@ static vw_status run_batch(vw_dynscene *ds, const vw_edit *edits, size_t n, int 
             for (size_t c = ci; c < nct && ct[c].tag == (int32_t)i; c++) {
                 if (moved[ct[c].obstacle]) continue; /* it has left that place */
                 if ((ct[c].how & VW_PROBE_END) && end_hit < 0) end_hit = ct[c].obstacle;
-                if ((ct[c].how & VW_PROBE_SWEEP) && sweep_hit < 0) sweep_hit = ct[c].obstacle;
+                if (sweep_hits(ct[c].how) && sweep_hit < 0) sweep_hit = ct[c].obstacle;
             }
             /* The new places of the edits accepted before this one in the batch. */
             for (size_t j = 0; j < i; j++) {
                 if (!ok[j] || pd[j].remove || res[j].outcome != VW_OUT_ACCEPTED) continue;
                 if (!boxes_overlap(&pd[i].reach, &pd[j].endb, ds->tol)) continue;
+                int how = 0; /* over every pair of their shapes: the rule is per object */
                 for (size_t k = 0; k < (size_t)pd[i].nshapes; k++) {
                     vw_probe p;
                     memset(&p, 0, sizeof p);
@@ -786,11 +794,11 @@ static vw_status run_batch(vw_dynscene *ds, const vw_edit *edits, size_t n, int 
                         vw_box ob;
                         vw_shape_bounds(o, NULL, &ob);
                         if (!boxes_overlap(&pb, &ob, ds->tol)) continue;
-                        int how = vw__probe_test(&p, o, ds->tol);
-                        if ((how & VW_PROBE_END) && (end_hit < 0 || pd[j].id < end_hit)) end_hit = pd[j].id;
-                        if ((how & VW_PROBE_SWEEP) && (sweep_hit < 0 || pd[j].id < sweep_hit)) sweep_hit = pd[j].id;
+                        how |= vw__probe_test(&p, o, ds->tol);
                     }
                 }
+                if ((how & VW_PROBE_END) && (end_hit < 0 || pd[j].id < end_hit)) end_hit = pd[j].id;
+                if (sweep_hits(how) && (sweep_hit < 0 || pd[j].id < sweep_hit)) sweep_hit = pd[j].id;
             }
         }
         if (end_hit >= 0) {

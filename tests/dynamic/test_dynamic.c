@@ -403,6 +403,46 @@ static void test_decisions(int seeds, int workers)
     }
 }
 
+/* A sphere sunk 0.1 into a floor is moved off it sideways, sweep on: the floor is an
+   object it already interpenetrates at its start, so the floor does not count for the
+   sweep, whether the floor is one triangle or a quad of two (the mover sunk in the
+   first, its path over the second): the rule was applied per triangle, and the quad
+   rejected the move ("would pass through object 0") where the triangle accepted it. */
+static void test_sunk(const vw_decomp *d, const vw_config *cfg)
+{
+    static const char *const floors[] = {"p 4\n0 0 0\n2 0 0\n2 1 0\n0 1 0\n",
+                                         "p 3\n0 0 0\n4 0 0\n0 2 0\n"};
+    for (int f = 0; f < 2; f++)
+        for (int brute = 0; brute < 2; brute++) {
+            char nff[512], err[256];
+            snprintf(nff, sizeof nff, "v\nfrom 0 -10 0\nat 0 0 0\nup 0 0 1\nangle 40\n"
+                     "hither 0.01\nresolution 16 16\nb 0 0 0\nl 0 -5 5\n"
+                     "f 1 1 1 1 0 0 0 1\n%ss 1.5 0.2 0.4 0.5\ns 4 4 4 0.1\n", floors[f]);
+            vw_scene *s;
+            CHECK(vw_scene_read_nff("sunk", nff, strlen(nff), &s, err, sizeof err) == VW_OK);
+            vw_dynscene_params p = {d, cfg, 0, brute};
+            vw_dynscene *ds;
+            CHECK(vw_dynscene_create(s, &p, &ds, err, sizeof err) == VW_OK);
+            vw_edit e;
+            vw_result r;
+            int *ch;
+            size_t nch;
+            CHECK(vw_edit_parse("move 1 -3 0.6 0", "t", 1, &e, err, sizeof err) == VW_OK);
+            CHECK(vw_dynscene_apply(ds, &e, 1, 1, 1, &r, &ch, &nch) == VW_OK);
+            free(ch);
+            EXPECT(r.outcome == VW_OUT_ACCEPTED, "floor %s, brute %d: outcome %d (obstacle %d)",
+                   f ? "triangle" : "quad", brute, (int)r.outcome, r.obstacle);
+            /* Back under the floor through it, from off it: that is a sweep hit. */
+            CHECK(vw_edit_parse("moveto 1 1 0.5 -1", "t", 2, &e, err, sizeof err) == VW_OK);
+            CHECK(vw_dynscene_apply(ds, &e, 1, 1, 1, &r, &ch, &nch) == VW_OK);
+            free(ch);
+            EXPECT(r.outcome == VW_OUT_SWEEP && r.obstacle == 0, "floor %s, brute %d: outcome "
+                   "%d (obstacle %d), expected a sweep hit on 0", f ? "triangle" : "quad",
+                   brute, (int)r.outcome, r.obstacle);
+            vw_dynscene_free(ds);
+        }
+}
+
 /* A small fast sphere and a thin triangle: the endpoint test accepts the jump, the
    swept test rejects it, naming the triangle. */
 static void test_tunnel(int workers)
@@ -502,6 +542,7 @@ static void test_tunnel(int workers)
 #endif
         vw_dynscene_free(ds);
     }
+    test_sunk(d, &cfg);
     vw_decomp_free(d);
 }
 

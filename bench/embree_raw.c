@@ -36,12 +36,10 @@ static void unit3(double v[3])
 }
 
 /* Where a ray leaving a surface of geometric normal n in direction d starts its search,
-   as the ray tracer's ray_eps makes it (apps/raytrace/module.c): eps over the cosine, at
-   most 64 eps, the factor rounded to a float as the ray carries it. */
+   as the ray tracer's shade() makes it (rt_ray_eps; the factor a float, as in the ray). */
 static double start(const bench *b, const double d[3], const double n[3])
 {
-    double c = fabs(dot3(d, n));
-    return (double)(float)(1.0 / (c > 1.0 / 64 ? c : 1.0 / 64)) * b->eps;
+    return (double)rt_ray_eps(d, n) * b->eps;
 }
 
 /* One ray from org, its search from t = tn (0 for an eye ray: it leaves no surface). */

@@ -28,7 +28,7 @@ typedef struct rt_ray {
                               spawn() on, clipped to the world box (vw_decomp_clip) */
     double weight[3];      /* shadow ray: the contribution added if unoccluded */
     int32_t pixel, depth, kind;
-    float eps_k;           /* its searches start at t = eps_k x sh->eps (ray_eps; 0 for
+    float eps_k;           /* its searches start at t = eps_k x sh->eps (rt_ray_eps; 0 for
                               eye rays): a factor, as a float has no room for the eps of
                               a scene 1e-50 across */
 } rt_ray;
@@ -231,18 +231,6 @@ static void normals(const rt_hit *h, const double p[3], double ng[3], double ns[
     }
 }
 
-/* The least t of a ray leaving a surface at direction d, as a factor of sh->eps
-   (Embree's and the doubles' error in the hit point across the surface): 1 over the
-   cosine of d to the surface's normal ng (a ray that leaves at a grazing angle needs
-   that much farther to get as far off the surface), up to 64. A surface nearer than
-   that to a ray's origin is not seen by it; features of any size above the float error
-   cast their shadows and show in mirrors. */
-static float ray_eps(const double d[3], const double ng[3])
-{
-    double c = fabs(dot3(d, ng));
-    return (float)(1.0 / (c > 1.0 / 64 ? c : 1.0 / 64));
-}
-
 /* Whitted shading at a hit: shadow rays to the lights that face the surface, a mirror
    ray weighted by the material's reflect (NFF: Ks; MTL: Ks by illum) and a transmitted
    ray weighted by T. Reads only the ray, the hit
@@ -285,7 +273,7 @@ static void shade(vw_ctx *ctx, rt_cell *c, const rt_ray *r, const rt_hit *h)
         double ndl = dot3(ns, s.dir);
         /* No shadow ray toward a light behind the surface. */
         if (ndl <= 0 || dot3(ng, s.dir) <= 0) continue;
-        s.eps_k = ray_eps(s.dir, ng);
+        s.eps_k = rt_ray_eps(s.dir, ng);
         if (!(dist > s.eps_k * sh->eps)) continue; /* a light on the surface */
         double spec = 0;
         if (has_spec) {
@@ -316,7 +304,7 @@ static void shade(vw_ctx *ctx, rt_cell *c, const rt_ray *r, const rt_hit *h)
         s.pixel = r->pixel;
         s.depth = r->depth + 1;
         s.kind = RT_REFLECT;
-        s.eps_k = ray_eps(refl, ng);
+        s.eps_k = rt_ray_eps(refl, ng);
         spawn(ctx, c, &s);
     }
     if (m->transmit > 0) {
@@ -339,7 +327,7 @@ static void shade(vw_ctx *ctx, rt_cell *c, const rt_ray *r, const rt_hit *h)
         s.pixel = r->pixel;
         s.depth = r->depth + 1;
         s.kind = RT_REFRACT;
-        s.eps_k = ray_eps(s.dir, ng);
+        s.eps_k = rt_ray_eps(s.dir, ng);
         spawn(ctx, c, &s);
     }
 }

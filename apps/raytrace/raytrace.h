@@ -339,6 +339,20 @@ void rt_job_overlay(const rt_job *j, uint8_t *out);
 /* The "rays" and per-cell pixel members for the stats JSON (malloc'ed string). */
 char *rt_job_stats_json(const rt_job *j);
 
+/* Where a ray leaving a surface in direction d (unit; ng the surface's unit geometric
+   normal) starts its searches, as a factor of rt_shared.eps (Embree's and the doubles'
+   error in the hit point across the surface): 1 over the cosine of d to ng (a ray that
+   leaves at a grazing angle needs that much farther to get as far off the surface), up
+   to 64. A surface nearer than that to a ray's origin is not seen by it; features of
+   any size above the float error cast their shadows and show in mirrors. Shared with
+   bench/embree_raw.c, which must cast the same rays. */
+static inline float rt_ray_eps(const double d[3], const double ng[3])
+{
+    double c = d[0] * ng[0] + d[1] * ng[1] + d[2] * ng[2];
+    c = c < 0 ? -c : c;
+    return (float)(1.0 / (c > 1.0 / 64 ? c : 1.0 / 64));
+}
+
 /* The fixed-point -> 8-bit rule, shared with the tests. */
 static inline uint8_t rt_fix_to_u8(int64_t q)
 {

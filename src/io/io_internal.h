@@ -101,6 +101,15 @@ static inline int vw__is_binary(unsigned char c)
            c == 0x7f;
 }
 
+/* How a message names a byte vw__is_binary refuses: "a NUL byte" or "control character
+   0x08" (buf: at least 24 bytes). */
+static inline const char *vw__binary_name(unsigned char c, char *buf)
+{
+    if (!c) return "a NUL byte";
+    snprintf(buf, 24, "control character 0x%02x", c);
+    return buf;
+}
+
 /* A UTF-8 byte order mark (Windows editors write one) is not part of the first line:
    left there, it would make the first keyword unknown. The OBJ, MTL and NFF readers
    start after it. */

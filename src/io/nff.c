@@ -154,10 +154,9 @@ static vw_status fail(nff *P, int line, const char *fmt, ...)
 /* The lexer stopped at a byte no text holds (lex_next returned -1). */
 static vw_status binary(nff *P, const lexer *lx)
 {
-    unsigned char c = (unsigned char)*lx->p;
-    if (!c)
-        return fail(P, lx->line, "a NUL byte: binary data, not NFF text");
-    return fail(P, lx->line, "control character 0x%02x: binary data, not NFF text", c);
+    char b[24];
+    return fail(P, lx->line, "%s: binary data, not NFF text",
+                vw__binary_name((unsigned char)*lx->p, b));
 }
 
 static vw_status fail_status(nff *P, vw_status st)

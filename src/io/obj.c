@@ -409,10 +409,9 @@ static vw_status check_text(obj *O, span line, const char *kind)
         if (c == '\n' || (c == '\r' && !(i + 1 < line.n && line.s[i + 1] == '\n')))
             at++;   /* a continuation's line end: CRLF counts at its LF */
         else if (vw__is_binary(c)) {
+            char b[24];
             O->line = at;
-            if (!c)
-                return fail(O, "a NUL byte: binary data, not %s text", kind);
-            return fail(O, "control character 0x%02x: binary data, not %s text", c, kind);
+            return fail(O, "%s: binary data, not %s text", vw__binary_name(c, b), kind);
         }
     }
     return VW_OK;

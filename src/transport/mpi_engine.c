@@ -129,8 +129,22 @@ int vw_engine_size(void)
     return n;
 }
 
+/* The length of a message's leading "FILE:LINE: " (bad input, as the readers word it),
+   or 0 when it has none: what comes before its first ": " must end in ':' and digits. */
+static size_t file_line_length(const char *msg)
+{
+    const char *sep = strstr(msg, ": ");
+    if (!sep) return 0;
+    const char *d = sep;
+    while (d > msg && d[-1] >= '0' && d[-1] <= '9') d--;
+    if (d == sep || d - msg < 2 || d[-1] != ':') return 0;
+    return (size_t)(sep + 2 - msg);
+}
+
 /* Two collectives: the lowest failing rank (MIN of rank-or-size), then its status and
-   message broadcast from it. Costs O(log P) when everybody is fine. */
+   message broadcast from it. Costs O(log P) when everybody is fine. The message names
+   that rank in front ("rank R: ..."), or after the "FILE:LINE: " of bad input, which
+   then stays first on the line, as without MPI. */
 vw_status vw__mpi_agree(MPI_Comm comm, vw_status local, char *msg, size_t len)
 {
     int rank, size;
@@ -146,8 +160,9 @@ vw_status vw__mpi_agree(MPI_Comm comm, vw_status local, char *msg, size_t len)
     memset(&b, 0, sizeof b);
     if (rank == first) {
         b.status = (int)local;
-        snprintf(b.text, sizeof b.text, "rank %d: %s", first,
-                 msg && *msg ? msg : vw_status_message(local));
+        const char *text = msg && *msg ? msg : vw_status_message(local);
+        size_t fl = file_line_length(text);
+        snprintf(b.text, sizeof b.text, "%.*srank %d: %s", (int)fl, text, first, text + fl);
     }
     MPI_Bcast(&b, (int)sizeof b, MPI_BYTE, first, comm);
     if (msg && len) snprintf(msg, len, "%s", b.text);

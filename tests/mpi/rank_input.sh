@@ -4,7 +4,8 @@
 #     apply the same edits (same log and frames as the single process's);
 #   * vwalls animate's edit script is rank 0's, read there and handed to every rank, so
 #     a script that differs (or is missing) on another rank changes nothing;
-#   * a scene missing on one rank stops every rank, naming it, and
+#   * a scene missing on one rank stops every rank, naming it; a bad one keeps its
+#     "FILE:LINE: " first, the rank after it; and
 #     another --workers, --depth, camera or scene (a material) on one rank is named as
 #     such, and so is
 #     another radiosity option that changes the solution (--sf, --hemicube, ...);
@@ -69,6 +70,19 @@ run "render, scene missing on rank 1" 2 "rank 1: .*s1.nff" \
 # shellcheck disable=SC2086
 run "animate, scene missing on rank 1" 2 "rank 1: .*s1.nff" \
     sh -c "exec \"$vwalls\" animate \"$dir/s$rank.nff\" \"$dir/edits\" -o \"$dir/a%d.png\" $common"
+# Bad input keeps its "FILE:LINE: " first on the line, as without MPI, with the rank
+# that failed after it (it used to come first: "rank 0: b0.nff:8: ...").
+{ cat "$scene"; printf 'zzz 1 2 3\n'; } >"$dir/b0.nff"
+badline=$(wc -l <"$dir/b0.nff")
+cp "$scene" "$dir/c0.nff"
+cp "$dir/b0.nff" "$dir/c1.nff"
+# shellcheck disable=SC2086
+run "render, a bad scene on every rank" 2 "^[^ ]*b0\.nff:$badline: rank 0: unknown keyword 'zzz'" \
+    "$vwalls" render "$dir/b0.nff" -o "$dir/r.png" $common
+# shellcheck disable=SC2086
+run "render, a bad scene on rank 1 alone" 2 "^[^ ]*c1\.nff:$badline: rank 1: unknown keyword 'zzz'" \
+    sh -c "exec \"$vwalls\" render \"$dir/c$rank.nff\" -o \"$dir/r.png\" $common"
+[ ! -e "$dir/r.png" ] || { echo "FAIL: render of a bad scene wrote its image"; fail=1; }
 # The edit script is rank 0's: the others' copies are not read, so one missing there
 # is no error, and one missing on rank 0 is named as such.
 # shellcheck disable=SC2086

@@ -94,6 +94,10 @@ add_test(NAME tutorial_hello_create_errmsg
          COMMAND sh -c "out=$(\"$0\" --workers 5000 2>&1); rc=$?; echo \"$out\"; test $rc -eq 1 && echo \"$out\" | grep -q '5000 workers (at most 1024)'"
                  $<TARGET_FILE:tutorial_hello_cells>)
 set_tests_properties(tutorial_hello_create_errmsg PROPERTIES LABELS "examples")
+# Memory it lacks for its points is named, not a silent exit (tests/examples/hello_nomem.sh).
+add_test(NAME tutorial_hello_nomem
+         COMMAND sh ${PROJECT_SOURCE_DIR}/tests/examples/hello_nomem.sh $<TARGET_FILE:tutorial_hello_cells>)
+set_tests_properties(tutorial_hello_nomem PROPERTIES LABELS "examples" SKIP_RETURN_CODE 77)
 if(VW_HAVE_MPI)
   add_test(NAME tutorial_hello_mpi_np2
            COMMAND ${MPIEXEC_EXECUTABLE} ${MPIEXEC_NUMPROC_FLAG} 2 ${MPIEXEC_PREFLAGS}

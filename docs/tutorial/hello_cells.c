@@ -85,29 +85,36 @@ int main(int argc, char **argv)
     }
     int ncells = vw_decomp_cell_count(d);
 
-    /* 3. The objects: every process adds all of them; each keeps those in its cells. */
+    /* 3. The objects: every process adds all of them; each keeps those in its cells.
+          What a process prepares alone is agreed on before the world: under mpirun, one
+          that gave up alone would leave the others waiting in vw_world_create. */
     size_t n = npoints > 0 ? (size_t)npoints : 0;
     ex_point *pts = malloc(sizeof *pts * (n ? n : 1));
     ex_hello_result result = {ncells, calloc((size_t)ncells, sizeof(int64_t)),
                               calloc((size_t)ncells, sizeof(int64_t)), 0};
-    if (!pts || !result.own || !result.neighbours) return 1;
-    uint64_t seed = 42;
-    for (size_t i = 0; i < n; i++)
-        for (int k = 0; k < 3; k++) pts[i].p[k] = uniform(&seed);
-
-    /* 4. The world: create, add, commit (cells are built), run to quiescence. */
     vw_config cfg;
     vw_config_init(&cfg);           /* defaults, then VW_STRESS from the environment */
     cfg.workers = workers;          /* 0: one per core */
+    msg[0] = 0;
+    vw_status st = pts && result.own && result.neighbours ? VW_OK : VW_E_NOMEM;
+    st = vw_config_agree(&cfg, st, msg, sizeof msg);
+    uint64_t seed = 42;
+    for (size_t i = 0; st == VW_OK && i < n; i++)
+        for (int k = 0; k < 3; k++) pts[i].p[k] = uniform(&seed);
+
+    /* 4. The world: create, add, commit (cells are built), run to quiescence. */
     vw_world *w = NULL;
-    vw_status st = vw_world_create(&ex_hello_module, &result, d, &cfg, &w);
-    if (st == VW_OK) st = vw_world_add_objects(w, pts, n);
-    if (st == VW_OK) st = vw_world_commit(w);
-    if (st == VW_OK) st = vw_world_run(w);
+    if (st == VW_OK) {
+        st = vw_world_create(&ex_hello_module, &result, d, &cfg, &w);
+        /* With w NULL, vw_world_errmsg says why vw_world_create made no world. */
+        if (st == VW_OK) st = vw_world_add_objects(w, pts, n);
+        if (st == VW_OK) st = vw_world_commit(w);
+        if (st == VW_OK) st = vw_world_run(w);
+        if (st != VW_OK) snprintf(msg, sizeof msg, "%s", vw_world_errmsg(w));
+    }
     int rc = 0;
     if (st != VW_OK) {
-        /* With w NULL, vw_world_errmsg says why vw_world_create made no world. */
-        fprintf(stderr, "hello_cells: %s\n", vw_world_errmsg(w));
+        fprintf(stderr, "hello_cells: %s\n", *msg ? msg : vw_status_message(st));
         rc = 1;
     }
 

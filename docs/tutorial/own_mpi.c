@@ -62,8 +62,14 @@ int main(int argc, char **argv)
     if (w && vw_world_is_output(w)) {
         int64_t total = 0;
         for (int c = 0; c < ncells; c++) total += result.own[c];
-        rc |= total != N || vw_world_counter(w, EX_HELLO_CNT_POINTS) != N;
-        rc |= result.summaries != ncells;     /* every cell reports once */
+        int64_t counted = vw_world_counter(w, EX_HELLO_CNT_POINTS);
+        if (rc == 0 && (total != N || counted != N || result.summaries != ncells)) {
+            /* every point owned and counted once; every cell reports once */
+            snprintf(msg, sizeof msg, "(points owned %lld, counted %lld, of %d; %lld reports "
+                     "of %d cells)", (long long)total, (long long)counted, N,
+                     (long long)result.summaries, ncells);
+            rc = 1;
+        }
         printf("group %d: %d process(es), %d cells, %lld points: %s%s\n", group,
                vw_world_processes(w), ncells, (long long)total, rc ? "FAILED " : "ok", msg);
     } else if (!w) {

@@ -469,7 +469,7 @@ int vw_cmd_render(int argc, char **argv)
     vw_scene *scene = NULL;
     /* Under MPI every process reads the scene; all stop if one cannot (a file missing on
        one host), and the output process says which and why (the parser's
-       "file:line: message", as it is, after "rank R: " under MPI). */
+       "file:line: message", under MPI with "rank R: " after its "file:line: "). */
     if (rc == VW_EXIT_OK && vw_scene_read_file(scene_path, &scene, err, sizeof err) != VW_OK)
         rc = VW_EXIT_USAGE;
     if ((rc = vw_cli_agree(CMD, rc, err, sizeof err)) != VW_EXIT_OK) {

@@ -76,6 +76,13 @@ add_test(NAME raytrace_cli
           -P ${PROJECT_SOURCE_DIR}/tests/raytrace/cli.cmake)
 set_tests_properties(raytrace_cli PROPERTIES ENVIRONMENT "${VW_RT_TSAN}")
 
+# vwalls bench: a row per configuration in order, the images checked identical (a
+# difference fails it), bad options refused with nothing written (tests/raytrace/cli_bench.sh).
+add_test(NAME raytrace_cli_bench
+         COMMAND sh ${PROJECT_SOURCE_DIR}/tests/raytrace/cli_bench.sh $<TARGET_FILE:vwalls_tool>
+                 ${CMAKE_CURRENT_BINARY_DIR}/raytrace_cli_bench)
+set_tests_properties(raytrace_cli_bench PROPERTIES ENVIRONMENT "${VW_RT_TSAN}" TIMEOUT 120)
+
 # bench/raytrace.sh: Embree's raw ray-casting rate for the same rays (the kernel limit).
 if(EXISTS ${PROJECT_SOURCE_DIR}/bench/embree_raw.c)
   add_executable(vw_bench_embree_raw ${PROJECT_SOURCE_DIR}/bench/embree_raw.c)
@@ -113,4 +120,11 @@ if(VW_HAVE_MPI AND MPIEXEC_EXECUTABLE)
             -P ${PROJECT_SOURCE_DIR}/tests/raytrace/mpi.cmake)
   set_tests_properties(raytrace_mpi PROPERTIES LABELS "mpi" TIMEOUT 120 PROCESSORS 2
     ENVIRONMENT "${VW_MPI_ENV};${VW_RT_TSAN}")
+  # vwalls bench under mpirun: the same checks, the table from the first process only.
+  add_test(NAME raytrace_cli_bench_mpi
+           COMMAND sh ${PROJECT_SOURCE_DIR}/tests/raytrace/cli_bench.sh $<TARGET_FILE:vwalls_tool>
+                   ${CMAKE_CURRENT_BINARY_DIR}/raytrace_cli_bench_mpi
+                   "${MPIEXEC_EXECUTABLE} ${MPIEXEC_NUMPROC_FLAG} 2 ${VW_MPI_PREFLAGS}")
+  set_tests_properties(raytrace_cli_bench_mpi PROPERTIES LABELS "mpi" TIMEOUT 240 PROCESSORS 2
+    ENVIRONMENT "${VW_MPI_ENV}")
 endif()

@@ -14,6 +14,7 @@ int vw_cmd_info(int argc, char **argv);
 int vw_cmd_radiosity(int argc, char **argv);
 int vw_cmd_animate(int argc, char **argv);
 int vw_cmd_edit(int argc, char **argv);
+int vw_cmd_bench(int argc, char **argv);
 /* The session of animate and edit (cmd_animate.c); cmd is "animate" or "edit". */
 int vw_anim_main(const char *cmd, int argc, char **argv);
 

@@ -25,6 +25,7 @@ static const vw_command commands[] = {
     {"radiosity", vw_cmd_radiosity, "progressive radiosity of an OBJ, NFF or PLY scene, distributed over cells"},
     {"animate", vw_cmd_animate, "run an edit script on a scene: collision-checked moves, a frame per 'frame'"},
     {"edit", vw_cmd_edit, "the edit language interactively from stdin"},
+    {"bench", vw_cmd_bench, "how the ray tracer scales here: layouts x workers side by side, same image"},
 };
 
 static void usage(FILE *f)

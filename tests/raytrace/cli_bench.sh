@@ -1,0 +1,56 @@
+#!/bin/sh
+# cli_bench.sh - vwalls bench: every configuration (layouts x worker counts) renders, the
+# table has a row for each in order, the first row is the reference (speedup 1), the
+# images are checked identical (and a difference, forced with VW_FAULT=bench-mismatch,
+# fails the command with status 1 and no CSV); bad options are usage errors (status 2)
+# that write nothing.
+# usage: cli_bench.sh VWALLS TMPDIR ["LAUNCHER -n 2 ..."]
+set -u
+V=$(cd "$(dirname "$1")" && pwd)/$(basename "$1") T=$2 L=${3:-}
+rm -rf "$T" && mkdir -p "$T" && cd "$T" || exit 1
+fail() { echo "FAIL: $*"; exit 1; }
+# shellcheck disable=SC2086
+run() { $L "$V" bench "$@"; }
+
+run --size 32x24 --repeat 2 --cells 1,2x2x2,3x1x2 --workers 1,2 --csv t.csv > out.txt 2> err.txt
+rc=$?
+[ "$rc" -eq 0 ] || { cat out.txt err.txt; fail "bench: status $rc"; }
+cat out.txt
+grep -q '^images: identical in all 6 configurations' out.txt || fail "no 'images: identical' line"
+[ "$(wc -l < t.csv)" -eq 7 ] || fail "CSV: $(wc -l < t.csv) lines, expected a header and 6 rows"
+head -1 t.csv | grep -q '^cells,cell_count,workers,copies,build_s,compute_s,speedup,' ||
+  fail "CSV header: $(head -1 t.csv)"
+# The rows in the order given: every layout with every worker count.
+got=$(sed 1d t.csv | cut -d, -f1,2 | tr '\n' ' ')
+[ "$got" = "1,1 1,1 2x2x2,8 2x2x2,8 3x1x2,6 3x1x2,6 " ] || fail "CSV rows: $got"
+# The first row is the reference, and a ray visits at least one cell.
+sed -n 2p t.csv | awk -F, '$7 != 1 || $8 != 1 || $9 != 1 { exit 1 }' || fail "first row: $(sed -n 2p t.csv)"
+sed 1d t.csv | awk -F, '$11 < 1 { exit 1 }' || fail "visits per ray below 1"
+# One cell visits one cell per ray; 2x2x2 more.
+sed -n 2p t.csv | awk -F, '$11 != 1 { exit 1 }' || fail "1 cell: visits per ray not 1"
+sed -n 4p t.csv | awk -F, '$11 <= 1 { exit 1 }' || fail "2x2x2: visits per ray not above 1"
+
+# A configuration whose image differs: status 1, named, no CSV.
+VW_FAULT=bench-mismatch run --size 16x16 --repeat 1 --cells 1,2x2x2 --workers 1 --csv m.csv \
+  > out.txt 2> err.txt
+rc=$?
+[ "$rc" -eq 1 ] || { cat out.txt err.txt; fail "mismatch: status $rc, expected 1"; }
+grep -q 'vwalls bench: cells 2x2x2 on 1 worker rendered another image than the first configuration' err.txt ||
+  { cat err.txt; fail "mismatch: no message"; }
+[ ! -e m.csv ] || fail "mismatch: the CSV was written"
+
+# Usage errors: status 2, a message, nothing written.
+for bad in "--cells 1,,2" "--cells 0" "--cells ," "--workers 0" "--workers 1,x" "--repeat 0" \
+           "--repeat 101" "--size 0x4" "--depth 65" "--farm most" "--bogus" "a.nff b.nff" \
+           "missing.nff"; do
+  # shellcheck disable=SC2086
+  run $bad --csv u.csv > out.txt 2> err.txt
+  rc=$?
+  [ "$rc" -eq 2 ] || { cat out.txt err.txt; fail "bench $bad: status $rc, expected 2"; }
+  [ -s err.txt ] || fail "bench $bad: no message"
+  [ ! -e u.csv ] || fail "bench $bad: the CSV was written"
+done
+# More configurations than the table takes.
+run --cells 1,2,3,4,5,6,7,8,9 --workers 1,2,3,4,5,6,7,8 > out.txt 2> err.txt
+[ $? -eq 2 ] && grep -q '72 configurations' err.txt || { cat err.txt; fail "72 configurations accepted"; }
+echo ok

@@ -203,6 +203,20 @@ const char *vw_cli_value(const char *cmd, int argc, char **argv, int *i)
     return argv[++*i];
 }
 
+int vw_cli_scene_arg(const char *cmd, const char *a, const char **scene)
+{
+    if (a[0] == '-' && a[1]) {
+        vw_cli_error(cmd, "unknown option '%s' (try --help)", a);
+        return -1;
+    }
+    if (*scene) {
+        vw_cli_error(cmd, "more than one scene: '%s' and '%s'", *scene, a);
+        return -1;
+    }
+    *scene = a;
+    return 0;
+}
+
 const char *vw_cli_output(const char *cmd, int argc, char **argv, int *i)
 {
     const char *v = vw_cli_value(cmd, argc, argv, i);

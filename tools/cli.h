@@ -47,6 +47,10 @@ int vw_cli_frame_pattern(const char *cmd, const char *opt, const char *s);
 /* The value after option argv[*i] (advancing *i), or an error and NULL: when there is
    none, or it is an option itself ("--stats --quiet"). */
 const char *vw_cli_value(const char *cmd, int argc, char **argv, int *i);
+/* An argument that no option of the command took: the scene when it is the first such
+   one (*scene NULL), else "vwalls CMD: more than one scene: ..." or, for what looks
+   like an option ("-x", not "-"), "unknown option '-x' (try --help)", and -1. */
+int vw_cli_scene_arg(const char *cmd, const char *a, const char **scene);
 /* The same for an option naming an output file: an empty name is an error too
    ("vwalls CMD: -o: empty file name"), caught with the other usage errors instead of
    when the file is written. */

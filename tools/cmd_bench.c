@@ -260,13 +260,7 @@ int vw_cmd_bench(int argc, char **argv)
                 return VW_EXIT_USAGE;
         } else if (!strcmp(a, "--csv")) {
             if (!(csv = vw_cli_output(CMD, argc, argv, &i))) return VW_EXIT_USAGE;
-        } else if (a[0] == '-' && a[1]) {
-            vw_cli_error(CMD, "unknown option '%s' (try --help)", a);
-            return VW_EXIT_USAGE;
-        } else if (!scene_path) {
-            scene_path = a;
-        } else {
-            vw_cli_error(CMD, "more than one scene: '%s' and '%s'", scene_path, a);
+        } else if (vw_cli_scene_arg(CMD, a, &scene_path)) {
             return VW_EXIT_USAGE;
         }
     }

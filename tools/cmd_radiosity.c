@@ -350,13 +350,7 @@ int vw_cmd_radiosity(int argc, char **argv)
         } else if (!strcmp(a, "--resume")) {
             VALUE();
             o.resume = v;
-        } else if (a[0] == '-' && a[1]) {
-            vw_cli_error(CMD, "unknown option '%s' (try --help)", a);
-            return VW_EXIT_USAGE;
-        } else if (!scene_path) {
-            scene_path = a;
-        } else {
-            vw_cli_error(CMD, "more than one scene: '%s' and '%s'", scene_path, a);
+        } else if (vw_cli_scene_arg(CMD, a, &scene_path)) {
             return VW_EXIT_USAGE;
         }
 #undef VALUE

@@ -366,13 +366,7 @@ int vw_cmd_render(int argc, char **argv)
             if (!(v = vw_cli_value(CMD, argc, argv, &i)) || vw_cli_angle(CMD, a, v, &angle))
                 return VW_EXIT_USAGE;
             has_angle = 1;
-        } else if (a[0] == '-' && a[1]) {
-            vw_cli_error(CMD, "unknown option '%s' (try --help)", a);
-            return VW_EXIT_USAGE;
-        } else if (!scene_path) {
-            scene_path = a;
-        } else {
-            vw_cli_error(CMD, "more than one scene: '%s' and '%s'", scene_path, a);
+        } else if (vw_cli_scene_arg(CMD, a, &scene_path)) {
             return VW_EXIT_USAGE;
         }
     }

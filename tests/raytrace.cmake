@@ -12,6 +12,7 @@ add_test(NAME raytrace_scale COMMAND vw_test_raytrace scale)
 add_test(NAME raytrace_analytic COMMAND vw_test_raytrace analytic)
 # The eye rays span the NFF angle, up to the reader's limit of 180 degrees.
 add_test(NAME raytrace_view COMMAND vw_test_raytrace view)
+add_test(NAME raytrace_hitcells COMMAND vw_test_raytrace hitcells)
 # The same scene 1e10 times its size from the origin: Embree sees it measured from the
 # world box's centre (rt_float_frame; at 1e5 it was 76/255 off, at 1e8 178/255), and a
 # shadow ray starts clear of its own surface by more than the doubles' rounding there

@@ -45,8 +45,9 @@ static void help(void)
            "                   as NFF gives a light without one; a colour is taken as an\n"
            "                   NFF 'l' takes it (negative darkens)\n"
            "  --stats FILE     write the stats JSON\n"
-           "  --overlay FILE   write a PNG of the image with the walls drawn and each cell's\n"
-           "                   pixels tinted by its measured load (green light .. red heavy)\n"
+           "  --overlay FILE   write a PNG of the image with the walls drawn and each pixel\n"
+           "                   tinted by the measured load of the cell where its eye ray\n"
+           "                   hit (green light .. red heavy; no tint where it hit nothing)\n"
            "  --balance S      none|tensor|rotate|staggered|divide|duplicate: a sparse pre-pass\n"
            "                   measures where the work lies, the balancer moves the walls (or,\n"
            "                   duplicate, copies overloaded cells to idle workers, which share\n"
@@ -79,9 +80,11 @@ static void help(void)
            "                   turns other copies of its cell (on any process) have not\n"
            "                   taken; off: every copy makes exactly its share; auto: on\n"
            "                   when a process has no more workers than cores\n"
-           "  --overlay-by B   load (default): each cell by its measured load; worker: each\n"
-           "                   pixel by the worker that made its eye ray (farmed cells show\n"
-           "                   their copies' turns)\n"
+           "  --overlay-by B   load (default): each pixel by the load of the cell its eye\n"
+           "                   ray hit in; entry: by the load of the cell where its eye ray\n"
+           "                   entered the world (the cells' primary pixels: the viewport's\n"
+           "                   projection onto the cells); worker: by the worker that made\n"
+           "                   its eye ray (farmed cells show their copies' turns)\n"
            "  --progress       the progress bar even when stderr is no terminal (mpirun)\n"
            "  -q, --quiet      no progress bar and no summary\n"
            "  --help           this text\n"
@@ -226,7 +229,7 @@ int vw_cmd_render(int argc, char **argv)
     int farm = -1, farm_copies = 0; /* -1: auto, resolved once the options are read */
     int steal = -1;                 /* vw_config.steal: -1 auto, 1 on, 0 off */
     vw_map_kind map = VW_MAP_BLOCK;
-    int map_given = 0, balance_given = 0, by_worker = 0, by_given = 0;
+    int map_given = 0, balance_given = 0, by_worker = 0, by_entry = 0, by_given = 0;
     const char *tuning = NULL; /* a pre-pass option given: it needs --balance or --map */
     long iters = 2, prepass = 0; /* 0: rt_prepass_stride() */
     vw_load_spec lspec;
@@ -317,11 +320,12 @@ int vw_cmd_render(int argc, char **argv)
             }
         } else if (!strcmp(a, "--overlay-by")) {
             if (!(v = vw_cli_value(CMD, argc, argv, &i))) return VW_EXIT_USAGE;
-            if (strcmp(v, "load") && strcmp(v, "worker")) {
-                vw_cli_error(CMD, "--overlay-by: bad value '%s' (expected load or worker)", v);
+            if (strcmp(v, "load") && strcmp(v, "entry") && strcmp(v, "worker")) {
+                vw_cli_error(CMD, "--overlay-by: bad value '%s' (expected load, entry or worker)", v);
                 return VW_EXIT_USAGE;
             }
             by_worker = !strcmp(v, "worker");
+            by_entry = !strcmp(v, "entry");
             by_given = 1;
         } else if (!strcmp(a, "--from")) {
             if (vw_cli_numbers(CMD, a, vw_cli_value(CMD, argc, argv, &i), "X,Y,Z", from, 3, 3,
@@ -589,12 +593,16 @@ int vw_cmd_render(int argc, char **argv)
         vw_world_add_time(w, "balance", vw_cli_now() - tb0 - vw_world_time(w, "balance"));
     }
     double t_build0 = vw_cli_now();
-    /* The worker map is the output process's alone: all stop if it has no room for it,
-       or the others would wait for it in the farming and the commit. */
+    /* The worker and cell maps are the output process's alone: all stop if it has no
+       room for one, or the others would wait for it in the farming and the commit. */
     if (overlay && by_worker &&
         (vw_cli_fault("eye-workers-nomem") && rt_job_is_output(job) ? VW_E_NOMEM
                                                                      : rt_job_record_eye_workers(job)) != VW_OK)
         rc = vw_cli_fail(CMD, VW_EXIT_FAIL, err, sizeof err, "out of memory for the overlay's worker map");
+    if (overlay && !by_worker && !by_entry &&
+        (vw_cli_fault("hit-cells-nomem") && rt_job_is_output(job) ? VW_E_NOMEM
+                                                                   : rt_job_record_hit_cells(job)) != VW_OK)
+        rc = vw_cli_fail(CMD, VW_EXIT_FAIL, err, sizeof err, "out of memory for the overlay's cell map");
     if ((rc = vw_cli_agree(CMD, rc, err, sizeof err)) != VW_EXIT_OK) {
         rt_job_free(job);
         free(speeds), free(slowdown);

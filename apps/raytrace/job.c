@@ -34,6 +34,7 @@ void rt_job_free(rt_job *j)
     free(j->sh.lights);
     free(j->sh.accum);
     free(j->sh.eye_worker);
+    free(j->sh.hit_cell);
     free(j->owner);
     free(j->owner_first);
     free(j->owner_pixels);
@@ -472,6 +473,8 @@ vw_status rt_job_reset(rt_job *j)
 {
     if (j->sh.accum)
         memset(j->sh.accum, 0, sizeof *j->sh.accum * (size_t)j->sh.view.width * j->sh.view.height);
+    if (j->sh.hit_cell)
+        for (size_t i = 0; i < (size_t)j->sh.view.width * j->sh.view.height; i++) j->sh.hit_cell[i] = -1;
     /* Each process computes the owners: all fail, or none waits for one in the
        collective step that follows (a commit, a redecomposition). */
     char msg[64] = "";
@@ -588,10 +591,11 @@ void rt_job_overlay(const rt_job *j, uint8_t *out)
         minl = fmin(minl, load[c]);
     }
     /* Tint: green for the lightest cell, red for the heaviest, half-transparent. */
-    if (j->owner)
+    const int *cell = j->sh.hit_cell ? j->sh.hit_cell : j->owner;
+    if (cell)
         for (size_t i = 0; i < (size_t)w * h; i++) {
-            int c = j->owner[i];
-            if (c < 0) continue;
+            int c = cell[i];
+            if (c < 0 || c >= nc) continue;
             double f = maxl > minl ? (load[c] - minl) / (maxl - minl) : 0.0;
             double tint[3] = {255.0 * f, 255.0 * (1.0 - f), 0.0};
             for (int k = 0; k < 3; k++)
@@ -599,6 +603,17 @@ void rt_job_overlay(const rt_job *j, uint8_t *out)
         }
     free(load);
     draw_walls(j, out);
+}
+
+vw_status rt_job_record_hit_cells(rt_job *j)
+{
+    j->sh.record_hit_cells = 1;
+    if (!j->sh.accum || j->sh.hit_cell) return VW_OK; /* (output process only) */
+    size_t np = (size_t)j->sh.view.width * (size_t)j->sh.view.height;
+    j->sh.hit_cell = malloc(np * sizeof *j->sh.hit_cell);
+    if (!j->sh.hit_cell) return VW_E_NOMEM;
+    for (size_t i = 0; i < np; i++) j->sh.hit_cell[i] = -1;
+    return VW_OK;
 }
 
 vw_status rt_job_record_eye_workers(rt_job *j)

@@ -41,6 +41,8 @@ typedef struct rt_ray {
 #define RT_F_PRIMARY 1 /* this entry ends an eye ray (progress counting) */
 #define RT_F_WORKER 2  /* no colour: worker flags >> 8 made the pixel's eye ray
                           (rt_shared.record_eye_workers) */
+#define RT_F_CELL 4    /* with RT_F_PRIMARY: the eye ray hit in cell flags >> 8
+                          (rt_shared.record_hit_cells) */
 typedef struct rt_entry {
     int64_t rgb[3];
     int32_t pixel, flags;
@@ -140,6 +142,7 @@ static void output_pixels(void *user, const void *msg)
                 (int64_t)((uint64_t)sh->accum[e->pixel][k] + (uint64_t)e->rgb[k]);
         primary += e->flags & RT_F_PRIMARY;
         if ((e->flags & RT_F_WORKER) && sh->eye_worker) sh->eye_worker[e->pixel] = e->flags >> 8;
+        if ((e->flags & RT_F_CELL) && sh->hit_cell) sh->hit_cell[e->pixel] = e->flags >> 8;
     }
     if (primary) atomic_fetch_add(&sh->pixels_done, primary);
     atomic_fetch_add(&sh->entries, n);
@@ -256,7 +259,10 @@ static void shade(vw_ctx *ctx, rt_cell *c, const rt_ray *r, const rt_hit *h)
 
     double local[3] = {0, 0, 0};
     for (int k = 0; k < 3; k++) local[k] = r->weight[k] * m->emission[k];
-    emit(ctx, c, r->pixel, local, r->kind == RT_EYE ? RT_F_PRIMARY : 0);
+    int flags = 0;
+    if (r->kind == RT_EYE)
+        flags = RT_F_PRIMARY | (sh->record_hit_cells ? RT_F_CELL | vw_ctx_cell(ctx) << 8 : 0);
+    emit(ctx, c, r->pixel, local, flags);
 
     int has_spec = m->specular[0] > 0 || m->specular[1] > 0 || m->specular[2] > 0;
     for (int i = 0; i < sh->nlights; i++) {

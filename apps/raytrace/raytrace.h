@@ -142,10 +142,16 @@ typedef struct rt_shared {
     /* Every process: record which worker makes each eye ray (rt_job_record_eye_workers):
        the cell sends it to the output process with the pixel's contributions. */
     int record_eye_workers;
+    /* Every process: send the cell where each eye ray hits (rt_job_record_hit_cells)
+       with the pixel's contributions. */
+    int record_hit_cells;
     /* Output process only: */
     int64_t (*accum)[3];        /* width*height fixed-point sums */
     int *eye_worker;            /* width*height, when recorded: the worker that made the
                                    pixel's eye ray in the last run, -1 = none */
+    int *hit_cell;              /* width*height, when recorded: the cell where the pixel's
+                                   eye ray hit in the last run, -1 = none (it left the
+                                   world, or missed it) */
     /* The counters below are written while every worker reads the fields above for
        every ray: each gets a cache line of its own, or the writes would bounce the
        read-mostly line between cores. */
@@ -272,6 +278,10 @@ vw_status rt_job_record_eye_workers(rt_job *j);
 int rt_job_eye_workers(const rt_job *j, int *worker);
 /* The overlay variant that tints each pixel by that worker. */
 void rt_job_overlay_workers(const rt_job *j, uint8_t *out);
+/* Record the cell where each eye ray hits in the runs that follow (for rt_job_overlay:
+   its tint then follows the visible surfaces' cells). Before rt_job_run; on every
+   process. VW_E_NOMEM when the output process has no room for the map. */
+vw_status rt_job_record_hit_cells(rt_job *j);
 /* ---- load balancing (apps/raytrace/balance.c) ---------------------------------------- */
 
 typedef struct rt_balance {
@@ -333,8 +343,11 @@ const int64_t *rt_job_sums(const rt_job *j);
 /* 8-bit RGB (clamp(sum / 2^32) * 255, rounded half up) and float RGB (sum / 2^32). */
 void rt_job_rgb8(const rt_job *j, uint8_t *out);
 void rt_job_rgbf(const rt_job *j, float *out);
-/* The overlay picture: the image with each cell's primary pixels tinted by the cell's
-   measured load (green = lightest, red = heaviest) and the cell walls drawn. */
+/* The overlay picture: the image with the cell walls drawn and each pixel tinted by
+   the measured load of a cell (green = lightest, red = heaviest): the cell where its
+   eye ray hit, when recorded (rt_job_record_hit_cells; a pixel whose ray hit nothing
+   is not tinted), else the cell where its eye ray entered the world (its primary
+   pixels, the viewport's projection onto the cells). */
 void rt_job_overlay(const rt_job *j, uint8_t *out);
 /* The "rays" and per-cell pixel members for the stats JSON (malloc'ed string). */
 char *rt_job_stats_json(const rt_job *j);

@@ -5,7 +5,8 @@
 #   * a camera override that is bad only against one host's copy of the scene (--at at
 #     that copy's eye);
 #   * memory for --speeds that one rank lacks (VW_FAULT=speeds-nomem there alone);
-#   * memory for --overlay-by worker's map, kept by rank 0 alone (VW_FAULT=eye-workers-nomem);
+#   * memory for --overlay-by worker's map, kept by rank 0 alone (VW_FAULT=eye-workers-nomem),
+#     and for --overlay's map of the cells where eye rays hit (VW_FAULT=hit-cells-nomem);
 #   * a radiosity --image larger than allowed by one host's copy of the scene;
 #   * memory for the spheres of example-pairs and example-components on rank 1
 #     (VW_FAULT=spheres-nomem), for animate's frame records (VW_FAULT=frames-nomem).
@@ -60,6 +61,10 @@ run "render, no memory for the worker map (rank 0 alone keeps it)" 1 \
     env VW_FAULT=eye-workers-nomem "$vwalls" render "$scene" -o "$dir/r.png" --overlay "$dir/o.png" \
     --overlay-by worker $common
 [ ! -e "$dir/r.png" ] || { echo "FAIL: render, worker map: output written"; fail=1; }
+run "render, no memory for the hit-cell map (rank 0 alone keeps it)" 1 \
+    "^vwalls render: rank 0: out of memory for the overlay's cell map" \
+    env VW_FAULT=hit-cells-nomem "$vwalls" render "$scene" -o "$dir/r.png" --overlay "$dir/o.png" $common
+[ ! -e "$dir/r.png" ] || { echo "FAIL: render, hit-cell map: output written"; fail=1; }
 
 "$vwalls" gen cornell -o "$dir/c0.nff" || fail=1
 sed 's/^resolution .*/resolution 20000 20000/' "$dir/c0.nff" >"$dir/c1.nff"

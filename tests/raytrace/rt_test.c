@@ -10,6 +10,7 @@
  *                         the float frame a job picks (rt_float_frame_of)
  *   watertight            rays aimed at a mesh's shared edges and vertices hit it
  *   concave SCENE         each polygon's triangle records cover it and nothing else
+ *   hitcells              the overlay's map of the cells where eye rays hit
  *   view                  the eye rays span the angle an NFF 'v' block gives, all of
  *                         the range the reader accepts (0..180 degrees)
  *   illum SCENE.obj       MTL illum decides the mirror ray: tests/data/good/illum.obj's
@@ -445,6 +446,79 @@ static int test_view(void)
     return vw_test_failures ? 1 : 0;
 }
 
+/* The overlay's cells (rt_job_record_hit_cells): two spheres, one each side of the
+   wall of a 2x1x1 layout, seen from outside the world box and from inside it. A pixel
+   through a sphere's centre is tinted by that sphere's cell, a corner pixel that sees
+   nothing by none (-1), and the map is the same on 1 worker and on 2 (farmed or
+   mapped). With the eye inside the box the cells where eye rays enter (rt_job's owner
+   map) are one cell for every pixel, and the hits still show both. */
+static int test_hitcells(void)
+{
+    /* From outside; and from inside the cell x < 0, near the box's -y face, with a
+       wide view that takes in both spheres. */
+    static const char *const eyes[] = {"0 -6 0 at 0 0 0 up 0 0 1 angle 60",
+                                       "-0.2 -0.45 0 at -0.2 1 0 up 0 0 1 angle 150"};
+    for (int e = 0; e < 2; e++) {
+        char nff[512], err[256];
+        int len = snprintf(nff, sizeof nff,
+                           "v from %s hither 0.01 resolution 64 64\n"
+                           "l 0 -10 10\nf 1 1 1 1 0 0 0 1\ns -1 0 0 0.5\ns 1 0 0 0.5\n",
+                           eyes[e]);
+        vw_scene *s;
+        CHECK(vw_scene_read_nff("hit.nff", nff, (size_t)len, &s, err, sizeof err) == VW_OK);
+        int *first = NULL;
+        for (int run = 0; run < 3; run++) {
+            static const int workers[] = {1, 2, 2};
+            static const rt_farm farms[] = {RT_FARM_NONE, RT_FARM_NONE, RT_FARM_ALL};
+            rt_params p;
+            memset(&p, 0, sizeof p);
+            p.width = p.height = 64;
+            p.dims[0] = 2, p.dims[1] = p.dims[2] = 1;
+            p.workers = workers[run];
+            rt_job *j;
+            CHECK(rt_job_create(s, &p, &j, err, sizeof err) == VW_OK);
+            CHECK(rt_job_record_hit_cells(j) == VW_OK && rt_job_farm(j, farms[run], NULL, err, sizeof err) == VW_OK &&
+                  rt_job_commit(j, err, sizeof err) == VW_OK && rt_job_run(j, err, sizeof err) == VW_OK);
+            const rt_shared *sh = rt_job_shared(j);
+            const vw_decomp *d = vw_world_decomp(rt_job_world(j));
+            CHECK(sh->hit_cell != NULL);
+            /* The pixels through the spheres' centres, and a corner. */
+            for (int k = 0; k < 2; k++) {
+                double c[3] = {k ? 1.0 : -1.0, 0, 0}, x, y;
+                CHECK(rt_view_project(&sh->view, c, &x, &y));
+                int px = (int)y * 64 + (int)x, want = vw_decomp_locate(d, c, NULL);
+                EXPECT(sh->hit_cell[px] == want, "eye %s, run %d: sphere %d's pixel tinted by cell %d, "
+                       "expected %d", eyes[e], run, k, sh->hit_cell[px], want);
+            }
+            EXPECT(sh->hit_cell[0] == -1, "eye %s: a corner that sees nothing tinted by cell %d",
+                   eyes[e], sh->hit_cell[0]);
+            if (!first) {
+                first = malloc(64 * 64 * sizeof *first);
+                CHECK(first != NULL);
+                memcpy(first, sh->hit_cell, 64 * 64 * sizeof *first);
+            } else {
+                EXPECT(!memcmp(first, sh->hit_cell, 64 * 64 * sizeof *first),
+                       "eye %s: another map of hit cells on %d workers, farm %d", eyes[e],
+                       workers[run], (int)farms[run]);
+            }
+            if (e == 1) { /* inside: one cell makes every eye ray */
+                int cells_entered = 0, seen[2] = {0, 0};
+                for (int i = 0; i < 64 * 64; i++)
+                    if (sh->owner[i] >= 0 && sh->owner[i] < 2 && !seen[sh->owner[i]]) {
+                        seen[sh->owner[i]] = 1;
+                        cells_entered++;
+                    }
+                EXPECT(cells_entered == 1, "eye inside: eye rays start in %d cells", cells_entered);
+            }
+            rt_job_free(j);
+        }
+        free(first);
+        vw_scene_free(s);
+    }
+    printf("hitcells: 2 eyes x 3 runs\n");
+    return vw_test_failures ? 1 : 0;
+}
+
 /* tests/data/good/illum.obj: strips on the floor y = 0 (x in [-3,-1]: illum 2, [-1,1]:
    illum 3, [1,3]: no illum; each Kd 0, Ks 0.5) before a wall at z = -5 that glows 1 and
    reflects nothing. A floor pixel whose mirror ray meets the wall shows 0.5 where the
@@ -853,6 +927,7 @@ int main(int argc, char **argv)
     if (argc >= 2 && !strcmp(argv[1], "cone")) return test_cone();
     if (argc >= 2 && !strcmp(argv[1], "scale")) return test_scale();
     if (argc >= 2 && !strcmp(argv[1], "view")) return test_view();
+    if (argc >= 2 && !strcmp(argv[1], "hitcells")) return test_hitcells();
     if (argc >= 3 && !strcmp(argv[1], "illum")) return test_illum(argv[2]);
     if (argc >= 2 && !strcmp(argv[1], "watertight")) return test_watertight();
     if (argc >= 3 && !strcmp(argv[1], "concave")) return test_concave(argv[2]);

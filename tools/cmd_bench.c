@@ -194,19 +194,20 @@ static vw_status run_one(const vw_scene *scene, const vw_camera *cam, int width,
     c->cells = vw_decomp_cell_count(vw_world_decomp(w));
     c->copies = rt_job_farm_copies(job);
     c->all_workers = vw_world_workers(w) * vw_world_processes(w);
+    st = VW_OK;
     if (rt_job_is_output(job)) {
         const rt_shared *sh = rt_job_shared(job);
         size_t n = (size_t)sh->view.width * (size_t)sh->view.height * 3;
         const int64_t *sums = rt_job_sums(job);
         if (!*ref) {
-            *ref = malloc(n * sizeof **ref);
-            if (!*ref) {
+            *ref = vw_cli_fault("bench-nomem") ? NULL : malloc(n * sizeof **ref);
+            if (*ref) {
+                memcpy(*ref, sums, n * sizeof **ref);
+                *nref = n;
+            } else {
                 snprintf(err, errlen, "out of memory for the reference image");
-                rt_job_free(job);
-                return VW_E_NOMEM;
+                st = VW_E_NOMEM;
             }
-            memcpy(*ref, sums, n * sizeof **ref);
-            *nref = n;
         } else {
             for (size_t i = 0; i < n && i < *nref; i++)
                 /* VW_FAULT=bench-mismatch (tests): the last configuration's last pixel
@@ -217,8 +218,11 @@ static vw_status run_one(const vw_scene *scene, const vw_camera *cam, int width,
                 }
         }
     }
+    /* The output process alone kept the image: all stop if it could not, or the others
+       would wait for it in the next render. */
+    st = vw_world_agree(rt_job_world(job), st, err, errlen);
     rt_job_free(job);
-    return VW_OK;
+    return st;
 }
 
 int vw_cmd_bench(int argc, char **argv)

@@ -2,8 +2,9 @@
 # cli_bench.sh - vwalls bench: every configuration (layouts x worker counts) renders, the
 # table has a row for each in order, the first row is the reference (speedup 1), the
 # images are checked identical (and a difference, forced with VW_FAULT=bench-mismatch,
-# fails the command with status 1 and no CSV); bad options are usage errors (status 2)
-# that write nothing.
+# fails the command with status 1 and no CSV); no memory for the reference image stops
+# every process (VW_FAULT=bench-nomem); bad options are usage errors (status 2) that
+# write nothing.
 # usage: cli_bench.sh VWALLS TMPDIR ["LAUNCHER -n 2 ..."]
 set -u
 V=$(cd "$(dirname "$1")" && pwd)/$(basename "$1") T=$2 L=${3:-}
@@ -38,6 +39,16 @@ rc=$?
 grep -q 'vwalls bench: cells 2x2x2 on 1 worker rendered another image than the first configuration' err.txt ||
   { cat err.txt; fail "mismatch: no message"; }
 [ ! -e m.csv ] || fail "mismatch: the CSV was written"
+
+# No memory for the reference image, which the output process alone keeps: every
+# process stops (under MPI the others used to wait for it in the next render).
+# shellcheck disable=SC2086
+VW_FAULT=bench-nomem timeout 60 $L "$V" bench --size 16x16 --repeat 1 --cells 1,2 --workers 1 \
+  --csv n.csv > out.txt 2> err.txt
+rc=$?
+[ "$rc" -eq 1 ] || { cat out.txt err.txt; fail "no memory: status $rc, expected 1"; }
+grep -q 'out of memory for the reference image' err.txt || { cat err.txt; fail "no memory: no message"; }
+[ ! -e n.csv ] || fail "no memory: the CSV was written"
 
 # Usage errors: status 2, a message, nothing written.
 for bad in "--cells 1,,2" "--cells 0" "--cells ," "--workers 0" "--workers 1,x" "--repeat 0" \

@@ -365,7 +365,8 @@ static void test_agree(int bad)
     if (bad < size) {
         CHECK_EQ_INT(st, VW_E_INPUT);
         char want[256];
-        snprintf(want, sizeof want, size > 1 ? "rank %d: scene.nff:3: bad number 'x'"
+        /* Under MPI the rank follows the FILE:LINE: of bad input, which stays first. */
+        snprintf(want, sizeof want, size > 1 ? "scene.nff:3: rank %d: bad number 'x'"
                                              : "scene.nff:3: bad number 'x'", bad);
         if (strcmp(msg, want) != 0) {
             fprintf(stderr, "rank %d: agreed message '%s', expected '%s'\n", rank, msg, want);

@@ -114,7 +114,9 @@ typedef struct vw_balance_params {
     const double *speeds; /* relative worker speeds (gworkers entries) or NULL; rotate
                            judges its frames by the lambda of their cells mapped by speed */
     double tolerance;   /* divide / duplicate: stop at lambda <= 1 + tolerance (0.03) */
-    int max_extra;      /* divide: at most this many extra cells (0: 4 * gworkers) */
+    int max_extra;      /* divide: at most this many extra cells (0: 4 * gworkers);
+                           duplicate: at most this many copies (0: 4 * gworkers, or one
+                           a cell where the cells are more, up to 1024) */
 } vw_balance_params;
 
 VW_API void vw_balance_params_init(vw_balance_params *p);

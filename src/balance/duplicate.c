@@ -15,7 +15,8 @@
  * equal speeds), and a worker's time is the sum of that over the cells it holds. The
  * placement itself sizes shares as L_c / k_c: the speeds of the copies still to place
  * are not known yet.
- * Cost: O(max_extra * (S log S + S * workers)) for S shares, plus cells * workers bytes.
+ * Cost: O(max_extra * (cells + S log S + S * workers)) for S shares, plus cells * workers
+ * bytes.
  */
 #include "balance/balance_internal.h"
 #include "core/world_internal.h"
@@ -61,14 +62,19 @@ vw_status vw__balance_duplicate_plan(const double *load, const int *cell_worker,
     double best = -1;
     int extra = 0;
     for (;;) {
-        /* Masters first, then the copies' shares, largest first. */
-        memset(holds, 0, (size_t)ncells * (size_t)gworkers);
+        /* Masters first, then the copies' shares, largest first. Only a copied cell's
+           row of holds is read (a cell alone is held by its master), so only those are
+           cleared and set: a round costs cells + copies x workers, not cells x workers
+           (32768 cells on 64 workers: 3.4 s for 1024 rounds, where the rows were all
+           cleared and summed each round). */
         for (int g = 0; g < gworkers; g++) t[g] = 0;
         int ns = 0;
         for (int c = 0; c < ncells; c++) {
             int g = cell_worker[c];
             if (g < 0 || g >= gworkers) continue;
             t[g] += load[c] / k[c];
+            if (k[c] < 2) continue;
+            memset(&holds[(size_t)c * gworkers], 0, (size_t)gworkers);
             holds[(size_t)c * gworkers + g] = 1;
             for (int i = 1; i < k[c]; i++) sh[ns++] = (share){load[c] / k[c], c};
         }
@@ -89,6 +95,16 @@ vw_status vw__balance_duplicate_plan(const double *load, const int *cell_worker,
         /* The placement as the runtime runs it: shares by speed. */
         for (int g = 0; g < gworkers; g++) time[g] = 0;
         for (int c = 0; c < ncells; c++) {
+            int m = cell_worker[c];
+            if (m < 0 || m >= gworkers) { /* no master: no share placed */
+                span[c] = 0;
+                continue;
+            }
+            if (k[c] < 2) { /* the master alone */
+                span[c] = load[c] / (speeds ? speeds[m] : 1.0);
+                time[m] += span[c];
+                continue;
+            }
             const unsigned char *h = &holds[(size_t)c * gworkers];
             double S = 0;
             for (int g = 0; g < gworkers; g++)

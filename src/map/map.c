@@ -100,24 +100,84 @@ static void leaf_order(const vw_kd_node *nodes, int node, int *order, int *k)
     leaf_order(nodes, nodes[node].right, order, k);
 }
 
+/* The largest block when cells are cut into d[a] parts a side (the parts of a side differ
+   by one cell at most), 0 when a side has more parts than cells (an empty block). */
+static long largest_block(const int cells[3], const int d[3])
+{
+    long m = 1;
+    for (int a = 0; a < 3; a++) {
+        if (d[a] > cells[a]) return 0;
+        m *= (cells[a] + d[a] - 1) / d[a];
+    }
+    return m;
+}
+
+/* The parts a side for n blocks of the cells: of the factorisations whose largest block is
+   the fewest cells n blocks can have (ceil(cells / n)), the one cutting fewest faces
+   (vw_map_dims' choice wherever n divides the cells evenly). 0 when no factorisation is
+   that even: a prime n over sides shorter than it, or uneven sides (8 cells 2x2x2 on 3
+   workers were 4, 4, 0; 3x3x3 on 4 were 12, 6, 6, 3); the caller cuts runs instead. */
+static int even_dims(int n, const int cells[3], int dims[3])
+{
+    long total = (long)cells[0] * cells[1] * cells[2];
+    long want = (total + n - 1) / n;
+    vw_map_dims(n, cells, dims);
+    if (largest_block(cells, dims) == want) return 1;
+    double best = INFINITY;
+    for (int a = 1; a <= n; a++) {
+        if (n % a) continue;
+        for (int b = 1; b <= n / a; b++) {
+            if ((n / a) % b) continue;
+            int d[3] = {a, b, n / a / b};
+            if (largest_block(cells, d) != want) continue;
+            double score = 0;
+            for (int x = 0; x < 3; x++)
+                score += (d[x] - 1) * (double)cells[(x + 1) % 3] * cells[(x + 2) % 3];
+            if (score < best) {
+                best = score;
+                memcpy(dims, d, sizeof d);
+            }
+        }
+    }
+    return best < INFINITY;
+}
+
+/* A cell's place in the leaf order of a grid's kd-tree (x slabs, in each y rows, in each
+   z cells: vw_decomp_create_grid) inside the block [lo, lo + size) of the grid. */
+static long block_rank(const int ix[3], const int lo[3], const int size[3])
+{
+    return ((long)(ix[0] - lo[0]) * size[1] + (ix[1] - lo[1])) * size[2] + (ix[2] - lo[2]);
+}
+
 vw_status vw_map_block(const vw_decomp *d, int nprocs, int wpp, int *cell_worker)
 {
     if (!d || nprocs < 1 || wpp < 1 || !cell_worker) return VW_E_INVAL;
     int nc = vw_decomp_cell_count(d);
+    long g = (long)nprocs * wpp;
     if (vw_decomp_get_kind(d) != VW_DECOMP_GRID) {
         int nn, k = 0;
         const vw_kd_node *nodes = vw_decomp_nodes(d, &nn);
         int *order = malloc(sizeof(int) * (size_t)nc);
         if (!order) return VW_E_NOMEM;
         leaf_order(nodes, 0, order, &k);
-        long g = (long)nprocs * wpp;
         for (int i = 0; i < nc; i++) cell_worker[order[i]] = (int)((long)i * g / nc);
         free(order);
         return VW_OK;
     }
     int cells[3], pd[3];
     vw_decomp_dims(d, cells);
-    vw_map_dims(nprocs, cells, pd);
+    /* Blocks as even as runs would be, or runs: a block mapping that left workers empty
+       and others with twice the mean was worse than the plain one, and a balancer whose
+       walls it mapped was refused for it (tensor on 2x2x2 and 3 workers). The runs are
+       of the grid's leaf order, so each is a slab or part of one. */
+    int zero[3] = {0, 0, 0};
+    if (!even_dims(nprocs, cells, pd)) {
+        for (int c = 0; c < nc; c++) {
+            int ix[3] = {c % cells[0], (c / cells[0]) % cells[1], c / (cells[0] * cells[1])};
+            cell_worker[c] = (int)(block_rank(ix, zero, cells) * g / nc);
+        }
+        return VW_OK;
+    }
     for (int c = 0; c < nc; c++) {
         int ix[3] = {c % cells[0], (c / cells[0]) % cells[1], c / (cells[0] * cells[1])};
         int pb[3], lo[3], hi[3], sub[3], wd[3], wb[3];
@@ -128,10 +188,15 @@ vw_status vw_map_block(const vw_decomp *d, int nprocs, int wpp, int *cell_worker
             hi[a] = (int)(((long)(pb[a] + 1) * cells[a] + pd[a] - 1) / pd[a]);
             sub[a] = hi[a] - lo[a];
         }
-        vw_map_dims(wpp, sub, wd);
-        for (int a = 0; a < 3; a++) wb[a] = (int)((long)(ix[a] - lo[a]) * wd[a] / (sub[a] ? sub[a] : 1));
-        int proc = pb[0] + pd[0] * (pb[1] + pd[1] * pb[2]);
-        int local = wb[0] + wd[0] * (wb[1] + wd[1] * wb[2]);
+        int proc = pb[0] + pd[0] * (pb[1] + pd[1] * pb[2]), local;
+        if (even_dims(wpp, sub, wd)) {
+            for (int a = 0; a < 3; a++)
+                wb[a] = (int)((long)(ix[a] - lo[a]) * wd[a] / (sub[a] ? sub[a] : 1));
+            local = wb[0] + wd[0] * (wb[1] + wd[1] * wb[2]);
+        } else {
+            long n = (long)sub[0] * sub[1] * sub[2];
+            local = (int)(block_rank(ix, lo, sub) * wpp / n);
+        }
         cell_worker[c] = proc * wpp + local;
     }
     return VW_OK;

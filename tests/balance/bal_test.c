@@ -14,12 +14,16 @@
  *   rotate                the principal-axis frame of an oblique line of load is the line;
  *                         with unequal worker speeds, the frame of lowest lambda by speed
  *   map                   every cell mapped once; block keeps a hand layout's neighbour
- *                         share; weighted gives speeds 1,1,2,4 proportional load; bad
+ *                         share, and gives no worker more cells than ceil(cells / workers)
+ *                         nor none where there are enough (2x2x2 on 3 workers: 3, 3, 2,
+ *                         not 4, 4, 0); weighted gives speeds 1,1,2,4 proportional load; bad
  *                         speeds and speed lists refused; lambda never NaN
  *   duplicate             cell duplication: the same sums and exact counters with copies,
  *                         copies built from the cell's objects (and rebuilt when they
  *                         change), bad copy lists refused, and lambda of the counted work
- *                         of a 50%-clustered scene down to <= 1.10 on 8 cells
+ *                         of a 50%-clustered scene down to <= 1.10 on 8 cells; 64 cells
+ *                         on 4 workers, the load on one worker's 16: lambda 4 -> <= 1.03
+ *                         (the default cap of copies was 4 x workers: lambda 2)
  *   thin                  cells a few doubles wide (a box far from the origin for its
  *                         size): every balancer returns a decomposition round after
  *                         round, every point in a cell, and a box with too few doubles
@@ -607,6 +611,35 @@ static int t_map(void)
         for (int g = 0; g < 4; g++) EXPECT(per[g] == 2, "worker %d hosts %d cells", g, per[g]);
         vw_decomp_free(d);
     }
+    /* Block never leaves a worker (or a process) emptier than runs of cells would: no
+       worker more than ceil(cells / workers) cells, none without a cell while there are
+       enough. 2x2x2 on 3 workers was 4, 4, 0 (and a tensor balance mapped so was
+       refused); on 5, 4, 0, 4, 0, 0; 3x3x3 on 4, 12, 6, 6, 3. Where the workers divide
+       the grid evenly the blocks are as before (the 2x4 case above). */
+    {
+        static const int lay[][3] = {{2, 2, 2}, {2, 2, 2}, {2, 2, 2}, {2, 2, 2}, {3, 3, 3},
+                                     {4, 4, 4}, {4, 4, 4}, {4, 4, 1}, {2, 2, 1}, {4, 2, 2}};
+        static const int pw2[][2] = {{1, 3}, {1, 5}, {3, 1}, {2, 3}, {1, 4},
+                                     {2, 3}, {3, 2}, {1, 5}, {1, 3}, {2, 4}};
+        for (size_t i = 0; i < sizeof lay / sizeof lay[0]; i++) {
+            vw_decomp *d;
+            vw_decomp_create_grid(&world, lay[i], &d);
+            int nc = vw_decomp_cell_count(d), gw = pw2[i][0] * pw2[i][1];
+            int cw[64], per[16] = {0}, pper[16] = {0};
+            EXPECT(vw_map_block(d, pw2[i][0], pw2[i][1], cw) == VW_OK, "block");
+            for (int c = 0; c < nc; c++) per[cw[c]]++, pper[cw[c] / pw2[i][1]]++;
+            int most = (nc + gw - 1) / gw, pmost = (nc + pw2[i][0] - 1) / pw2[i][0];
+            for (int g = 0; g < gw; g++)
+                EXPECT(per[g] <= most && per[g] >= 1, "block %dx%dx%d on %d x %d: worker %d "
+                       "hosts %d cells (at most %d, at least 1)", lay[i][0], lay[i][1],
+                       lay[i][2], pw2[i][0], pw2[i][1], g, per[g], most);
+            for (int q = 0; q < pw2[i][0]; q++)
+                EXPECT(pper[q] <= pmost, "block %dx%dx%d on %d x %d: process %d hosts %d cells "
+                       "(at most %d)", lay[i][0], lay[i][1], lay[i][2], pw2[i][0], pw2[i][1],
+                       q, pper[q], pmost);
+            vw_decomp_free(d);
+        }
+    }
     /* Weighted: speeds 1,1,2,4 over 256 cells of uneven load -> shares 1/8,1/8,1/4,1/2. */
     {
         int dims[3] = {16, 16, 1};
@@ -879,6 +912,38 @@ static int t_duplicate(void)
     printf("duplicate: work lambda none %.3f, duplicate %.3f\n", lam[0], lam[1]);
     EXPECT(lam[1] <= 1.10 && lam[1] < lam[0], "duplicate lambda %.3f (none: %.3f)", lam[1], lam[0]);
     vw_scene_free(s);
+    /* Many cells on few workers: 4x4x4 on 4 workers, all the load in the 16 cells of
+       worker 3. Every one of them needs a copy on each other worker (48 copies) for
+       lambda 1; the default cap of 4 x workers (16) stopped at one copy each, lambda 2. */
+    {
+        vw_box world = {{0, 0, 0}, {1, 1, 1}};
+        int d4[3] = {4, 4, 4};
+        vw_decomp *d;
+        vw_decomp_create_grid(&world, d4, &d);
+        vw_config cfg;
+        vw_config_init(&cfg);
+        cfg.workers = 4;
+        vw_world *w;
+        EXPECT(vw_world_create(&tmodule_ind, NULL, d, &cfg, &w) == VW_OK, "create");
+        double cl[64];
+        for (int c = 0; c < 64; c++) cl[c] = c >= 48 ? 1.0 + (c % 3) : 0.0;
+        vw_load_field *f;
+        vw_load_field_create(&f);
+        vw_load_field_add_cells(f, d, cl, 4);
+        vw_balance_params p;
+        vw_balance_params_init(&p);
+        p.strategy = VW_BALANCE_DUPLICATE;
+        vw_balance_report r;
+        EXPECT(vw_balance_world(w, f, &p, NULL, &r) == VW_OK, "balance: %s", vw_world_errmsg(w));
+        printf("duplicate: 64 cells on 4 workers: lambda %.3f -> %.3f, %d copies\n",
+               r.imbalance_before, r.imbalance_predicted, r.duplicates);
+        EXPECT(r.applied && r.imbalance_before > 3.9 && r.imbalance_predicted <= 1.03,
+               "64 cells on 4 workers: lambda %.3f -> %.3f with %d copies, expected <= 1.03",
+               r.imbalance_before, r.imbalance_predicted, r.duplicates);
+        vw_load_field_free(f);
+        vw_world_free(w);
+        vw_decomp_free(d);
+    }
     return vw_test_failures ? 1 : 0;
 }
 

@@ -178,4 +178,22 @@ execute_process(COMMAND ${VWALLS} render ${SCENE} -o ${WORK}/bad.png --workers 2
 if(NOT rc EQUAL 2 OR EXISTS ${WORK}/bad.png OR NOT err MATCHES "K from 1 to 1000")
   message(FATAL_ERROR "--slow 1:2000: exit ${rc} (expected 2, naming the limit): ${err}")
 endif()
+# --map block on workers that do not cut the grid into even blocks: no worker idle, none
+# with more than ceil(cells / workers) cells (2x2x2 on 3 workers was 4, 4, 0), and the
+# same PNG.
+render(${WORK}/block3.png ${VWALLS} render ${SCENE} -o ${WORK}/block3.png ${common}
+       --cells 2x2x2 --workers 3 --farm none --map block --stats ${WORK}/block3.json)
+file(READ ${WORK}/block3.json json)
+set(per0 0)
+set(per1 0)
+set(per2 0)
+foreach(c RANGE 7)
+  string(JSON g GET "${json}" cells ${c} worker)
+  math(EXPR per${g} "${per${g}} + 1")
+endforeach()
+if(per0 GREATER 3 OR per1 GREATER 3 OR per2 GREATER 3 OR per0 EQUAL 0 OR per1 EQUAL 0
+   OR per2 EQUAL 0)
+  message(FATAL_ERROR "--map block, 2x2x2 on 3 workers: ${per0}, ${per1}, ${per2} cells "
+          "(expected at most 3 each, none idle)")
+endif()
 message(STATUS "balance_cli: every strategy and mapping gives the same PNG")

@@ -118,6 +118,15 @@ static inline size_t vw__bom_length(const char *text, size_t len)
     return len >= 3 && !memcmp(text, "\xEF\xBB\xBF", 3) ? 3 : 0;
 }
 
+/* A DOS end-of-file mark (Ctrl-Z, 0x1A) as the text's last byte is not part of it: DOS
+   editors and tools of the SPD's time ended text files with one. The NFF, OBJ and MTL
+   readers end their text before it (and the PLY reader's ASCII data); anywhere else it
+   is a control character like any other. Returns the text's length without it. */
+static inline size_t vw__text_length(const char *text, size_t len)
+{
+    return len && text[len - 1] == 0x1a ? len - 1 : len;
+}
+
 /* Reads a whole file into a NUL-terminated buffer (the NUL is not counted in *len). */
 vw_status vw__read_whole_file(const char *path, char **text, size_t *len, char *err,
                               size_t errlen);

@@ -595,7 +595,7 @@ VW_API vw_status vw_scene_read_nff(const char *name, const char *text, size_t le
     /* Offsetting a null pointer, even by zero, is undefined: use an empty text. */
     const char *t = text ? text : "";
     P.lx.p = t + vw__bom_length(t, len);
-    P.lx.end = t + len;
+    P.lx.end = t + vw__text_length(t, len);
     P.lx.line = 1;
     P.err = err;
     P.errlen = errlen;

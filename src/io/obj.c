@@ -4,8 +4,10 @@
  * have it); a backslash that ends a line joins the next one to it (the OBJ and MTL
  * specifications' continuation), and messages name the physical line of the token
  * they are about. Faces stay polygons (consumers triangulate) over the shared
- * vertex array; texture coordinates, groups, objects and smoothing are accepted and
- * ignored. OBJ has no camera and no lights: camera.valid is 0. A material library
+ * vertex array; a positive index numbers the data of the whole file, so a face may name
+ * a vertex, texture coordinate or normal defined after it (checked at the end of the
+ * file); texture coordinates, groups, objects and smoothing are accepted and ignored.
+ * OBJ has no camera and no lights: camera.valid is 0. A material library
  * that cannot be read and a usemtl name no library defines are warnings (once each),
  * and the faces get the default material, as in common OBJ tools.
  *
@@ -21,6 +23,7 @@
 #include <float.h>
 #include <limits.h>
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -57,7 +60,22 @@ typedef struct obj {
     int default_mat;
     char **warned;        /* what was warned about ("lib PATH", "mat NAME"): once each */
     size_t nwarned, cap_warned;
+    int *libs;            /* the libraries read, as strings of the scene */
+    size_t nlibs, cap_libs;
+    struct later *later;  /* the face references to data defined after them, in file order */
+    size_t nlater, cap_later;
 } obj;
+
+/* A face's reference (positive: absolute) to a vertex, texture coordinate or normal the
+   file had not defined yet: OBJ numbers its data through the whole file, and readers such
+   as Assimp and tinyobjloader take data defined after the face. Checked at the end of
+   the file; the corner's vertex index is stored as is meanwhile, its normal filled in. */
+struct later {
+    char kind;            /* 'v', 't' or 'n' */
+    int line;             /* the token's physical line, for the message */
+    long long v;          /* the index as written */
+    size_t slot;          /* 'n': the corner (index into the scene's indices) */
+};
 
 static int is_space(char c)
 {
@@ -459,7 +477,7 @@ static const char *const obj_ignored[] = {
 
 static vw_status parse_mtl(obj *O, const char *text, size_t len)
 {
-    const char *p = text + vw__bom_length(text, len), *end = text + len;
+    const char *p = text + vw__bom_length(text, len), *end = text + vw__text_length(text, len);
     vw_material *m = NULL;
     int illum = -1;   /* m's illumination model; -1 until an illum statement gives one */
     O->line = 0;
@@ -568,15 +586,14 @@ static vw_status parse_mtl(obj *O, const char *text, size_t len)
     return VW_OK;
 }
 
-static vw_status load_mtllib(obj *O, const char *dir, span fname)
+/* The path of library fname of an OBJ in dir (absolute: as it is), malloc'd; NULL when
+   out of memory. */
+static char *library_path(const char *dir, span fname)
 {
-    char sb[48];
-    if (memchr(fname.s, '\0', fname.n))
-        return fail(O, "bad material library name '%s'", show(fname, sb));
     size_t dn = strlen(dir);
     char *path = malloc(dn + fname.n + 2);
     if (!path)
-        return fail_status(O, VW_E_NOMEM);
+        return NULL;
     if (fname.n && fname.s[0] == '/') {
         memcpy(path, fname.s, fname.n);
         path[fname.n] = '\0';
@@ -586,6 +603,45 @@ static vw_status load_mtllib(obj *O, const char *dir, span fname)
         memcpy(path + dn + 1, fname.s, fname.n);
         path[dn + 1 + fname.n] = '\0';
     }
+    return path;
+}
+
+/* Is the rest of an mtllib line, holding a blank, the name of a file that opens? (No
+   continuation, comment or NUL in it: those make it several names, or none.) */
+static int library_exists(const char *dir, span whole)
+{
+    int blank = 0;
+    for (size_t i = 0; i < whole.n; i++) {
+        char c = whole.s[i];
+        if (c == '\n' || c == '\r' || c == '#' || c == '\0')
+            return 0;
+        blank |= is_space(c);
+    }
+    if (!blank)
+        return 0;
+    char *path = library_path(dir, whole);
+    FILE *f = path ? fopen(path, "rb") : NULL;
+    free(path);
+    if (f)
+        fclose(f);
+    return f != NULL;
+}
+
+static vw_status load_mtllib(obj *O, const char *dir, span fname)
+{
+    char sb[48];
+    if (memchr(fname.s, '\0', fname.n))
+        return fail(O, "bad material library name '%s'", show(fname, sb));
+    char *path = library_path(dir, fname);
+    if (!path)
+        return fail_status(O, VW_E_NOMEM);
+    /* A library read before (exporters repeat mtllib before each object) defines
+       nothing new: read again, every material of it would be in the scene twice. */
+    for (size_t i = 0; i < O->nlibs; i++)
+        if (!strcmp(O->b.s->strings[O->libs[i] - 1], path)) {
+            free(path);
+            return VW_OK;
+        }
     char *text;
     size_t len;
     char why[256] = "";
@@ -608,10 +664,21 @@ static vw_status load_mtllib(obj *O, const char *dir, span fname)
     int file;
     st = vw__sb_add_string(&O->b, path, strlen(path), &file);
     free(path);
+    if (st == VW_OK && O->nlibs == O->cap_libs) {
+        size_t ncap = O->cap_libs ? O->cap_libs * 2 : 4;
+        int *q = realloc(O->libs, ncap * sizeof *q);
+        if (q) {
+            O->libs = q;
+            O->cap_libs = ncap;
+        } else {
+            st = VW_E_NOMEM;
+        }
+    }
     if (st != VW_OK) {
         free(text);
         return fail_status(O, st);
     }
+    O->libs[O->nlibs++] = file;
     const char *obj_name = O->name;
     int obj_line = O->line, obj_next = O->next_no;
     O->name = O->b.s->strings[file - 1];
@@ -627,19 +694,57 @@ static vw_status load_mtllib(obj *O, const char *dir, span fname)
 
 /* ---- OBJ ---------------------------------------------------------------------- */
 
-/* Resolves one OBJ index (1-based, or negative: relative to the end so far). */
-static vw_status resolve(obj *O, span t, const char *what, size_t count, int *out)
+static vw_status index_range(obj *O, const char *what, long long v, size_t count)
+{
+    return fail(O, "%s index %lld out of range (%zu %s)", what, v, count,
+                !strcmp(what, "vertex") ? "vertices"
+                : !strcmp(what, "normal") ? "normals" : "texture coordinates");
+}
+
+/* Resolves one OBJ index (1-based, or negative: relative to the end so far). A positive
+   index past the data so far is noted in O->later (slot: the corner, for a normal) and
+   *out gets it as is: the end of the file checks it. */
+static vw_status resolve(obj *O, span t, const char *what, size_t count, size_t slot, int *out)
 {
     char sb[48];
     long long v;
     if (!vw__parse_int(t.s, t.n, 15, &v))
         return fail(O, "bad %s index '%s'", what, show(t, sb));
     long long at = v > 0 ? v - 1 : (long long)count + v;
-    if (v == 0 || at < 0 || at >= (long long)count)
-        return fail(O, "%s index %lld out of range (%zu %s)", what, v, count,
-                    !strcmp(what, "vertex") ? "vertices"
-                    : !strcmp(what, "normal") ? "normals" : "texture coordinates");
+    if (v == 0 || at < 0 || at >= INT_MAX)
+        return index_range(O, what, v, count);
+    if (at >= (long long)count) {
+        if (O->nlater == O->cap_later) {
+            size_t ncap = O->cap_later ? O->cap_later * 2 : 16;
+            struct later *q = realloc(O->later, ncap * sizeof *q);
+            if (!q)
+                return fail_status(O, VW_E_NOMEM);
+            O->later = q;
+            O->cap_later = ncap;
+        }
+        O->later[O->nlater++] = (struct later){what[0] == 'v' ? 'v' : what[0] == 'n' ? 'n' : 't',
+                                               O->line, v, slot};
+    }
     *out = (int)at;
+    return VW_OK;
+}
+
+/* At the end of the file: the references to data defined after their face are to data
+   the file has (the first that is not is the error), and the normals are filled in. */
+static vw_status resolve_later(obj *O)
+{
+    const vw_scene *s = O->b.s;
+    for (size_t i = 0; i < O->nlater; i++) {
+        const struct later *l = &O->later[i];
+        const char *what = l->kind == 'v' ? "vertex" : l->kind == 'n' ? "normal" : "texture";
+        size_t count = l->kind == 'v' ? s->nvertices : l->kind == 'n' ? O->nvn : O->nvt;
+        if ((unsigned long long)l->v > count) {
+            O->line = l->line;
+            return index_range(O, what, l->v, count);
+        }
+        if (l->kind == 'n')
+            memcpy(s->normals[l->slot], O->vn[l->v - 1], sizeof s->normals[0]);
+    }
     return VW_OK;
 }
 
@@ -665,22 +770,27 @@ static vw_status parse_face(obj *O, span *line)
             }
         }
         int vi, ti, ni = -1;
-        vw_status st = resolve(O, part[0], "vertex", O->b.s->nvertices, &vi);
+        size_t slot = O->b.s->nindices;   /* this corner's */
+        vw_status st = resolve(O, part[0], "vertex", O->b.s->nvertices, slot, &vi);
         if (st != VW_OK)
             return st;
-        if (np >= 2 && part[1].n && (st = resolve(O, part[1], "texture", O->nvt, &ti)) != VW_OK)
+        if (np >= 2 && part[1].n &&
+            (st = resolve(O, part[1], "texture", O->nvt, slot, &ti)) != VW_OK)
             return st;
         if (np == 2 && !part[1].n)
             return fail(O, "bad face vertex '%s'", show(t, sb));
         if (np == 3) {
             if (!part[2].n)
                 return fail(O, "bad face vertex '%s'", show(t, sb));
-            if ((st = resolve(O, part[2], "normal", O->nvn, &ni)) != VW_OK)
+            if ((st = resolve(O, part[2], "normal", O->nvn, slot, &ni)) != VW_OK)
                 return st;
         }
         if (ni < 0)
             all_normals = 0;
-        st = vw__sb_polygon_corner(&O->b, vi, ni >= 0 ? O->vn[ni] : NULL);
+        /* A normal defined later is filled in at the end (resolve_later). */
+        static const double none[3] = {0, 0, 0};
+        const double *nrm = ni < 0 ? NULL : (size_t)ni < O->nvn ? O->vn[ni] : none;
+        st = vw__sb_polygon_corner(&O->b, vi, nrm);
         if (st != VW_OK)
             return fail_status(O, st);
         n++;
@@ -705,7 +815,7 @@ static vw_status parse_face(obj *O, span *line)
 
 static vw_status parse_obj(obj *O, const char *text, size_t len, const char *dir)
 {
-    const char *p = text + vw__bom_length(text, len), *end = text + len;
+    const char *p = text + vw__bom_length(text, len), *end = text + vw__text_length(text, len);
     span line, key;
     while (next_line(O, &p, end, &line)) {
         vw_status st = check_text(O, line, "OBJ");
@@ -760,6 +870,15 @@ static vw_status parse_obj(obj *O, const char *text, size_t len, const char *dir
             span fname;
             if (!dir)
                 continue;   /* no directory given: libraries are not loaded */
+            /* The specification separates several libraries by blanks, but exporters
+               write a name with blanks in it as it is ("mtllib my model.mtl", Blender
+               does): a line that names a file as a whole is that file. */
+            span whole = rest_of_line(line);
+            if (library_exists(dir, whole)) {
+                if ((st = load_mtllib(O, dir, whole)) != VW_OK)
+                    return st;
+                continue;
+            }
             while (next_tok(O, &line, &fname))
                 if ((st = load_mtllib(O, dir, fname)) != VW_OK)
                     return st;
@@ -768,6 +887,9 @@ static vw_status parse_obj(obj *O, const char *text, size_t len, const char *dir
                 return st;
         }
     }
+    vw_status st = resolve_later(O);
+    if (st != VW_OK)
+        return st;
     for (size_t i = 0; i < O->nnames; i++)
         if (O->mat_wait[i]) {
             char sb[48];
@@ -815,6 +937,8 @@ VW_API vw_status vw_scene_read_obj(const char *name, const char *text, size_t le
     free(O.mat_ids);
     free(O.mat_wait);
     free(O.vn);
+    free(O.later);
+    free(O.libs);
     if ((st = vw__sb_close(&O.b, st, out)) == VW_OK) (*out)->camera.valid = 0;
     return st;
 }

@@ -54,6 +54,7 @@ typedef struct ply {
     int last_line;                /* of the last ASCII value read */
     int rec_line;                 /* ASCII: the line of the record being read, 0 between */
     int format;
+    int eol;                      /* how the last header line ended: '\n', 'r' (CRLF) or '\r' */
     elem *elems;
     int nelems;
     vw__sb b;
@@ -117,10 +118,15 @@ static int header_line(ply *P, const char *w[6], size_t wn[6])
     while (P->p < P->end && *P->p != '\n' && *P->p != '\r')
         P->p++;
     const unsigned char *e = P->p;
-    if (P->p < P->end && *P->p == '\r')
+    P->eol = 0;
+    if (P->p < P->end && *P->p == '\r') {
         P->p++;
-    if (P->p < P->end && *P->p == '\n')
+        P->eol = '\r';
+    }
+    if (P->p < P->end && *P->p == '\n') {
         P->p++; /* LF, or the LF of CRLF */
+        P->eol = P->eol ? 'r' : '\n';
+    }
     int n = 0;
     while (s < e && n < 6) {
         while (s < e && (*s == ' ' || *s == '\t'))
@@ -136,16 +142,24 @@ static int header_line(ply *P, const char *w[6], size_t wn[6])
     return n;
 }
 
+/* A token of the file as messages show it: printable, bounded (files may hold anything). */
+static const char *show(const void *s, size_t n, char buf[48])
+{
+    return vw_text_shown(s, n, VW_SHOWN_NAME, buf, 48);
+}
+
 static int word_is(const char *w, size_t n, const char *lit) { return strlen(lit) == n && !memcmp(w, lit, n); }
 
 static vw_status parse_header(ply *P)
 {
+    char sb[48];
     const char *w[6];
     size_t wn[6];
     P->line = 1;
     int n = header_line(P, w, wn);
     if (n != 1 || !word_is(w[0], wn[0], "ply"))
         return fail(P, "not a PLY file (its first line is not 'ply')");
+    int first_eol = P->eol;
     int have_format = 0;
     for (;;) {
         P->line++;
@@ -159,6 +173,11 @@ static vw_status parse_header(ply *P)
                 return fail(P, "end_header takes no values");
             if (!have_format)
                 return fail(P, "no format line before end_header");
+            /* A header of lone CRs (the PLY description ends its lines with a carriage
+               return) whose binary data starts with byte 10: that byte is data, not the
+               LF of a CRLF. */
+            if (P->format != F_ASCII && first_eol == '\r' && P->eol == 'r')
+                P->p--;
             return VW_OK;
         }
         if (word_is(w[0], wn[0], "format")) {
@@ -173,11 +192,10 @@ static vw_status parse_header(ply *P)
             else if (word_is(w[1], wn[1], "binary_big_endian"))
                 P->format = F_BE;
             else
-                return fail(P, "unknown format '%.*s' (ascii, binary_little_endian or "
-                            "binary_big_endian)", (int)(wn[1] > 40 ? 40 : wn[1]), w[1]);
+                return fail(P, "unknown format '%s' (ascii, binary_little_endian or "
+                            "binary_big_endian)", show(w[1], wn[1], sb));
             if (!word_is(w[2], wn[2], "1.0"))
-                return fail(P, "unknown format version '%.*s' (1.0)", (int)(wn[2] > 20 ? 20 : wn[2]),
-                            w[2]);
+                return fail(P, "unknown format version '%s' (1.0)", show(w[2], wn[2], sb));
             have_format = 1;
         } else if (word_is(w[0], wn[0], "element")) {
             if (!have_format)
@@ -188,7 +206,7 @@ static vw_status parse_header(ply *P)
             if (wn[1] >= sizeof P->elems[0].name)
                 return fail(P, "element name too long");
             if (!vw__parse_int(w[2], wn[2], 12, &count) || count < 0 || count > 0x7fffffff)
-                return fail(P, "bad element count '%.*s'", (int)(wn[2] > 20 ? 20 : wn[2]), w[2]);
+                return fail(P, "bad element count '%s'", show(w[2], wn[2], sb));
             elem *ne = realloc(P->elems, ((size_t)P->nelems + 1) * sizeof *ne);
             if (!ne)
                 return fail_status(P, VW_E_NOMEM);
@@ -213,17 +231,17 @@ static vw_status parse_header(ply *P)
                 pr.count = type_of(w[2], wn[2]);
                 pr.type = type_of(w[3], wn[3]);
                 if (pr.count == T_NONE || is_float(pr.count))
-                    return fail(P, "bad list count type '%.*s' (an integer type)",
-                                (int)(wn[2] > 20 ? 20 : wn[2]), w[2]);
+                    return fail(P, "bad list count type '%s' (an integer type)",
+                                show(w[2], wn[2], sb));
                 if (pr.type == T_NONE)
-                    return fail(P, "unknown type '%.*s'", (int)(wn[3] > 20 ? 20 : wn[3]), w[3]);
+                    return fail(P, "unknown type '%s'", show(w[3], wn[3], sb));
                 nm = w[4], nw = wn[4];
             } else {
                 if (n != 3)
                     return fail(P, "property wants 2 values (a type and a name), got %d", n - 1);
                 pr.type = type_of(w[1], wn[1]);
                 if (pr.type == T_NONE)
-                    return fail(P, "unknown type '%.*s'", (int)(wn[1] > 20 ? 20 : wn[1]), w[1]);
+                    return fail(P, "unknown type '%s'", show(w[1], wn[1], sb));
                 nm = w[2], nw = wn[2];
             }
             if (nw >= sizeof pr.name)
@@ -242,7 +260,7 @@ static vw_status parse_header(ply *P)
             }
             e->props[e->nprops++] = pr;
         } else {
-            return fail(P, "unknown header keyword '%.*s'", (int)(wn[0] > 40 ? 40 : wn[0]), w[0]);
+            return fail(P, "unknown header keyword '%s'", show(w[0], wn[0], sb));
         }
     }
 }
@@ -253,6 +271,7 @@ static vw_status parse_header(ply *P)
    or a later one; binary: type_size(t) bytes in the file's byte order. */
 static vw_status value(ply *P, enum ptype t, const char *what, double *out)
 {
+    char sb[48];
     if (P->format == F_ASCII) {
         for (;;) {
             while (P->p < P->end && (*P->p == ' ' || *P->p == '\t'))
@@ -293,17 +312,17 @@ static vw_status value(ply *P, enum ptype t, const char *what, double *out)
         if (is_float(t)) {
             int r = vw__parse_double(s, n, out);
             if (r < 0)
-                return fail(P, "%s: NaN or infinite number '%.*s'", what, (int)(n > 30 ? 30 : n), s);
+                return fail(P, "%s: NaN or infinite number '%s'", what, show(s, n, sb));
             if (r == 0)
-                return fail(P, "%s: bad number '%.*s'", what, (int)(n > 30 ? 30 : n), s);
+                return fail(P, "%s: bad number '%s'", what, show(s, n, sb));
             if (fabs(*out) > FLT_MAX)
-                return fail(P, "%s: number '%.*s' out of range (at most %g in size)", what,
-                            (int)(n > 30 ? 30 : n), s, (double)FLT_MAX);
+                return fail(P, "%s: number '%s' out of range (at most %g in size)", what,
+                            show(s, n, sb), (double)FLT_MAX);
             return VW_OK;
         }
         long long v;
         if (!vw__parse_int(s, n, 12, &v))
-            return fail(P, "%s: bad integer '%.*s'", what, (int)(n > 30 ? 30 : n), s);
+            return fail(P, "%s: bad integer '%s'", what, show(s, n, sb));
         static const long long lo[] = {0, -128, 0, -32768, 0, -2147483648LL, 0};
         static const long long hi[] = {0, 127, 255, 32767, 65535, 2147483647LL, 4294967295LL};
         if (v < lo[t] || v > hi[t])
@@ -601,6 +620,8 @@ static vw_status parse_ply(ply *P)
     if (st != VW_OK)
         return st;
     P->line++; /* ASCII values start on the line after end_header */
+    if (P->format == F_ASCII)   /* not a DOS end-of-file mark after them */
+        P->end = P->p + vw__text_length((const char *)P->p, (size_t)(P->end - P->p));
     int seen_vertices = 0;
     for (int i = 0; i < P->nelems && st == VW_OK; i++) {
         const elem *e = &P->elems[i];

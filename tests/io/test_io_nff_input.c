@@ -4,7 +4,8 @@
  * with the OBJ reader's words (a NUL in a comment used to pass unseen, one in a number
  * to read as a "bad number"); tab, VT, FF and every byte from 0x80 up (UTF-8, Latin-1)
  * stay accepted. An error earlier in the file is still the one reported. A UTF-8 byte
- * order mark before the first line is skipped; numbers are decimal (no "0x10").
+ * order mark before the first line is skipped; numbers are decimal (no "0x10"). A DOS
+ * end-of-file mark (Ctrl-Z) as the last byte is not part of the text.
  * Usage: test_io_nff_input (no data: every input is made here)
  */
 #define _GNU_SOURCE
@@ -141,9 +142,22 @@ static void text_bytes(void)
     ACCEPTED(VIEW FILL "s +1 0 0 +.5e+0\n", 1, 0);
 }
 
+/* A DOS end-of-file mark (Ctrl-Z) as the file's last byte ends the text (it was refused
+   as binary data); anywhere else it is a control character as before. */
+static void dos_eof(void)
+{
+    ACCEPTED(VIEW FILL "s 0 0 0 1\r\n\x1a", 1, 0);
+    ACCEPTED(VIEW FILL "s 0 0 0 1\x1a", 1, 0);
+    ACCEPTED("\xEF\xBB\xBF" VIEW "\x1a", 0, 0);
+    REFUSED(VIEW FILL "s 0 0 0 1\x1a\n", "t.nff:3: control character 0x1a: binary data, not NFF text");
+    REFUSED(VIEW FILL "s 0 0 0 1\n\x1a\x1a", "t.nff:4: control character 0x1a: binary data, not NFF text");
+    REFUSED(VIEW FILL "s 0 0 0\n\x1a", "t.nff:3: file ends in the middle of 's'");
+}
+
 int main(void)
 {
     binary_bytes();
     text_bytes();
+    dos_eof();
     TEST_DONE();
 }

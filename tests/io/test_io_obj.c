@@ -307,6 +307,83 @@ static void cr_line_ends(const char *data, const vw_scene *lf)
     rmdir(dir);
 }
 
+/* Positive indices number the file's data as a whole: a face may name a vertex, texture
+   coordinate or normal defined after it (Assimp and tinyobjloader read such files). One
+   the file never defines is the error, at the face's line, with the file's total. */
+static void later_references(void)
+{
+    char err[512];
+    vw_scene *s;
+    const char *t = "v 0 0 0\nf 1//2 2//1 3//2\nv 1 0 0\nvn 0 0 1\nv 0 1 0\nvn 0 0 -1\n"
+                    "f 4/1 -3/1 -2/1\nvt 0 0\nv 1 1 0\n";
+    vw_status st = vw_scene_read_obj("l.obj", t, strlen(t), NULL, &s, err, sizeof err);
+    if (st != VW_OK)
+        fprintf(stderr, "%s\n", err);
+    CHECK_EQ_INT(st, VW_OK);
+    CHECK_EQ_INT(s->npolygons, 2);
+    CHECK(corner(s, 0, 0) == 0 && corner(s, 0, 1) == 1 && corner(s, 0, 2) == 2);
+    CHECK(corner(s, 1, 0) == 3 && corner(s, 1, 1) == 0 && corner(s, 1, 2) == 1);
+    CHECK_EQ_INT(s->polygons[0].has_normals, 1);
+    CHECK(s->normals[0][2] == -1.0 && s->normals[1][2] == 1.0 && s->normals[2][2] == -1.0);
+    CHECK_EQ_INT(s->polygons[1].has_normals, 0);
+    vw_scene_free(s);
+    const char *bad[][2] = {
+        {"v 0 0 0\nv 1 0 0\nf 1 2 3\n# 3 is here\nv 0 1 0\nf 1 2 4\nf 1 2 5\n",
+         "b.obj:6: vertex index 4 out of range (3 vertices)"},
+        {"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1//1 2//1 \\\n 3//2\nvn 0 0 1\n",
+         "b.obj:5: normal index 2 out of range (1 normals)"},
+        {"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1/1 2/2 3/1\nvt 0 0\n",
+         "b.obj:4: texture index 2 out of range (1 texture coordinates)"},
+        {"v 0 0 0\nf 1 2 3000000000\nv 1 0 0\n",
+         "b.obj:2: vertex index 3000000000 out of range (1 vertices)"},
+    };
+    for (int i = 0; i < 4; i++) {
+        st = vw_scene_read_obj("b.obj", bad[i][0], strlen(bad[i][0]), NULL, &s, err, sizeof err);
+        CHECK_EQ_INT(st, VW_E_INPUT);
+        if (strcmp(err, bad[i][1]))
+            fprintf(stderr, "case %d: '%s'\n  expected '%s'\n", i, err, bad[i][1]);
+        CHECK(!strcmp(err, bad[i][1]));
+    }
+}
+
+/* "mtllib my model.mtl": exporters write a library whose name has blanks as it is. A
+   line that names a file as a whole is that file; otherwise blanks separate names. A
+   library named twice is read once. */
+static void library_with_blanks(void)
+{
+    char dir[] = "/tmp/vw_blank_XXXXXX", path[256];
+    CHECK(mkdtemp(dir) != NULL);
+    write_file(dir, "my model.mtl", "newmtl blue\nKd 0 0 1\n");
+    write_file(dir, "a.mtl", "newmtl red\nKd 1 0 0\n");
+    write_file(dir, "b.mtl", "newmtl green\nKd 0 1 0\n");
+    const char *t = "mtllib my model.mtl \nmtllib a.mtl  b.mtl # two\nv 0 0 0\nv 1 0 0\n"
+                    "v 0 1 0\nusemtl blue\nf 1 2 3\nusemtl red\nf 1 2 3\nusemtl green\nf 1 2 3\n"
+                    "mtllib b.mtl\nusemtl green\nf 1 2 3\n";
+    char err[512];
+    vw_scene *s;
+    nwarnings = 0;
+    vw_status st = vw_scene_read_obj("m.obj", t, strlen(t), dir, &s, err, sizeof err);
+    if (st != VW_OK)
+        fprintf(stderr, "%s\n", err);
+    CHECK_EQ_INT(st, VW_OK);
+    CHECK_EQ_INT(nwarnings, 0);
+    CHECK_EQ_INT(s->npolygons, 4);
+    const float want[3][3] = {{0, 0, 1}, {1, 0, 0}, {0, 1, 0}};
+    for (int i = 0; i < 3; i++)
+        CHECK(!memcmp(s->materials[s->polygons[i].material].diffuse, want[i], sizeof want[i]));
+    /* A library named again (exporters repeat mtllib before each object) is not read
+       again: its materials are in the scene once. */
+    CHECK_EQ_INT(s->nmaterials, 3);
+    CHECK_EQ_INT(s->polygons[3].material, s->polygons[2].material);
+    vw_scene_free(s);
+    const char *names[] = {"my model.mtl", "a.mtl", "b.mtl"};
+    for (int i = 0; i < 3; i++) {
+        snprintf(path, sizeof path, "%s/%s", dir, names[i]);
+        remove(path);
+    }
+    rmdir(dir);
+}
+
 int main(int argc, char **argv)
 {
     CHECK(argc == 2);
@@ -411,6 +488,8 @@ int main(int argc, char **argv)
     warn_corpus(argv[1]);
     illum_models();
     material_place();
+    later_references();
+    library_with_blanks();
     /* A library that is there but wrong is still an error. */
     snprintf(path, sizeof path, "%s/bad/obj_mtl_error.obj", argv[1]);
     CHECK_EQ_INT(vw_scene_read_file(path, &n, err, sizeof err), VW_E_INPUT);

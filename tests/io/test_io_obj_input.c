@@ -227,6 +227,35 @@ static void no_faces(void)
     accepted("v 0 0 0\nv 1 0 0\n", 16, 0, 0);
 }
 
+/* A DOS end-of-file mark (Ctrl-Z) as the last byte of an OBJ or MTL ends its text (it
+   was refused as binary data); anywhere else it is a control character as before. */
+static void dos_eof(void)
+{
+    static const char a[] = "v 0 0 0\r\nv 1 0 0\r\nv 0 1 0\r\nf 1 2 3\r\n\x1a";
+    static const char b[] = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\x1a";
+    accepted(a, sizeof a - 1, 0, 1);
+    accepted(b, sizeof b - 1, 0, 1);
+    static const char c[] = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\x1a\n";
+    refused(c, sizeof c - 1, "t.obj:4: control character 0x1a: binary data, not OBJ text");
+    char dir[] = "/tmp/vw_dos_XXXXXX", path[256], err[512];
+    CHECK(mkdtemp(dir) != NULL);
+    snprintf(path, sizeof path, "%s/d.mtl", dir);
+    FILE *f = fopen(path, "wb");
+    CHECK(f != NULL);
+    CHECK(fputs("newmtl red\r\nKd 1 0 0\r\n\x1a", f) >= 0);
+    CHECK(fclose(f) == 0);
+    static const char o[] = "mtllib d.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl red\nf 1 2 3\n";
+    vw_scene *s;
+    vw_status st = read_obj(o, sizeof o - 1, dir, &s, err, sizeof err);
+    EXPECT(st == VW_OK && nwarnings == 0, "status %d (%s), %d warnings", (int)st, err, nwarnings);
+    if (st == VW_OK) {
+        CHECK(s->materials[s->polygons[0].material].diffuse[1] == 0.0f);
+        vw_scene_free(s);
+    }
+    remove(path);
+    rmdir(dir);
+}
+
 int main(void)
 {
     vw_scene_set_warning_handler(collect, NULL);
@@ -235,5 +264,6 @@ int main(void)
     keywords();
     libraries();
     no_faces();
+    dos_eof();
     TEST_DONE();
 }

@@ -166,6 +166,40 @@ int main(void)
     EXPECT(sb->materials[0].line == 0, "binary face colour: line %d", sb->materials[0].line);
     CHECK(!strcmp(vw_scene_string(sb, sb->materials[0].file), "t.ply"));
     vw_scene_free(sb);
+    /* A header of lone CRs (the PLY description's "carriage-return terminated lines")
+       before binary data whose first byte is 10: that byte is the data's, not the LF of
+       a CRLF (it was taken as one, and every value after it was read a byte late). */
+    const char *crh = "ply\rformat binary_little_endian 1.0\relement vertex 3\rproperty uchar q\r"
+                      "property float x\rproperty float y\rproperty float z\relement face 1\r"
+                      "property list uchar int vertex_indices\rend_header\r";
+    q = bin + strlen(crh);
+    memcpy(bin, crh, strlen(crh));
+    for (int v = 0; v < 3; v++) {
+        *q++ = 10;
+        for (int k = 0; k < 3; k++) {
+            uint32_t u;
+            memcpy(&u, &bv[3 * v + k], 4);
+            for (int i = 0; i < 4; i++) *q++ = (unsigned char)(u >> (8 * i));
+        }
+    }
+    *q++ = 3;
+    for (int k = 0; k < 3; k++) *q++ = (unsigned char)k, *q++ = 0, *q++ = 0, *q++ = 0;
+    vw_scene *scr2 = good(bin, (size_t)(q - bin), "binary after a header of lone CRs");
+    CHECK(scr2 && scr2->nvertices == 3 && scr2->npolygons == 1 && scr2->vertices[1][0] == 1.0 &&
+          scr2->vertices[2][1] == 1.0 && scr2->polygons[0].count == 3);
+    vw_scene_free(scr2);
+    /* ... and CRLF line ends before binary data whose first byte is 10 still end there. */
+    const char *crlfh = "ply\r\nformat binary_little_endian 1.0\r\nelement vertex 3\r\n"
+                        "property uchar q\r\nproperty float x\r\nproperty float y\r\n"
+                        "property float z\r\nelement face 1\r\n"
+                        "property list uchar int vertex_indices\r\nend_header\r\n";
+    size_t body = (size_t)(q - bin) - strlen(crh);
+    unsigned char bin2[512];
+    memcpy(bin2, crlfh, strlen(crlfh));
+    memcpy(bin2 + strlen(crlfh), bin + strlen(crh), body);
+    scr2 = good(bin2, strlen(crlfh) + body, "binary after a CRLF header");
+    CHECK(scr2 && scr2->nvertices == 3 && scr2->vertices[1][0] == 1.0 && scr2->npolygons == 1);
+    vw_scene_free(scr2);
     /* No colour: the default grey, defined nowhere. */
     vw_scene *sg = good(ascii(), strlen(ascii()), "no colour");
     CHECK(sg && sg->nmaterials == 1 && sg->materials[0].line == 0 && sg->materials[0].file == 0 &&
@@ -212,6 +246,28 @@ int main(void)
     bad("ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
         "element face 1\nproperty list char int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n-3 0 1 2\n", 0,
         "t.ply:13: face 0: list vertex_indices has a negative length -3");
+    /* A token is shown printable (an escape sequence from the file is not sent to the
+       terminal), as the NFF and OBJ readers show theirs. */
+    bad("ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\n"
+        "end_header\n0 \x1b[31mred 0\n", 0, "t.ply:8: vertex 0: bad number '?[31mred'");
+    bad("ply\nformat \x1b[2J 1.0\n", 0, "t.ply:2: unknown format '?[2J'");
+    /* A DOS end-of-file mark (Ctrl-Z) after ASCII data ends it; elsewhere it is not a value. */
+    static const char dos[] = "ply\r\nformat ascii 1.0\r\nelement vertex 3\r\nproperty float x\r\n"
+                              "property float y\r\nproperty float z\r\nelement face 1\r\n"
+                              "property list uchar int vertex_indices\r\nend_header\r\n"
+                              "0 0 0\r\n1 0 0\r\n0 1 0\r\n3 0 1 2";
+    char dosz[sizeof dos + 4];
+    memcpy(dosz, dos, sizeof dos - 1);
+    memcpy(dosz + sizeof dos - 1, "\x1a", 1);
+    vw_scene *sd = good(dosz, sizeof dos, "ASCII ending in Ctrl-Z");
+    CHECK(sd && sd->npolygons == 1);
+    vw_scene_free(sd);
+    memcpy(dosz + sizeof dos - 1, "\r\n\x1a", 3);
+    sd = good(dosz, sizeof dos + 2, "ASCII ending in CRLF and Ctrl-Z");
+    CHECK(sd && sd->npolygons == 1);
+    vw_scene_free(sd);
+    memcpy(dosz + sizeof dos - 1, "\x1a\r\n", 3);
+    bad(dosz, sizeof dos + 2, "t.ply:13: face 0: bad integer '2?'");
     /* binary data cut short: the element and record are named */
     unsigned char *cut = binary(0, &nle);
     bad((const char *)cut, nle - 3, "t.ply:11: the binary data ends inside face 4");

@@ -51,3 +51,10 @@ set_tests_properties(balance_cli PROPERTIES LABELS "balance;mpi" TIMEOUT 300 PRO
 # lower it), and goes on where, with speeds or company on its worker, cuts still can.
 add_test(NAME balance_divide_stop COMMAND vw_test_balance divide_stop)
 set_tests_properties(balance_divide_stop PROPERTIES LABELS "balance")
+
+# A balance the render keeps never gives its slowest worker more counted work than the
+# layout it started from (rotate and divide lowered lambda while adding work).
+add_test(NAME balance_slowest
+         COMMAND sh ${PROJECT_SOURCE_DIR}/tests/balance/slowest.sh $<TARGET_FILE:vwalls_tool>
+                 ${CMAKE_CURRENT_BINARY_DIR}/balance_slowest)
+set_tests_properties(balance_slowest PROPERTIES LABELS "balance" TIMEOUT 120)

@@ -189,29 +189,51 @@ static vw_status layout_restore(vw_world *w, const layout *l)
     return st;
 }
 
-/* lambda of the last run's loads per worker (copies of duplicated cells where they ran)
-   into *lam; VW_E_NOMEM on this process alone. */
-static vw_status measured_lambda(vw_world *w, const vw_load_spec *ls, const double *cell_load,
-                                 const double *speeds, double *lam)
+/* What the last run (a pre-pass) measured of the layout: lambda of its loads per
+   worker (copies of duplicated cells where they ran) into *lam, and its cost: the
+   slowest worker's load (its busy time, or its counted or modelled load over its
+   speed) per pixel sampled. The cost compares layouts; lambda compares a layout with
+   itself. A balance that adds work can lower lambda and raise the slowest worker's load
+   all the same: a rotated frame's larger world box lets more eye rays in, and divided
+   cells' walls are crossed by more rays (docs/balancing.md, "lambda is not the time").
+   VW_E_NOMEM on this process alone. */
+static vw_status measured(vw_world *w, const vw_load_spec *ls, const double *cell_load,
+                          const double *speeds, double pixels, double *lam, double *cost)
 {
     int gw = vw_world_workers(w) * vw_world_processes(w);
     int nc = vw_decomp_cell_count(vw_world_decomp(w));
     double *t = calloc((size_t)gw, sizeof *t);
     int *id = malloc(sizeof(int) * (size_t)gw);
     *lam = 0;
+    *cost = 0;
     if (t && id) {
         for (int g = 0; g < gw; g++) id[g] = g;
         if (ls->model == VW_LOAD_COUNTER)
             for (int g = 0; g < gw; g++) t[g] = (double)vw_world_worker_counter(w, g, ls->counter);
+        else if (ls->model == VW_LOAD_BUSY)
+            for (int g = 0; g < gw; g++) t[g] = vw_world_worker_busy(w, g);
         else
             for (int c = 0; c < nc; c++) t[vw_world_cell_worker(w, c)] += cell_load[c];
         /* Busy times are times already: the world's lambda weighs them by speed. */
         *lam = ls->model == VW_LOAD_BUSY ? vw_world_imbalance(w)
                                          : vw_balance_imbalance(t, id, gw, gw, speeds);
+        double slowest = 0;
+        for (int g = 0; g < gw; g++) {
+            double x = ls->model != VW_LOAD_BUSY && speeds ? t[g] / speeds[g] : t[g];
+            if (x > slowest) slowest = x;
+        }
+        *cost = pixels > 0 ? slowest / pixels : slowest;
     }
     vw_status st = t && id ? VW_OK : VW_E_NOMEM;
     free(t), free(id);
     return st;
+}
+
+/* The pixels a pre-pass of this stride samples: every stride-th row and column. */
+static double sampled_pixels(const rt_shared *sh, int stride)
+{
+    double s = stride > 1 ? stride : 1;
+    return ceil(sh->view.width / s) * ceil(sh->view.height / s);
 }
 
 /* Extra pre-pass / balance rounds for divide and rotate (see rt_job_balance). */
@@ -255,10 +277,11 @@ vw_status rt_job_balance(rt_job *j, const rt_balance *b, rt_balance_result *bi, 
     if (b->strategy == VW_BALANCE_DIVIDE || b->strategy == VW_BALANCE_ROTATE)
         rounds += RT_BALANCE_EXTRA;
     /* Every balance is checked by the next pre-pass: the best measured layout so far is
-       kept and restored at the end, so a balance the measurement refutes (lambda no
-       lower than the best) is undone. So with R rounds there are R + 1 pre-passes. */
+       kept and restored at the end, so a balance the measurement refutes (its slowest
+       worker's load per sampled pixel no lower than the best's: measured()) is undone.
+       So with R rounds there are R + 1 pre-passes. */
     layout best = {0};
-    double best_lam = 0;
+    double best_cost = 0;
     for (int r = 0; st == VW_OK && r <= rounds; r++) {
         double t0 = now();
         if (b->stride <= 0 && r > 0) {
@@ -290,19 +313,20 @@ vw_status rt_job_balance(rt_job *j, const rt_balance *b, rt_balance_result *bi, 
            mapping, the balance) each process works alone: the loads (global figures,
            the same everywhere) and their lambda, the saved layout, the field. Its memory
            is its own, so the round agrees once on all of it, before that step. */
-        double lam = 0;
+        double lam = 0, cost = 0;
         st = vw_balance_cell_loads(w, &b->load, load);
         if (st != VW_OK)
             snprintf(err, errlen, "the load field: %s", vw_status_message(st));
-        else if ((st = measured_lambda(w, &b->load, load, b->speeds, &lam)) != VW_OK)
+        else if ((st = measured(w, &b->load, load, b->speeds, sampled_pixels(sh, stride), &lam,
+                                &cost)) != VW_OK)
             snprintf(err, errlen, "the measured imbalance: %s", vw_status_message(st));
-        /* Refuted (lambda no lower than the best measured): the field still learns
+        /* Refuted (its cost no lower than the best measured): the field still learns
            from this measurement and the next round balances on from here; the best
            layout measured is restored when the rounds end. */
-        int refuted = r > 0 && b->strategy != VW_BALANCE_NONE && !(lam < best_lam);
+        int refuted = r > 0 && b->strategy != VW_BALANCE_NONE && !(cost < best_cost);
         int last = r == rounds;
         if (st == VW_OK && !refuted && b->strategy != VW_BALANCE_NONE) {
-            best_lam = lam;
+            best_cost = cost;
             bi->measured = lam;
             if ((st = layout_save(w, &best)) != VW_OK)
                 snprintf(err, errlen, "saving the layout: %s", vw_status_message(st));

@@ -313,7 +313,9 @@ typedef struct rt_balance_result {
 /* Single image: a cheap sparse pre-pass measures where the work lies, the balancer
    builds the load field and moves the walls (repeated b->rounds times, each pre-pass
    re-calibrating the field on the new layout, and each balance checked by the next
-   pre-pass: one that does not lower the measured lambda is undone and ends the rounds);
+   pre-pass: one that does not lower the slowest worker's measured load per sampled
+   pixel is undone and ends the rounds; lambda alone cannot see a balance that adds
+   work, as rotate's larger world box and divide's extra walls do);
    then the job is reset for the full render (commit + run). Strategy none with map
    greedy/weighted maps by the measured loads instead. Collective under MPI: what each
    process does alone between the collective steps (its loads, field and saved layout,

@@ -203,6 +203,16 @@ const char *vw_cli_value(const char *cmd, int argc, char **argv, int *i)
     return argv[++*i];
 }
 
+int vw_cli_image_option(const char *cmd, int argc, char **argv, int *i, int *width, int *height,
+                        long *depth)
+{
+    const char *a = argv[*i], *v;
+    if (strcmp(a, "--size") && strcmp(a, "--depth")) return 0;
+    if (!(v = vw_cli_value(cmd, argc, argv, i))) return -1;
+    if (!strcmp(a, "--size")) return vw_cli_size(cmd, a, v, width, height) ? -1 : 1;
+    return vw_cli_int(cmd, a, v, 1, 64, depth) ? -1 : 1;
+}
+
 int vw_cli_scene_arg(const char *cmd, const char *a, const char **scene)
 {
     if (a[0] == '-' && a[1]) {

@@ -47,6 +47,11 @@ int vw_cli_frame_pattern(const char *cmd, const char *opt, const char *s);
 /* The value after option argv[*i] (advancing *i), or an error and NULL: when there is
    none, or it is an option itself ("--stats --quiet"). */
 const char *vw_cli_value(const char *cmd, int argc, char **argv, int *i);
+/* The ray tracer's image options, alike in every command that renders: --size WxH and
+   --depth D (1 to 64). 1 when argv[*i] is one of them (its value taken, *i advanced), 0
+   when it is not, -1 after "vwalls CMD: ...: bad value" for a bad one. */
+int vw_cli_image_option(const char *cmd, int argc, char **argv, int *i, int *width, int *height,
+                        long *depth);
 /* An argument that no option of the command took: the scene when it is the first such
    one (*scene NULL), else "vwalls CMD: more than one scene: ..." or, for what looks
    like an option ("-x", not "-"), "unknown option '-x' (try --help)", and -1. */

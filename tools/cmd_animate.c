@@ -534,6 +534,7 @@ int vw_anim_main(const char *cmd, int argc, char **argv)
     int rc = VW_EXIT_USAGE, farm = -1; /* -1: auto, resolved once the options are read */
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i], *v;
+        int taken;
         if (!strcmp(a, "--help") || !strcmp(a, "-h")) {
             help(cmd);
             free(s);
@@ -544,10 +545,8 @@ int vw_anim_main(const char *cmd, int argc, char **argv)
             if (!(v = vw_cli_value(cmd, argc, argv, &i)) || vw_cli_layout(cmd, a, v, p.dims)) goto done;
         } else if (!strcmp(a, "--workers")) {
             if (!(v = vw_cli_value(cmd, argc, argv, &i)) || vw_cli_int(cmd, a, v, 1, 1024, &workers)) goto done;
-        } else if (!strcmp(a, "--size")) {
-            if (!(v = vw_cli_value(cmd, argc, argv, &i)) || vw_cli_size(cmd, a, v, &p.width, &p.height)) goto done;
-        } else if (!strcmp(a, "--depth")) {
-            if (!(v = vw_cli_value(cmd, argc, argv, &i)) || vw_cli_int(cmd, a, v, 1, 64, &depth)) goto done;
+        } else if ((taken = vw_cli_image_option(cmd, argc, argv, &i, &p.width, &p.height, &depth))) {
+            if (taken < 0) goto done;
         } else if (!strcmp(a, "--balance")) {
             if (!(s->strategy = vw_cli_value(cmd, argc, argv, &i))) goto done;
         } else if (!strcmp(a, "--farm")) {

@@ -234,6 +234,7 @@ int vw_cmd_bench(int argc, char **argv)
     memset(&L, 0, sizeof L);
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
+        int taken;
         if (!strcmp(a, "--help") || !strcmp(a, "-h")) {
             help();
             return VW_EXIT_OK;
@@ -249,12 +250,8 @@ int vw_cmd_bench(int argc, char **argv)
             if (!(v = vw_cli_value(CMD, argc, argv, &i)) || each_item(a, v, one_workers, &L))
                 return VW_EXIT_USAGE;
             workers_given = 1;
-        } else if (!strcmp(a, "--size")) {
-            if (!(v = vw_cli_value(CMD, argc, argv, &i)) || vw_cli_size(CMD, a, v, &width, &height))
-                return VW_EXIT_USAGE;
-        } else if (!strcmp(a, "--depth")) {
-            if (!(v = vw_cli_value(CMD, argc, argv, &i)) || vw_cli_int(CMD, a, v, 1, 64, &depth))
-                return VW_EXIT_USAGE;
+        } else if ((taken = vw_cli_image_option(CMD, argc, argv, &i, &width, &height, &depth))) {
+            if (taken < 0) return VW_EXIT_USAGE;
         } else if (!strcmp(a, "--repeat")) {
             if (!(v = vw_cli_value(CMD, argc, argv, &i)) ||
                 vw_cli_int(CMD, a, v, 1, MAX_ROUNDS, &repeat))

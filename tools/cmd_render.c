@@ -236,6 +236,7 @@ int vw_cmd_render(int argc, char **argv)
     vw_load_spec_init(&lspec);
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i], *v;
+        int taken;
         if (!strcmp(a, "--help") || !strcmp(a, "-h")) {
             help();
             return VW_EXIT_OK;
@@ -251,12 +252,8 @@ int vw_cmd_render(int argc, char **argv)
         } else if (!strcmp(a, "--workers")) {
             if (!(v = vw_cli_value(CMD, argc, argv, &i)) || vw_cli_int(CMD, a, v, 1, 1024, &workers))
                 return VW_EXIT_USAGE;
-        } else if (!strcmp(a, "--size")) {
-            if (!(v = vw_cli_value(CMD, argc, argv, &i)) || vw_cli_size(CMD, a, v, &width, &height))
-                return VW_EXIT_USAGE;
-        } else if (!strcmp(a, "--depth")) {
-            if (!(v = vw_cli_value(CMD, argc, argv, &i)) || vw_cli_int(CMD, a, v, 1, 64, &depth))
-                return VW_EXIT_USAGE;
+        } else if ((taken = vw_cli_image_option(CMD, argc, argv, &i, &width, &height, &depth))) {
+            if (taken < 0) return VW_EXIT_USAGE;
         } else if (!strcmp(a, "--stats")) {
             if (!(stats = vw_cli_output(CMD, argc, argv, &i))) return VW_EXIT_USAGE;
         } else if (!strcmp(a, "--overlay")) {

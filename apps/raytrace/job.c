@@ -605,26 +605,27 @@ void rt_job_overlay(const rt_job *j, uint8_t *out)
     draw_walls(j, out);
 }
 
+/* A map of one int a pixel, all -1 ("none"), in *map: made once, on the output process
+   only (the one that keeps the image and reads the overlays' maps). */
+static vw_status pixel_map(const rt_job *j, int **map)
+{
+    if (!j->sh.accum || *map) return VW_OK;
+    size_t np = (size_t)j->sh.view.width * (size_t)j->sh.view.height;
+    if (!(*map = malloc(np * sizeof **map))) return VW_E_NOMEM;
+    for (size_t i = 0; i < np; i++) (*map)[i] = -1;
+    return VW_OK;
+}
+
 vw_status rt_job_record_hit_cells(rt_job *j)
 {
     j->sh.record_hit_cells = 1;
-    if (!j->sh.accum || j->sh.hit_cell) return VW_OK; /* (output process only) */
-    size_t np = (size_t)j->sh.view.width * (size_t)j->sh.view.height;
-    j->sh.hit_cell = malloc(np * sizeof *j->sh.hit_cell);
-    if (!j->sh.hit_cell) return VW_E_NOMEM;
-    for (size_t i = 0; i < np; i++) j->sh.hit_cell[i] = -1;
-    return VW_OK;
+    return pixel_map(j, &j->sh.hit_cell);
 }
 
 vw_status rt_job_record_eye_workers(rt_job *j)
 {
     j->sh.record_eye_workers = 1;
-    if (!j->sh.accum || j->sh.eye_worker) return VW_OK; /* (output process only) */
-    size_t np = (size_t)j->sh.view.width * (size_t)j->sh.view.height;
-    j->sh.eye_worker = malloc(np * sizeof *j->sh.eye_worker);
-    if (!j->sh.eye_worker) return VW_E_NOMEM;
-    for (size_t i = 0; i < np; i++) j->sh.eye_worker[i] = -1;
-    return VW_OK;
+    return pixel_map(j, &j->sh.eye_worker);
 }
 
 int rt_job_eye_workers(const rt_job *j, int *worker)

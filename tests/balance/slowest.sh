@@ -1,7 +1,7 @@
 #!/bin/sh
 # slowest.sh - a balance the render keeps never gives its slowest worker more work than
 # the layout it started from: on an oblique line of spheres (bench/balance.sh's) at
-# 2x2x2 cells, a cell a worker, with the counted work as the load (ray-cell visits:
+# 2x2x2 cells and 160x160, a cell a worker, with the counted work as the load (ray-cell visits:
 # deterministic), the most visits any worker makes with each balancer is at most what
 # it is with none. rotate (a larger world box: more eye rays enter it) and divide (more
 # walls, more visits) lowered lambda and were kept while their slowest worker did 2.2
@@ -9,24 +9,16 @@
 # usage: slowest.sh VWALLS TMPDIR
 set -u
 V=$(cd "$(dirname "$1")" && pwd)/$(basename "$1") T=$2
+HERE=$(cd "$(dirname "$0")" && pwd)
 rm -rf "$T" && mkdir -p "$T" && cd "$T" || exit 1
 fail() { echo "FAIL: $*"; exit 1; }
-awk 'BEGIN {
-  print "v\nfrom 22 -14 8\nat 5 5 5\nup 0 0 1\nangle 40\nhither 0.01\nresolution 160 160";
-  print "b 0.1 0.1 0.1\nl 30 -20 30\nl -10 -10 20";
-  srand(7);
-  for (i = 0; i < 400; i++) {
-    t = i / 399; j = 0.25 * (rand() - 0.5); k = 0.25 * (rand() - 0.5);
-    printf "f %.2f %.2f %.2f 0.8 0.2 10 0 1\n", 0.3 + 0.7 * t, 0.4, 1 - 0.7 * t;
-    printf "s %.4f %.4f %.4f 0.08\n", 1 + 8 * t + j, 1 + 8 * t + k, 1 + 8 * t + j - k;
-  }
-}' > oblique.nff
+awk -f "$HERE/../../bench/oblique.awk" > oblique.nff
 # The most ray-cell visits of any worker in a run's stats (python3: scripts/setup.sh build).
 slowest() {
   python3 -c 'import json, sys; j = json.load(open(sys.argv[1])); print(max(w["counters"]["segments"] for w in j["workers"]))' "$1"
 }
 for b in none tensor rotate staggered divide duplicate; do
-  "$V" render oblique.nff -o "$b.png" --cells 2x2x2 --workers 8 --farm none --balance "$b" \
+  "$V" render oblique.nff -o "$b.png" --size 160x160 --cells 2x2x2 --workers 8 --farm none --balance "$b" \
     --balance-load segments --stats "$b.json" --quiet 2> err.txt
   rc=$?
   [ "$rc" -eq 0 ] || { cat err.txt; fail "$b: status $rc"; }

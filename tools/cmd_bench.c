@@ -297,8 +297,10 @@ int vw_cmd_bench(int argc, char **argv)
     vw_scene *scene = NULL;
     if (scene_path) {
         if (vw_scene_read_file(scene_path, &scene, err, sizeof err) != VW_OK) rc = VW_EXIT_USAGE;
-    } else if (vw_gen("balls", NULL, &scene, err, sizeof err) != VW_OK) {
-        rc = vw_cli_fail(CMD, VW_EXIT_FAIL, err, sizeof err, "generating the sphereflake: %s", err);
+    } else {
+        char why[512] = "";
+        if (vw_gen("balls", NULL, &scene, why, sizeof why) != VW_OK)
+            rc = vw_cli_fail(CMD, VW_EXIT_FAIL, err, sizeof err, "generating the sphereflake: %s", why);
     }
     if ((rc = vw_cli_agree(CMD, rc, err, sizeof err)) != VW_EXIT_OK) {
         vw_scene_free(scene);
@@ -318,6 +320,7 @@ int vw_cmd_bench(int argc, char **argv)
     if (!conf) rc = vw_cli_fail(CMD, VW_EXIT_FAIL, err, sizeof err, "out of memory for the table");
     if ((rc = vw_cli_agree(CMD, rc, err, sizeof err)) != VW_EXIT_OK) {
         vw_scene_free(scene);
+        free(conf);
         return rc;
     }
     for (int l = 0, k = 0; l < L.nlayouts; l++)

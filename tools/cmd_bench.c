@@ -230,7 +230,7 @@ int vw_cmd_bench(int argc, char **argv)
     const char *scene_path = NULL, *csv = NULL, *v;
     int width = 256, height = 256, quiet = 0, farm = -1, cells_given = 0, workers_given = 0;
     long depth = 5, repeat = 3;
-    static lists L;
+    lists L;
     memset(&L, 0, sizeof L);
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];

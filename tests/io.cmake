@@ -42,9 +42,10 @@ target_include_directories(test_io_triangulate PRIVATE ${PROJECT_SOURCE_DIR}/tes
 target_link_libraries(test_io_triangulate PRIVATE vwalls_static m)
 add_test(NAME io_triangulate COMMAND test_io_triangulate)
 
-# The command's output files and its help texts, and info --materials (each script says
-# what it checks; a few seconds).
-foreach(t outputs help args info)
+# The command's output files and its help texts, info --materials, and --stats in every
+# command's help with gen's and info's stats JSON (each script says what it checks; a few
+# seconds).
+foreach(t outputs help args info stats)
   add_test(NAME io_cli_${t}
            COMMAND sh ${PROJECT_SOURCE_DIR}/tests/io/cli_${t}.sh $<TARGET_FILE:vwalls_tool>
                    ${CMAKE_CURRENT_BINARY_DIR}/io_cli_${t})

@@ -721,3 +721,70 @@ int vw_cli_same_view(const char *cmd, int width, int height, long depth, const v
     return vw_cli_same_as_first(cmd, v, sizeof v / sizeof v[0],
                                 "view (image size, depth, camera or lights)");
 }
+
+const char *vw_cli_json_number(double x, char buf[32])
+{
+    if (isfinite(x)) snprintf(buf, 32, "%.17g", x);
+    else snprintf(buf, 32, "null");
+    return buf;
+}
+
+int vw_cli_json_string(char **buf, size_t *len, size_t *cap, const char *s)
+{
+    if (!s) return vw_cli_appendf(buf, len, cap, "null");
+    int ok = vw_cli_appendf(buf, len, cap, "\"");
+    for (; *s && ok; s++) {
+        unsigned char ch = (unsigned char)*s;
+        if (ch == '"' || ch == '\\') ok = vw_cli_appendf(buf, len, cap, "\\%c", ch);
+        else if (ch < 0x20 || ch == 0x7f) ok = vw_cli_appendf(buf, len, cap, "\\u%04x", ch);
+        else ok = vw_cli_appendf(buf, len, cap, "%c", ch);
+    }
+    return ok && vw_cli_appendf(buf, len, cap, "\"");
+}
+
+int vw_cli_stats_begin(char **buf, size_t *len, size_t *cap, const char *cmd, int workers)
+{
+    int p = vw_engine_size();
+    int ok = vw_cli_appendf(buf, len, cap, "{\n  \"command\": ");
+    ok = ok && vw_cli_json_string(buf, len, cap, cmd);
+    return ok && vw_cli_appendf(buf, len, cap,
+                                ",\n  \"version\": \"%s\",\n  \"engine\": {\"kind\": \"%s\", "
+                                "\"processes\": %d, \"workers\": %d, \"workers_per_process\": %d}",
+                                VW_VERSION_STRING, p > 1 ? "mpi" : "threads", p, workers * p,
+                                workers);
+}
+
+int vw_cli_stats_end(const char *cmd, const char *path, char **buf, size_t *len, size_t *cap,
+                     double t0, const char *const *phases, const double *secs, int nphases)
+{
+    char n[32], err[1024];
+    int ok = vw_cli_appendf(buf, len, cap, ",\n  \"time_s\": {");
+    for (int k = 0; k < nphases && ok; k++)
+        ok = vw_cli_appendf(buf, len, cap, "\"%s\": %s, ", phases[k], vw_cli_json_number(secs[k], n));
+    if (!ok || !vw_cli_appendf(buf, len, cap, "\"total\": %s}\n}\n",
+                               vw_cli_json_number(vw_cli_now() - t0, n))) {
+        vw_cli_error(cmd, "out of memory for the stats");
+        return VW_EXIT_FAIL;
+    }
+    if (vw_cli_is_output() && vw_outfile_write(path, *buf, *len, err, sizeof err) != VW_OK) {
+        vw_cli_error(cmd, "%s", err);
+        return VW_EXIT_FAIL;
+    }
+    return VW_EXIT_OK;
+}
+
+int vw_cli_scene_json(char **buf, size_t *len, size_t *cap, const vw_scene *s)
+{
+    double lo[3], hi[3];
+    char n[6][32];
+    vw_scene_bounds(s, lo, hi);
+    return vw_cli_appendf(buf, len, cap,
+                          "\"objects\": %zu, \"spheres\": %zu, \"cones\": %zu, \"polygons\": %zu, "
+                          "\"vertices\": %zu, \"materials\": %zu, \"lights\": %zu, "
+                          "\"bounds\": [[%s, %s, %s], [%s, %s, %s]]",
+                          vw_scene_count_objects(s), s->nspheres, s->ncones, s->npolygons,
+                          s->nvertices, s->nmaterials, s->nlights, vw_cli_json_number(lo[0], n[0]),
+                          vw_cli_json_number(lo[1], n[1]), vw_cli_json_number(lo[2], n[2]),
+                          vw_cli_json_number(hi[0], n[3]), vw_cli_json_number(hi[1], n[4]),
+                          vw_cli_json_number(hi[2], n[5]));
+}

@@ -214,4 +214,28 @@ const char *vw_cli_bytes(double n, char *buf, size_t len);
 int vw_cli_appendf(char **buf, size_t *len, size_t *cap, const char *fmt, ...)
     __attribute__((format(printf, 4, 5)));
 
+/* The stats JSON of the commands that run no world (gen, info, bench; the others write
+   theirs with vw_world_write_stats): DESIGN's section 9 asks every command for
+   --stats FILE. vw_cli_stats_begin starts the object with the members every stats file
+   opens with: "command", "version", "engine" (kind, processes, workers: the job's,
+   workers_per_process); the caller appends its own members, each ",\n  \"name\": ...",
+   and vw_cli_stats_end closes the object and writes it to path on the output process
+   through vw_outfile (complete or absent). Its last member is "time_s": the nphases
+   phases' seconds by name (plain names: they are not escaped), then "total", the time
+   since t0. Each returns 0 when out of memory (append) or VW_EXIT_OK/VW_EXIT_FAIL
+   (end, after "vwalls CMD: path: why"). */
+int vw_cli_stats_begin(char **buf, size_t *len, size_t *cap, const char *cmd, int workers);
+int vw_cli_stats_end(const char *cmd, const char *path, char **buf, size_t *len, size_t *cap,
+                     double t0, const char *const *phases, const double *secs, int nphases);
+/* A JSON string (quoted, escaped) appended, as vw_cli_appendf; NULL is null. */
+int vw_cli_json_string(char **buf, size_t *len, size_t *cap, const char *s);
+/* x as a JSON number ("%.17g"), or null: JSON has no NaN nor infinity, and "nan" makes
+   the whole stats file unreadable. In buf. */
+const char *vw_cli_json_number(double x, char buf[32]);
+/* A scene's member of the stats JSON: "objects", "spheres", "cones", "polygons",
+   "vertices", "materials", "lights" and "bounds" [[lo], [hi]], appended after
+   ",\n  \"scene\": {" and what the caller puts first (its "file" or "generator") and
+   ", ". */
+int vw_cli_scene_json(char **buf, size_t *len, size_t *cap, const vw_scene *s);
+
 #endif

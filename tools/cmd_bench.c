@@ -47,6 +47,7 @@ static void help(void)
            "                   none maps the cells onto the workers, so rays cross between\n"
            "                   workers as messages (the paper's setting)\n"
            "  --csv FILE       also write the table as CSV (one row per configuration)\n"
+           "  --stats FILE     the stats JSON: the table's figures and every round's times\n"
            "  -q, --quiet      the table only (no scene line, no progress)\n"
            "  --help           this text\n"
            "Configurations: every layout with every worker count, in the order given; the\n"
@@ -152,6 +153,16 @@ static double median_ratio(const double *a, const double *b, int n)
     return n % 2 ? r[n / 2] : 0.5 * (r[n / 2 - 1] + r[n / 2]);
 }
 
+/* ", \"name\": [v0, v1, ...]": every round's seconds. 0 when out of memory. */
+static int rounds_json(char **buf, size_t *len, size_t *cap, const char *name, const double *v, int n)
+{
+    char x[32];
+    int ok = vw_cli_appendf(buf, len, cap, ", \"%s\": [", name);
+    for (int i = 0; i < n && ok; i++)
+        ok = vw_cli_appendf(buf, len, cap, "%s%s", i ? ", " : "", vw_cli_json_number(v[i], x));
+    return ok && vw_cli_appendf(buf, len, cap, "]");
+}
+
 /* One render of configuration c (its times go to round `round`; last: it is the last
    configuration); the output process keeps the pixel sums of the first render in *ref
    (allocated here) and compares every later render's with them: the first pixel that
@@ -227,7 +238,8 @@ static vw_status run_one(const vw_scene *scene, const vw_camera *cam, int width,
 
 int vw_cmd_bench(int argc, char **argv)
 {
-    const char *scene_path = NULL, *csv = NULL, *v;
+    const char *scene_path = NULL, *csv = NULL, *stats = NULL, *v;
+    double t0 = vw_cli_now();
     int width = 256, height = 256, quiet = 0, farm = -1, cells_given = 0, workers_given = 0;
     long depth = 5, repeat = 3;
     lists L;
@@ -261,6 +273,8 @@ int vw_cmd_bench(int argc, char **argv)
                 return VW_EXIT_USAGE;
         } else if (!strcmp(a, "--csv")) {
             if (!(csv = vw_cli_output(CMD, argc, argv, &i))) return VW_EXIT_USAGE;
+        } else if (!strcmp(a, "--stats")) {
+            if (!(stats = vw_cli_output(CMD, argc, argv, &i))) return VW_EXIT_USAGE;
         } else if (vw_cli_scene_arg(CMD, a, &scene_path)) {
             return VW_EXIT_USAGE;
         }
@@ -284,10 +298,10 @@ int vw_cmd_bench(int argc, char **argv)
         return VW_EXIT_USAGE;
     }
     {
-        const char *opts[] = {"--csv"};
-        const char *paths[] = {csv};
+        const char *opts[] = {"--csv", "--stats"};
+        const char *paths[] = {csv, stats};
         const char *inputs[] = {scene_path, NULL};
-        int crc = vw_cli_check_files(CMD, inputs, opts, paths, 1);
+        int crc = vw_cli_check_files(CMD, inputs, opts, paths, 2);
         if (crc != VW_EXIT_OK) return crc;
     }
 
@@ -314,6 +328,15 @@ int vw_cmd_bench(int argc, char **argv)
     if (vw_cli_same_view(CMD, width, height, depth, &cam, scene) || vw_cli_same_scene(CMD, scene)) {
         vw_scene_free(scene);
         return VW_EXIT_USAGE;
+    }
+    { /* no output over one of the scene's material libraries */
+        const char *opts[] = {"--csv", "--stats"};
+        const char *paths[] = {csv, stats};
+        int crc = vw_cli_check_scene_files(CMD, scene, opts, paths, 2);
+        if (crc != VW_EXIT_OK) {
+            vw_scene_free(scene);
+            return crc;
+        }
     }
 
     bench_config *conf = calloc((size_t)nconf, sizeof *conf);
@@ -364,6 +387,26 @@ int vw_cmd_bench(int argc, char **argv)
         }
     vw_progress_end(&bar);
     free(ref);
+    /* The stats' head, while the scene is at hand (the table's rows follow). */
+    char *js = NULL;
+    size_t jl = 0, jc = 0;
+    int jok = 1;
+    if (st == VW_OK && stats && out) {
+        long most = 1;
+        for (int k = 0; k < L.nworkers; k++)
+            if (L.workers[k] > most) most = L.workers[k];
+        jok = vw_cli_stats_begin(&js, &jl, &jc, CMD, (int)most);
+        jok = jok && vw_cli_appendf(&js, &jl, &jc, ",\n  \"scene\": {\"file\": ");
+        jok = jok && vw_cli_json_string(&js, &jl, &jc, scene_path);
+        if (!scene_path) jok = jok && vw_cli_appendf(&js, &jl, &jc, ", \"generator\": \"balls\"");
+        jok = jok && vw_cli_appendf(&js, &jl, &jc, ", ");
+        jok = jok && vw_cli_scene_json(&js, &jl, &jc, scene);
+        jok = jok && vw_cli_appendf(&js, &jl, &jc,
+                                    "},\n  \"image\": {\"width\": %d, \"height\": %d, \"depth\": %ld},"
+                                    "\n  \"rounds\": %ld,\n  \"farm\": \"%s\",\n  \"configurations\": [",
+                                    width, height, depth, repeat,
+                                    farm < 0 ? "auto" : rt_farm_name((rt_farm)farm));
+    }
     vw_scene_free(scene);
     if (st != VW_OK) {
         vw_cli_error(CMD, "%s", err);
@@ -399,8 +442,26 @@ int vw_cmd_bench(int argc, char **argv)
             ok &= vw_cli_appendf(&csvtext, &cl, &cc, "%s,%d,%d,%d,%.6f,%.6f,%.4f,%.4f,%.4f,%.4f,%.4f,%llu\n",
                                  name, c->cells, c->all_workers, c->copies, bb, cb, speedup, med, eff,
                                  c->lambda, visits, c->messages);
+            if (js) {
+                char n[7][32];
+                jok = jok && vw_cli_appendf(&js, &jl, &jc,
+                    "%s\n    {\"layout\": \"%s\", \"cells\": %d, \"workers\": %d, "
+                    "\"workers_per_process\": %ld, \"copies\": %d, \"build_s\": %s, \"compute_s\": %s, "
+                    "\"speedup\": %s, \"speedup_median\": %s, \"efficiency\": %s, \"imbalance\": %s, "
+                    "\"rays\": %lld, \"segments\": %lld, \"visits_per_ray\": %s, \"messages\": %llu",
+                    k ? "," : "", name, c->cells, c->all_workers, c->workers, c->copies,
+                    vw_cli_json_number(bb, n[0]), vw_cli_json_number(cb, n[1]),
+                    vw_cli_json_number(speedup, n[2]), vw_cli_json_number(med, n[3]),
+                    vw_cli_json_number(eff, n[4]), vw_cli_json_number(c->lambda, n[5]), c->rays,
+                    c->segments, vw_cli_json_number(visits, n[6]), c->messages);
+                jok = jok && rounds_json(&js, &jl, &jc, "build_rounds_s", c->build, (int)repeat);
+                jok = jok && rounds_json(&js, &jl, &jc, "compute_rounds_s", c->compute, (int)repeat);
+                jok = jok && vw_cli_appendf(&js, &jl, &jc, "}");
+            }
         }
-        if (!ok) {
+        if (js) jok = jok && vw_cli_appendf(&js, &jl, &jc, "\n  ],\n  \"images_identical\": %s",
+                                            bad_conf < 0 ? "true" : "false");
+        if (!ok || (stats && !jok)) {
             vw_cli_error(CMD, "out of memory for the table");
             rc = VW_EXIT_FAIL;
         } else {
@@ -422,15 +483,26 @@ int vw_cmd_bench(int argc, char **argv)
             } else if (!quiet) {
                 printf("images: identical in all %d configurations (fixed-point pixel sums)\n", nconf);
             }
-            /* A failed run leaves no output, as every command's. */
-            if (rc == VW_EXIT_OK && csv && vw_outfile_write(csv, csvtext, cl, err, sizeof err) != VW_OK) {
-                vw_cli_error(CMD, "%s", err);
-                rc = VW_EXIT_FAIL;
+            /* A failed run leaves no output, as every command's; the CSV and the stats
+               appear together or not at all. */
+            if (rc == VW_EXIT_OK && (csv || stats)) {
+                vw_outfile_hold();
+                if (csv && vw_outfile_write(csv, csvtext, cl, err, sizeof err) != VW_OK) {
+                    vw_cli_error(CMD, "%s", err);
+                    rc = VW_EXIT_FAIL;
+                }
+                if (rc == VW_EXIT_OK && stats)
+                    rc = vw_cli_stats_end(CMD, stats, &js, &jl, &jc, t0, NULL, NULL, 0);
+                if (vw_outfile_release(rc == VW_EXIT_OK, err, sizeof err) != VW_OK && rc == VW_EXIT_OK) {
+                    vw_cli_error(CMD, "%s", err);
+                    rc = VW_EXIT_FAIL;
+                }
             }
         }
         free(table);
         free(csvtext);
     }
+    free(js);
     free(conf);
     return rc;
 }

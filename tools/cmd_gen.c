@@ -35,13 +35,39 @@ static void gen_usage(FILE *f)
             "  --resolution WxH  camera resolution (default 512x512)\n"
             "  -o FILE.nff       write to FILE.nff (atomically) instead of stdout; under mpirun\n"
             "                    the first process alone writes it\n"
+            "  --stats FILE      the stats JSON: the generator, its parameters, the scene's\n"
+            "                    counts and bounds, the time taken\n"
             "  --help            this text\n"
             "\nexit status: 0 success, 2 bad input or usage, 1 any other failure\n");
 }
 
+/* The stats JSON up to its times: the generator and the parameters it used (those it
+   takes: --size of balls, rings, tree; --count and --cluster of spheres; --seed of
+   spheres and tree), then the scene's counts and bounds. 0 when out of memory. */
+static int gen_stats(char **buf, size_t *len, size_t *cap, const char *name,
+                     const vw_gen_params *p, const vw_scene *s, int sized, int seeded, int random)
+{
+    char n[32];
+    int ok = vw_cli_stats_begin(buf, len, cap, "gen", 1);
+    ok = ok && vw_cli_appendf(buf, len, cap, ",\n  \"scene\": {\"generator\": ");
+    ok = ok && vw_cli_json_string(buf, len, cap, name);
+    if (sized)
+        ok = ok && vw_cli_appendf(buf, len, cap, ", \"size\": %d",
+                                  p->size ? p->size : vw_gen_default_size(name));
+    if (random)
+        ok = ok && vw_cli_appendf(buf, len, cap, ", \"count\": %d, \"cluster\": %s",
+                                  p->count ? p->count : 1000, vw_cli_json_number(p->cluster, n));
+    if (seeded)
+        ok = ok && vw_cli_appendf(buf, len, cap, ", \"seed\": %llu", (unsigned long long)p->seed);
+    ok = ok && vw_cli_appendf(buf, len, cap, ", ");
+    ok = ok && vw_cli_scene_json(buf, len, cap, s);
+    return ok && vw_cli_appendf(buf, len, cap, "}");
+}
+
 int vw_cmd_gen(int argc, char **argv)
 {
-    const char *cmd = "gen", *name = NULL, *out = NULL, *v;
+    const char *cmd = "gen", *name = NULL, *out = NULL, *stats = NULL, *v;
+    double t0 = vw_cli_now();
     int seed_given = 0, cluster_given = 0;
     vw_gen_params p;
     vw_gen_params_init(&p);
@@ -87,6 +113,9 @@ int vw_cmd_gen(int argc, char **argv)
         } else if (!strcmp(a, "-o")) {
             if (!(out = vw_cli_output(cmd, argc, argv, &i)))
                 return VW_EXIT_USAGE;
+        } else if (!strcmp(a, "--stats")) {
+            if (!(stats = vw_cli_output(cmd, argc, argv, &i)))
+                return VW_EXIT_USAGE;
         } else if (a[0] == '-' && a[1]) {
             vw_cli_error(cmd, "unknown option '%s' (try vwalls gen --help)", a);
             return VW_EXIT_USAGE;
@@ -125,9 +154,9 @@ int vw_cmd_gen(int argc, char **argv)
                           "--count, --cluster: spheres; --seed: spheres, tree)", unused, name);
         return VW_EXIT_USAGE;
     }
-    if (out) { /* before generating: a big scene was made, then not written */
-        const char *opts[] = {"-o"}, *paths[] = {out};
-        int rc = vw_cli_check_outputs(cmd, opts, paths, 1);
+    if (out || stats) { /* before generating: a big scene was made, then not written */
+        const char *opts[] = {"-o", "--stats"}, *paths[] = {out, stats};
+        int rc = vw_cli_check_outputs(cmd, opts, paths, 2);
         if (rc != VW_EXIT_OK) return rc;
     }
     char err[512] = "";
@@ -137,6 +166,20 @@ int vw_cmd_gen(int argc, char **argv)
         vw_cli_error(cmd, "%s", err);
         return st == VW_E_INVAL || st == VW_E_LIMIT ? VW_EXIT_USAGE : VW_EXIT_FAIL;
     }
+    double t1 = vw_cli_now();
+    /* The stats are made before the scene is written, so that running out of memory
+       for them leaves no scene file either. */
+    char *json = NULL;
+    size_t jl = 0, jc = 0;
+    if (stats && !gen_stats(&json, &jl, &jc, name, &p, s, sized, seeded, random)) {
+        vw_cli_error(cmd, "out of memory for the stats");
+        vw_scene_free(s);
+        free(json);
+        return VW_EXIT_FAIL;
+    }
+    /* The scene and the stats appear together or not at all (vw_outfile_hold). */
+    int held = out && stats && vw_cli_is_output();
+    if (held) vw_outfile_hold();
     if (out) {
         /* Under mpirun only the output process writes the file, as every command writes
            its outputs (the others wrote the same bytes over it); all exit with its status
@@ -144,13 +187,26 @@ int vw_cmd_gen(int argc, char **argv)
         st = vw_cli_is_output() ? vw_scene_write_nff_file(s, out, err, sizeof err) : VW_OK;
     } else {
         st = vw_scene_write_nff(s, stdout);
-        if (st != VW_OK && ferror(stdout)) st = VW_OK; /* main reports standard output */
         snprintf(err, sizeof err, "cannot write to standard output");
+        /* main reports a failed standard output (and says why); with --stats it must
+           be known here, or the stats would tell of a scene that was not written. */
+        if (stats) fflush(stdout);
+        if (ferror(stdout)) st = VW_E_IO, err[0] = 0;
     }
     vw_scene_free(s);
+    int rc = VW_EXIT_OK;
     if (st != VW_OK) {
-        vw_cli_error(cmd, "%s", err);
-        return VW_EXIT_FAIL;
+        if (err[0]) vw_cli_error(cmd, "%s", err);
+        rc = VW_EXIT_FAIL;
+    } else if (stats) {
+        const char *names[] = {"generate", "write"};
+        double secs[] = {t1 - t0, vw_cli_now() - t1};
+        rc = vw_cli_stats_end(cmd, stats, &json, &jl, &jc, t0, names, secs, 2);
     }
-    return VW_EXIT_OK;
+    if (held && vw_outfile_release(rc == VW_EXIT_OK, err, sizeof err) != VW_OK && rc == VW_EXIT_OK) {
+        vw_cli_error(cmd, "%s", err);
+        rc = VW_EXIT_FAIL;
+    }
+    free(json);
+    return rc;
 }

@@ -13,19 +13,21 @@
 
 static void info_usage(FILE *f)
 {
-    fprintf(f, "usage: vwalls info SCENE.(nff|obj|ply) [--objects] [--materials]\n"
+    fprintf(f, "usage: vwalls info SCENE.(nff|obj|ply) [--objects] [--materials] [--stats FILE]\n"
                "\n"
                "Prints what the scene holds: object counts, bounds, camera and lights.\n"
-               "  --objects   also one line per object: id, kind, bounds and material\n"
-               "  --materials also one line per material:\n"
-               "                material N: 'NAME' at FILE:LINE used by U (diffuse R G B, ...)\n"
-               "              (the name for MTL only; 'at -' when from no file: a default, or\n"
-               "              a usemtl name no library defined; U: spheres, cones and polygons\n"
-               "              using it), and after it, for a reflectance (diffuse) the\n"
-               "              radiosity solver clamps (outside [0, 1]) or warns about (1 or\n"
-               "              more in a channel, not emitting), a line\n"
-               "                FILE:LINE: warning: material 'NAME': reflectance R G B ...\n"
-               "  --help      this text\n"
+               "  --objects    also one line per object: id, kind, bounds and material\n"
+               "  --materials  also one line per material:\n"
+               "                 material N: 'NAME' at FILE:LINE used by U (diffuse R G B, ...)\n"
+               "               (the name for MTL only; 'at -' when from no file: a default, or\n"
+               "               a usemtl name no library defined; U: spheres, cones and polygons\n"
+               "               using it), and after it, for a reflectance (diffuse) the\n"
+               "               radiosity solver clamps (outside [0, 1]) or warns about (1 or\n"
+               "               more in a channel, not emitting), a line\n"
+               "                 FILE:LINE: warning: material 'NAME': reflectance R G B ...\n"
+               "  --stats FILE the stats JSON: the scene's counts and bounds, the time to\n"
+               "               read it\n"
+               "  --help       this text\n"
                "\nexit status: 0 success, 2 bad input or usage, 1 any other failure\n");
 }
 
@@ -154,9 +156,22 @@ static void print_materials(const vw_scene *s, const char *path, const size_t *u
     }
 }
 
+/* The stats JSON up to its times: the scene file, its counts and bounds, whether it
+   gives a camera. 0 when out of memory. */
+static int info_stats(char **buf, size_t *len, size_t *cap, const char *path, const vw_scene *s)
+{
+    int ok = vw_cli_stats_begin(buf, len, cap, "info", 1);
+    ok = ok && vw_cli_appendf(buf, len, cap, ",\n  \"scene\": {\"file\": ");
+    ok = ok && vw_cli_json_string(buf, len, cap, path);
+    ok = ok && vw_cli_appendf(buf, len, cap, ", ");
+    ok = ok && vw_cli_scene_json(buf, len, cap, s);
+    return ok && vw_cli_appendf(buf, len, cap, ", \"camera\": %s}", s->camera.valid ? "true" : "false");
+}
+
 int vw_cmd_info(int argc, char **argv)
 {
-    const char *cmd = "info", *path = NULL;
+    const char *cmd = "info", *path = NULL, *stats = NULL;
+    double t0 = vw_cli_now();
     int objects = 0, materials = 0;
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
@@ -167,6 +182,9 @@ int vw_cmd_info(int argc, char **argv)
             objects = 1;
         } else if (!strcmp(a, "--materials")) {
             materials = 1;
+        } else if (!strcmp(a, "--stats")) {
+            if (!(stats = vw_cli_output(cmd, argc, argv, &i)))
+                return VW_EXIT_USAGE;
         } else if (a[0] == '-' && a[1]) {
             vw_cli_error(cmd, "unknown option '%s' (try vwalls info --help)", a);
             return VW_EXIT_USAGE;
@@ -181,6 +199,11 @@ int vw_cmd_info(int argc, char **argv)
         vw_cli_error(cmd, "which scene? (try vwalls info --help)");
         return VW_EXIT_USAGE;
     }
+    const char *opts[] = {"--stats"}, *paths[] = {stats}, *inputs[] = {path, NULL};
+    if (stats) {
+        int crc = vw_cli_check_files(cmd, inputs, opts, paths, 1);
+        if (crc != VW_EXIT_OK) return crc;
+    }
     char err[1024] = "";
     vw_scene *s = NULL;
     /* Under MPI every process reads the scene, as every command does; all stop if one
@@ -192,6 +215,23 @@ int vw_cmd_info(int argc, char **argv)
         vw_scene_free(s);
         return st == VW_E_INPUT || st == VW_E_INVAL ? VW_EXIT_USAGE : VW_EXIT_FAIL;
     }
+    double t1 = vw_cli_now();
+    if (stats) { /* not over one of its material libraries */
+        int crc = vw_cli_check_scene_files(cmd, s, opts, paths, 1);
+        if (crc != VW_EXIT_OK) {
+            vw_scene_free(s);
+            return crc;
+        }
+    }
+    /* The stats are made before anything is printed, as the material uses are. */
+    char *json = NULL;
+    size_t jl = 0, jc = 0;
+    if (stats && !info_stats(&json, &jl, &jc, path, s)) {
+        vw_cli_error(cmd, "%s: out of memory", path);
+        vw_scene_free(s);
+        free(json);
+        return VW_EXIT_FAIL;
+    }
     /* Counted before anything is printed, so that running out of memory prints nothing. */
     size_t *uses = NULL;
     if (materials) {
@@ -199,6 +239,7 @@ int vw_cmd_info(int argc, char **argv)
         if (!uses) {
             vw_cli_error(cmd, "%s: out of memory", path);
             vw_scene_free(s);
+            free(json);
             return VW_EXIT_FAIL;
         }
         count_uses(s, uses);
@@ -233,5 +274,17 @@ int vw_cmd_info(int argc, char **argv)
         print_materials(s, path, uses);
     free(uses);
     vw_scene_free(s);
-    return VW_EXIT_OK; /* a failed write shows at the flush: main checks standard output */
+    int rc = VW_EXIT_OK; /* a failed write shows at the flush: main checks standard output */
+    if (stats) {
+        /* After the description has reached standard output (main would report its
+           failure, and there must be no stats then). */
+        fflush(stdout);
+        if (!ferror(stdout)) {
+            const char *names[] = {"load"};
+            double secs[] = {t1 - t0};
+            rc = vw_cli_stats_end(cmd, stats, &json, &jl, &jc, t0, names, secs, 1);
+        }
+    }
+    free(json);
+    return rc;
 }

@@ -160,15 +160,6 @@ static void on_round(void *user, rad_solver *s, int round)
     if (vw_world_agree(w, wst, err, sizeof err) != VW_OK) r->failed = 1;
 }
 
-/* x as a JSON number, or null: JSON has no NaN nor infinity, and "nan" makes the whole
-   stats file unreadable. */
-static const char *json_number(double x, char buf[32])
-{
-    if (isfinite(x)) snprintf(buf, 32, "%.17g", x);
-    else snprintf(buf, 32, "null");
-    return buf;
-}
-
 /* --view fx,fy,fz,ax,ay,az[,fov]: the camera, +y up (+z when the view is within a
    degree of vertical); -1 after the message when it gives no view. Its near plane is
    set once the scene is read (view_hither). */
@@ -601,13 +592,13 @@ int vw_cmd_radiosity(int argc, char **argv)
                      "\"elements\": %zu, "
                      "\"emitted\": %s, \"absorbed\": %s, \"unshot\": %s, \"escaped\": %s, "
                      "\"shot_messages\": %lld, \"shot_bytes\": %lld, \"full_messages\": %lld}",
-                     (long long)rad_solver_shots(s), json_number(rad_solver_unshot_ratio(s), n[0]),
-                     json_number(L.error, n[1]), converged ? "true" : "false", stalled ? "true" : "false",
-                     json_number(o.sf, n[2]),
-                     o.res, mesh.npieces, ne, json_number(L.emitted[0] + L.emitted[1] + L.emitted[2], n[3]),
-                     json_number(L.absorbed[0] + L.absorbed[1] + L.absorbed[2], n[4]),
-                     json_number(L.unshot[0] + L.unshot[1] + L.unshot[2], n[5]),
-                     json_number(L.escaped[0] + L.escaped[1] + L.escaped[2], n[6]),
+                     (long long)rad_solver_shots(s), vw_cli_json_number(rad_solver_unshot_ratio(s), n[0]),
+                     vw_cli_json_number(L.error, n[1]), converged ? "true" : "false", stalled ? "true" : "false",
+                     vw_cli_json_number(o.sf, n[2]),
+                     o.res, mesh.npieces, ne, vw_cli_json_number(L.emitted[0] + L.emitted[1] + L.emitted[2], n[3]),
+                     vw_cli_json_number(L.absorbed[0] + L.absorbed[1] + L.absorbed[2], n[4]),
+                     vw_cli_json_number(L.unshot[0] + L.unshot[1] + L.unshot[2], n[5]),
+                     vw_cli_json_number(L.escaped[0] + L.escaped[1] + L.escaped[2], n[6]),
                      (long long)sm, (long long)sb, (long long)fm);
             vw_world_add_time(w, "load", t1 - t0);
             vw_world_add_time(w, "build", (t2 - t1) + (t3 - t2));

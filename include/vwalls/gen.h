@@ -34,6 +34,10 @@ VW_API void vw_gen_params_init(vw_gen_params *p);
 VW_API vw_status vw_gen(const char *name, const vw_gen_params *p, vw_scene **out,
                         char *err, size_t errlen);
 
+/* The size a generator takes when vw_gen_params.size is 0: balls 4, rings 5, tree 6;
+   0 for the others (and unknown names), which take no size. */
+VW_API int vw_gen_default_size(const char *name);
+
 /* The generator names, for help texts: i = 0, 1, ... until NULL. */
 VW_API const char *vw_gen_name(size_t i);
 

@@ -266,9 +266,15 @@ static vw_status flake(vw__sb *b, int m, const double (*dirs)[3], const double c
     return VW_OK;
 }
 
+int vw_gen_default_size(const char *name)
+{
+    return !name ? 0 : !strcmp(name, "balls") ? 4 : !strcmp(name, "rings") ? 5
+         : !strcmp(name, "tree") ? 6 : 0;
+}
+
 static vw_status gen_balls(vw__sb *b, const vw_gen_params *p)
 {
-    int n = p->size ? p->size : 4;
+    int n = p->size ? p->size : vw_gen_default_size("balls");
     vw_scene *s = b->s;
     /* The classic SPD view, lights and colours (each of 3 lights at 1/sqrt(3)). */
     camera(s, p, 2.1, 1.3, 1.7, 0, 0, 0, 0, 0, 1, 45, 0.01);
@@ -298,7 +304,7 @@ static vw_status gen_balls(vw__sb *b, const vw_gen_params *p)
    alternate between two tilts so that neighbours interlock like chain mail. */
 static vw_status gen_rings(vw__sb *b, const vw_gen_params *p)
 {
-    int n = p->size ? p->size : 5;
+    int n = p->size ? p->size : vw_gen_default_size("rings");
     vw_scene *s = b->s;
     const double R = 1.0, tube = 0.18, spacing = 1.7 * R;
     const int segs = 12;
@@ -399,7 +405,7 @@ static vw_status branch(tree_ctx *t, const double base[3], const double dir[3], 
 
 static vw_status gen_tree(vw__sb *b, const vw_gen_params *p)
 {
-    int n = p->size ? p->size : 6;
+    int n = p->size ? p->size : vw_gen_default_size("tree");
     vw_scene *s = b->s;
     camera(s, p, 0, -9, 3.2, 0, 0, 2.6, 0, 0, 1, 45, 0.01);
     s->background[0] = 0.55f;

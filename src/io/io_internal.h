@@ -87,6 +87,11 @@ vw_status vw__sb_add_vertex(vw__sb *b, const double v[3], int *index);
 void vw__sb_polygon_begin(vw__sb *b);
 vw_status vw__sb_polygon_corner(vw__sb *b, int vertex, const double *normal);
 vw_status vw__sb_polygon_end(vw__sb *b, int material, int has_normals);
+/* Drops the polygon being built, its corners so far (a reader that skips a face). */
+static inline void vw__sb_polygon_drop(vw__sb *b)
+{
+    b->s->nindices = b->poly_first;
+}
 /* Convenience: a polygon from its own fresh vertices (no normals). */
 vw_status vw__sb_add_polygon(vw__sb *b, int material, int n, const double (*v)[3]);
 

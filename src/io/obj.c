@@ -383,13 +383,45 @@ static vw_status add_named_material(obj *O, span name, int wait_line)
     return VW_OK;
 }
 
+/* A material name without the comment a hand-edited file may put after it: the part
+   before the first blank followed by '#' ("red # the red one": "red"), blanks around it
+   removed; the name as it is when it has no such comment (or the comment would be all
+   of it). */
+static span without_comment(span name)
+{
+    for (size_t i = 1; i < name.n; i++)
+        if (name.s[i] == '#' && is_space(name.s[i - 1])) {
+            span k = rest_of_line((span){name.s, i});
+            return k.n ? k : name;
+        }
+    return name;
+}
+
+static int span_eq(span a, span b)
+{
+    return a.n == b.n && memcmp(a.s, b.s, a.n) == 0;
+}
+
 /* The newest material called name, or -1: a later library's definition of a name
-   replaces an earlier one for the usemtl statements after it. */
+   replaces an earlier one for the usemtl statements after it.
+   A name is the rest of its line, blanks and '#' included, as Blender and Assimp read
+   it (3ds Max names materials "Material #1"); names are matched whole first. Only when
+   no name matches whole does a comment count: a name with one matches a name without
+   it ("usemtl red # the red one" finds "newmtl red", and "usemtl red" finds "newmtl red
+   # the red one"). Two names both cut at their '#' are never compared, so "Material #2"
+   does not find "Material #1". */
 static long find_named_material(const obj *O, span name)
 {
     for (size_t i = O->nnames; i-- > 0;)
         if (strlen(O->mat_names[i]) == name.n && memcmp(O->mat_names[i], name.s, name.n) == 0)
             return (long)i;
+    span cut = without_comment(name);
+    for (size_t i = O->nnames; i-- > 0;) {
+        span have = {O->mat_names[i], strlen(O->mat_names[i])};
+        if ((cut.n != name.n && span_eq(cut, have)) ||
+            (cut.n == name.n && span_eq(without_comment(have), name)))
+            return (long)i;
+    }
     return -1;
 }
 
@@ -503,6 +535,13 @@ static vw_status parse_mtl(obj *O, const char *text, size_t len)
             if (i >= 0 && O->mat_wait[i]) {
                 O->mat_wait[i] = 0;
                 m = &O->b.s->materials[O->mat_ids[i]];
+                /* Matched without a comment (find_named_material): the material takes
+                   the name its definition gives, which later usemtl lines look up. */
+                if (strlen(O->mat_names[i]) != name.n || memcmp(O->mat_names[i], name.s, name.n)) {
+                    if ((st = vw__sb_add_string(&O->b, name.s, name.n, &m->name)) != VW_OK)
+                        return fail_status(O, st);
+                    O->mat_names[i] = O->b.s->strings[m->name - 1];
+                }
             } else {
                 st = add_named_material(O, name, 0);
                 if (st != VW_OK)
@@ -756,7 +795,7 @@ static vw_status parse_face(obj *O, span *line)
     O->b.line = O->line; /* the statement's first line */
     vw__sb_polygon_begin(&O->b);
     while (next_tok(O, line, &t)) {
-        /* v, v/vt, v//vn or v/vt/vn */
+        /* v, v/vt, v/vt/ (as v/vt), v//vn or v/vt/vn */
         span part[3] = {{t.s, 0}, {NULL, 0}, {NULL, 0}};
         int np = 1;
         for (size_t i = 0; i < t.n; i++) {
@@ -779,12 +818,13 @@ static vw_status parse_face(obj *O, span *line)
             return st;
         if (np == 2 && !part[1].n)
             return fail(O, "bad face vertex '%s'", show(t, sb));
-        if (np == 3) {
-            if (!part[2].n)
-                return fail(O, "bad face vertex '%s'", show(t, sb));
-            if ((st = resolve(O, part[2], "normal", O->nvn, slot, &ni)) != VW_OK)
-                return st;
-        }
+        /* v/vt/ (an empty normal after a texture index) is v/vt: some exporters write
+           it, and tinyobjloader and Assimp read it so. v// is still an error. */
+        if (np == 3 && !part[2].n && !part[1].n)
+            return fail(O, "bad face vertex '%s'", show(t, sb));
+        if (np == 3 && part[2].n &&
+            (st = resolve(O, part[2], "normal", O->nvn, slot, &ni)) != VW_OK)
+            return st;
         if (ni < 0)
             all_normals = 0;
         /* A normal defined later is filled in at the end (resolve_later). */

@@ -3,12 +3,13 @@
  * either byte order.
  *
  * Read: the element "vertex" (x, y, z; nx, ny, nz when all three are there: the
- * corners' normals; red, green, blue when all three are there: integers as 0..255,
- * floats as 0..1) and the element "face" (its list "vertex_indices" or "vertex_index";
- * red, green, blue as for vertices). A face's colour is its own, else the mean of its
- * corners' colours, else 0.8 grey, as an OBJ face without a material; equal colours
- * share one material. Every other element and property is read past. PLY has no
- * camera and no lights: the commands' defaults apply, as for OBJ.
+ * corners' normals; red, green, blue when all three are there: ushort as 0..65535,
+ * other integers as 0..255, floats as 0..1) and the element "face" (its list
+ * "vertex_indices" or "vertex_index"; red, green, blue as for vertices). A face's
+ * colour is its own, else the mean of its corners' colours, else 0.8 grey, as an OBJ
+ * face without a material; equal colours share one material. A face of fewer than 3
+ * corners is skipped with a warning. Every other element and property is read past.
+ * PLY has no camera and no lights: the commands' defaults apply, as for OBJ.
  * Errors are "file:line: message": the header's line, an ASCII value's line, and for
  * binary data the line of end_header with the element, the record and the byte offset
  * in the message. An ASCII record is one line (a value more or less is that line's
@@ -72,6 +73,15 @@ static vw_status fail(ply *P, const char *fmt, ...)
     vw_status st = vw__input_error(P->err, P->errlen, P->name, P->line, fmt, ap);
     va_end(ap);
     return st;
+}
+
+static void warn(ply *P, int line, const char *fmt, ...) __attribute__((format(printf, 3, 4)));
+static void warn(ply *P, int line, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    vw__scene_warning(P->name, line, fmt, ap);
+    va_end(ap);
 }
 
 static vw_status fail_status(ply *P, vw_status st)
@@ -438,12 +448,15 @@ static int find3(const elem *e, const char *a, const char *b, const char *c, int
     return 1;
 }
 
-/* A colour component: integers 0..255, floats 0..1. */
+/* A colour component: floats 0..1, ushort 0..65535 (16-bit colour, scaled by its
+   type's range as Blender's importer does), every other integer type 0..255. */
 static vw_status color_value(ply *P, enum ptype t, double v, const char *what, float *out)
 {
-    double c = is_float(t) ? v : v / 255.0;
+    double full = is_float(t) ? 1.0 : t == T_U16 ? 65535.0 : 255.0;
+    double c = v / full;
     if (!(c >= 0 && c <= 1))
-        return fail(P, "%s: colour component %g outside %s", what, v, is_float(t) ? "0..1" : "0..255");
+        return fail(P, "%s: colour component %g outside %s", what, v,
+                    is_float(t) ? "0..1" : "0..255");
     *out = (float)c;
     return VW_OK;
 }
@@ -570,16 +583,27 @@ static vw_status read_faces(ply *P, const elem *e, int seen_vertices)
     if (!vals)
         return fail_status(P, VW_E_NOMEM);
     char what[64];
+    /* A face of fewer than 3 corners (a face collapsed to an edge or a point) is no
+       polygon: it is skipped, as Blender's importer drops it, with one warning for all
+       of them at the first one's line (in binary data the line after end_header). */
+    uint64_t skipped = 0, first_skipped = 0;
+    int skipped_line = 0;
     for (uint64_t r = 0; r < e->count && st == VW_OK; r++) {
         snprintf(what, sizeof what, "face %llu", (unsigned long long)r);
         face_acc acc = {0, {0, 0, 0}};
         vw__sb_polygon_begin(&P->b);
         st = read_record(P, e, what, vals, list, face_corner, &acc);
         P->b.line = P->format == F_ASCII ? P->last_line : 0; /* an ASCII record is a line */
-        if (st == VW_OK && acc.corners < 3)
-            st = fail(P, "%s: a polygon needs at least 3 vertices, it has %d", what, acc.corners);
         if (st != VW_OK)
             break;
+        if (acc.corners < 3) {
+            vw__sb_polygon_drop(&P->b);
+            if (!skipped++) {
+                first_skipped = r;
+                skipped_line = P->format == F_ASCII ? P->last_line : P->line;
+            }
+            continue;
+        }
         float c[3];
         const float *col = NULL;
         if (has_c) {
@@ -599,6 +623,10 @@ static vw_status read_faces(ply *P, const elem *e, int seen_vertices)
             st = fail_status(P, st);
     }
     free(vals);
+    if (st == VW_OK && skipped)
+        warn(P, skipped_line, "%llu face%s of fewer than 3 corners skipped (the first: face %llu)",
+             (unsigned long long)skipped, skipped > 1 ? "s" : "",
+             (unsigned long long)first_skipped);
     return st;
 }
 

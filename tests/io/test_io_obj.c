@@ -384,6 +384,50 @@ static void library_with_blanks(void)
     rmdir(dir);
 }
 
+/* A '#' after a blank in a usemtl or newmtl name (known-issues, 26th review): the name is
+   the whole rest of the line, as Blender and Assimp read it, so 3ds Max's "Material #1"
+   and "Material #2" stay two materials; a name that matches no material whole is tried
+   without its comment, so "usemtl red # the red one" finds "newmtl red" (it was a
+   material of its own, 0.8 grey, with a warning) and "usemtl green" finds "newmtl green
+   # the green one", in either order of usemtl and library. */
+static void material_comments(void)
+{
+    char dir[] = "/tmp/vw_mcomment_XXXXXX", path[256];
+    CHECK(mkdtemp(dir) != NULL);
+    write_file(dir, "c.mtl", "newmtl red\nKd 1 0 0\nnewmtl green # the green one\nKd 0 1 0\n"
+                             "newmtl Material #1\nKd 0 0 1\nnewmtl Material #2\nKd 1 1 0\n");
+    const char *t = "usemtl red # before its library\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"
+                    "mtllib c.mtl\nusemtl red # the red one\nf 1 2 3\nusemtl green\nf 1 2 3\n"
+                    "usemtl Material #1\nf 1 2 3\nusemtl Material #2 \nf 1 2 3\n"
+                    "usemtl Material #3\nf 1 2 3\n";
+    char err[512];
+    vw_scene *s;
+    nwarnings = 0;
+    vw_status st = vw_scene_read_obj("m.obj", t, strlen(t), dir, &s, err, sizeof err);
+    if (st != VW_OK)
+        fprintf(stderr, "%s\n", err);
+    CHECK_EQ_INT(st, VW_OK);
+    for (int k = 0; k < nwarnings && k < 16; k++)
+        printf("material_comments: warning %d: %s\n", k, warnings[k]);
+    /* Only "Material #3" is not defined: it does not take "Material #1" or "#2". */
+    CHECK_EQ_INT(nwarnings, 1);
+    CHECK(!strcmp(warnings[0], "m.obj:15: warning: material 'Material #3' is not defined by a "
+                               "material library (the default material is used)"));
+    CHECK_EQ_INT(s->npolygons, 6);
+    const float want[6][3] = {{1, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {1, 1, 0},
+                              {0.8f, 0.8f, 0.8f}};
+    for (int i = 0; i < 6; i++) {
+        const float *d = s->materials[s->polygons[i].material].diffuse;
+        EXPECT(!memcmp(d, want[i], sizeof want[i]), "face %d: diffuse %g %g %g", i, d[0], d[1], d[2]);
+    }
+    /* The usemtl before the library and the one after it name one material. */
+    CHECK_EQ_INT(s->polygons[0].material, s->polygons[1].material);
+    vw_scene_free(s);
+    snprintf(path, sizeof path, "%s/c.mtl", dir);
+    remove(path);
+    rmdir(dir);
+}
+
 int main(int argc, char **argv)
 {
     CHECK(argc == 2);
@@ -490,10 +534,29 @@ int main(int argc, char **argv)
     material_place();
     later_references();
     library_with_blanks();
+    material_comments();
     /* A library that is there but wrong is still an error. */
     snprintf(path, sizeof path, "%s/bad/obj_mtl_error.obj", argv[1]);
     CHECK_EQ_INT(vw_scene_read_file(path, &n, err, sizeof err), VW_E_INPUT);
     CHECK(strstr(err, "kd_first.mtl:") != NULL);
+    /* v/vt/ (a texture index and an empty normal, known-issues, 26th review) reads as
+       v/vt, as tinyobjloader and Assimp read it; it was "bad face vertex". v// and
+       v/vt/vn/x still are. */
+    t = "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvn 0 0 1\nf 1/1/ 2/1/ 3/1/\nf 1/1/ 2/1/1 3/1/\n";
+    st = vw_scene_read_obj("t.obj", t, strlen(t), NULL, &n, err, sizeof err);
+    if (st != VW_OK)
+        fprintf(stderr, "%s\n", err);
+    CHECK_EQ_INT(st, VW_OK);
+    CHECK(n->npolygons == 2 && n->polygons[0].count == 3 && !n->polygons[0].has_normals &&
+          !n->polygons[1].has_normals);
+    CHECK(corner(n, 0, 0) == 0 && corner(n, 0, 1) == 1 && corner(n, 0, 2) == 2);
+    vw_scene_free(n);
+    t = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1// 2// 3//\n";
+    CHECK_EQ_INT(vw_scene_read_obj("t.obj", t, strlen(t), NULL, &n, err, sizeof err), VW_E_INPUT);
+    CHECK(!strcmp(err, "t.obj:4: bad face vertex '1//'"));
+    t = "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nf 1/1/ 2/1/ 3/2/\n";
+    CHECK_EQ_INT(vw_scene_read_obj("t.obj", t, strlen(t), NULL, &n, err, sizeof err), VW_E_INPUT);
+    CHECK(!strcmp(err, "t.obj:5: texture index 2 out of range (1 texture coordinates)"));
     /* Exact message for an index out of range. */
     t = "v 0 0 0\nv 1 0 0\nv 0 1 0\n# comment\nf 1 2 4\n";
     CHECK_EQ_INT(vw_scene_read_obj("r.obj", t, strlen(t), NULL, &n, err, sizeof err), VW_E_INPUT);

@@ -52,6 +52,14 @@ set_tests_properties(balance_cli PROPERTIES LABELS "balance;mpi" TIMEOUT 300 PRO
 add_test(NAME balance_divide_stop COMMAND vw_test_balance divide_stop)
 set_tests_properties(balance_divide_stop PROPERTIES LABELS "balance")
 
+# divide's bound on extra cells holds over a run of divides, each on the last one's result
+# (render's rounds, animate's rebalances), not per call: the cells piled up round after
+# round (1026 at 4x4x4 on 64 workers for a bound of 64 + 4 x 64).
+add_test(NAME balance_divide_rounds COMMAND vw_test_balance divide_rounds)
+add_test(NAME balance_divide_rounds_render COMMAND vw_test_balance divide_rounds_render)
+set_tests_properties(balance_divide_rounds balance_divide_rounds_render PROPERTIES
+  LABELS "balance;threads" ENVIRONMENT "${VW_BAL_TSAN}")
+
 # A balance the render keeps never gives its slowest worker more counted work than the
 # layout it started from (rotate and divide lowered lambda while adding work).
 add_test(NAME balance_slowest

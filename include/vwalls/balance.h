@@ -114,7 +114,10 @@ typedef struct vw_balance_params {
     const double *speeds; /* relative worker speeds (gworkers entries) or NULL; rotate
                            judges its frames by the lambda of their cells mapped by speed */
     double tolerance;   /* divide / duplicate: stop at lambda <= 1 + tolerance (0.03) */
-    int max_extra;      /* divide: at most this many extra cells (0: 4 * gworkers);
+    int max_extra;      /* divide: at most this many extra cells (0: 4 * gworkers),
+                           over a run of divides each on the last one's result: a
+                           VW_DECOMP_DIVIDED decomposition (divide's) may grow to
+                           gworkers + max_extra cells in all, no further;
                            duplicate: at most this many copies (0: 4 * gworkers, or one
                            a cell where the cells are more, up to 1024) */
 } vw_balance_params;

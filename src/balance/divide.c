@@ -8,7 +8,8 @@
  * wide to hold a wall or its cut would leave all the load on one side, the next longest
  * that is not). A cell that cannot be cut on any side (every side too few doubles wide)
  * is marked and passed over for the next heaviest: the other cells' pieces can still
- * fill the other workers. Bounded by max_extra splits; ends early when no cell can be
+ * fill the other workers. Bounded by max_extra extra cells over a run of divides, each on
+ * the last one's cells, not per call (divide_limit); ends early when no cell can be
  * cut, and when an uncuttable cell alone sets lambda on a fastest worker (no cut can
  * lower lambda then: see divide_stops).
  */
@@ -121,6 +122,28 @@ static int divide_stops(const vw_decomp *d, const double *load, const int *map, 
     return 0;
 }
 
+/* How many cells divide may leave in all, given cur's nc cells on gw workers and
+   max_extra extra cells. The bound holds over a run of divides, each on the last one's
+   result (the ray tracer's rounds, animate's rebalances between frames), not per call:
+   divide never merges cells, and a per-call max_extra let the cells pile up round after
+   round (the clustered scene at 4x4x4 on 64 workers, render's five rounds: 1026 cells
+   for a budget of 256 extra). A decomposition divide has not made (a grid, a staggered
+   one) is where a run starts: max_extra more. A divided one (the kind divide returns)
+   may already hold extra cells, and which of them are extra the tree does not tell:
+   it may grow to gworkers + max_extra cells, and one that holds that many or more
+   gets none. So a run that starts from n cells never holds more than max(n, gworkers) +
+   max_extra (n + max_extra where n >= gworkers, the grid of every worker a cell or
+   more). VW_MAX_CELLS caps it all. */
+static int divide_limit(const vw_decomp *cur, int nc, int gw, int max_extra)
+{
+    long long lim = (long long)nc + max_extra;
+    if (vw_decomp_get_kind(cur) == VW_DECOMP_DIVIDED) {
+        lim = (long long)gw + max_extra;
+        if (lim < nc) lim = nc;
+    }
+    return lim > VW_MAX_CELLS ? (nc > VW_MAX_CELLS ? nc : VW_MAX_CELLS) : (int)lim;
+}
+
 vw_status vw__balance_divide(const vw_decomp *cur, const vw_load_field *f,
                              const vw_balance_params *p, vw_decomp **out, int *cell_worker)
 {
@@ -129,8 +152,11 @@ vw_status vw__balance_divide(const vw_decomp *cur, const vw_load_field *f,
     int nc = vw_decomp_cell_count(cur);
     int gw = p->gworkers > 0 ? p->gworkers : nc;
     int max_extra = p->max_extra > 0 ? p->max_extra : 4 * gw;
-    if (nc + max_extra > VW_MAX_CELLS) max_extra = VW_MAX_CELLS - nc;
-    int cap_nodes = nn0 + 2 * max_extra, cap_cells = nc + max_extra;
+    /* The cells there may be at the end (divide_limit): a fresh decomposition gets
+       max_extra more; a divided one, as divide returns it, no more than gworkers +
+       max_extra in all. */
+    int limit = divide_limit(cur, nc, gw, max_extra);
+    int cap_nodes = nn0 + 2 * (limit - nc), cap_cells = limit;
     vw_kd_node *nodes = malloc(sizeof *nodes * (size_t)cap_nodes);
     double *load = calloc((size_t)cap_cells, sizeof *load);
     int *map = malloc(sizeof(int) * (size_t)cap_cells);
@@ -146,7 +172,7 @@ vw_status vw__balance_divide(const vw_decomp *cur, const vw_load_field *f,
         memcpy(nodes, n0, sizeof *nodes * (size_t)nn0);
         st = vw_decomp_clone(cur, &d);
     }
-    int nn = nn0, extra = 0;
+    int nn = nn0;
     const double *F = vw_decomp_frame(cur);
     vw_box wb = vw_decomp_world(cur);
     while (st == VW_OK) {
@@ -154,9 +180,9 @@ vw_status vw__balance_divide(const vw_decomp *cur, const vw_load_field *f,
         st = vw_map_greedy(d, load, gw, p->speeds, 0.0, map);
         if (st != VW_OK) break;
         double lam = vw_balance_imbalance(load, map, nc, gw, p->speeds);
-        if (lam <= 1.0 + p->tolerance || extra >= max_extra) break;
+        if (lam <= 1.0 + p->tolerance || nc >= limit) break;
         /* An uncuttable cell alone on a fastest worker sets lambda: cuts would spend cells
-           up to max_extra for nothing (they did, lambda unchanged). */
+           up to the limit for nothing (they did, lambda unchanged). */
         int known = -1, kaxis = -1;
         double ksplit = 0;
         if (divide_stops(d, load, map, nc, gw, p->speeds, uncut, pts, npts, tmp, F, &wb,
@@ -186,7 +212,6 @@ vw_status vw__balance_divide(const vw_decomp *cur, const vw_load_field *f,
         /* The leaf becomes a wall with the old cell on its low side, a new cell above. */
         nn = vw__kd_divide(nodes, nn, heavy, axis, split, nc);
         nc++;
-        extra++;
         vw_decomp *nd;
         st = vw_decomp_create_kd(&wb, nodes, nn, F, VW_DECOMP_DIVIDED, &nd);
         if (st != VW_OK) break;

@@ -36,6 +36,10 @@
  *                         holding a point of load, the heaviest: the other cells are
  *                         divided still (lambda 1.29 -> <= 1.05 on 2 workers, 1.75 ->
  *                         <= 1.15 on 8), the hot cell kept whole, no empty cell cut
+ *   divide_rounds         divide round after round on its own result: the cells stay
+ *                         within max(start, workers) + max_extra (the limit held per
+ *                         round, and they piled up); divide_rounds_render: render's
+ *                         rounds at 4x4x4 on 64 workers within 64 + 4 x 64
  */
 #include <float.h>
 #include <math.h>
@@ -1479,10 +1483,113 @@ static int t_divide_stop(void)
     TEST_DONE();
 }
 
+/* ---- divide_rounds: the bound on extra cells holds over rounds ---------------------------- */
+
+/* Divides again and again, each round on the last one's result (as render's rounds and
+   animate's rebalances between frames do), the load a tight cluster of points in one cell
+   that max_extra cuts cannot spread over the workers, so every round would cut on. The
+   cells never pass max(start, gw) + max_extra (max_extra 0: 4 x gw); divide's limit held
+   per call, and the cells piled up (one cell on 8 workers, max_extra 4: 40 after ten
+   rounds, up to the tolerance). Returns the cells after `rounds`. */
+static int divide_rounds_run(const int dims[3], int gw, int max_extra, int rounds)
+{
+    vw_box world = {{0, 0, 0}, {1, 1, 1}};
+    vw_decomp *d = NULL;
+    vw_load_field *f = NULL;
+    CHECK(vw_decomp_create_grid(&world, dims, &d) == VW_OK);
+    CHECK(vw_load_field_create(&f) == VW_OK);
+    /* 10^3 points in [0.1, 0.2)^3, and a thin spread everywhere. */
+    for (int i = 0; i < 10; i++)
+        for (int j = 0; j < 10; j++)
+            for (int k = 0; k < 10; k++) {
+                double q[3] = {0.1 + 0.01 * i, 0.1 + 0.01 * j, 0.1 + 0.01 * k};
+                CHECK(vw_load_field_add_point(f, q, 1.0) == VW_OK);
+                double r[3] = {0.05 + 0.1 * i, 0.05 + 0.1 * j, 0.05 + 0.1 * k};
+                CHECK(vw_load_field_add_point(f, r, 0.01) == VW_OK);
+            }
+    int start = vw_decomp_cell_count(d);
+    int extra = max_extra > 0 ? max_extra : 4 * gw;
+    int bound = (start > gw ? start : gw) + extra, first = start + extra;
+    int cells = start, prev = start;
+    char what[96];
+    for (int r = 0; r < rounds; r++) {
+        snprintf(what, sizeof what, "%dx%dx%d on %d workers, max_extra %d, round %d", dims[0],
+                 dims[1], dims[2], gw, max_extra, r + 1);
+        double lam;
+        vw_decomp *nd = divide_checked(d, f, gw, NULL, max_extra, what, &lam, &cells);
+        if (!nd) break;
+        vw_decomp_free(d);
+        d = nd;
+        /* The first round is as before: max_extra more than it was given. */
+        EXPECT(r > 0 || cells <= first, "%s: %d cells, more than %d + %d", what, cells, start,
+               extra);
+        EXPECT(cells <= bound, "%s: %d cells, more than max(%d, %d) + %d = %d", what, cells,
+               start, gw, extra, bound);
+        EXPECT(cells >= prev, "%s: %d cells, fewer than %d", what, cells, prev);
+        prev = cells;
+    }
+    printf("divide_rounds: %dx%dx%d on %d workers, max_extra %d: %d cells after %d rounds "
+           "(bound %d)\n", dims[0], dims[1], dims[2], gw, max_extra, cells, rounds, bound);
+    vw_load_field_free(f);
+    vw_decomp_free(d);
+    return cells;
+}
+
+static int t_divide_rounds(void)
+{
+    static const int d222[3] = {2, 2, 2}, d111[3] = {1, 1, 1}, d444[3] = {4, 4, 4};
+    /* As many cells as workers: 8 + 4 over the run (was 15, the tolerance reached). */
+    int c = divide_rounds_run(d222, 8, 4, 10);
+    EXPECT(c == 12, "2x2x2 on 8 workers, max_extra 4: %d cells after 10 rounds (want 12)", c);
+    /* The default max_extra, 4 x 8: 8 + 32 = 40. */
+    divide_rounds_run(d222, 8, 0, 10);
+    /* Fewer cells than workers: gworkers + max_extra at most (the first round 1 + 4;
+       was 40). */
+    divide_rounds_run(d111, 8, 4, 10);
+    /* More cells than workers: 64 + 4 (was 71). */
+    c = divide_rounds_run(d444, 8, 4, 10);
+    EXPECT(c == 68, "4x4x4 on 8 workers, max_extra 4: %d cells after 10 rounds (want 68)", c);
+    TEST_DONE();
+}
+
+/* ---- divide_rounds_render: render's rounds keep to the bound ----------------------------- */
+
+/* Render's divide rounds (2 + 3) on a fully clustered scene at 4x4x4 on 64 workers, sampled
+   every 4th row and column: each round divided anew with 4 x 64 extra cells, and the
+   scene ended on 1026 cells (2000 spheres, 128x128, vwalls render --prepass 4). */
+static int t_divide_rounds_render(void)
+{
+    char err[512];
+    vw_scene *s = NULL;
+    vw_gen_params gp;
+    vw_gen_params_init(&gp);
+    gp.count = 2000;
+    gp.cluster = 1;
+    gp.seed = 1;
+    if (vw_gen("spheres", &gp, &s, err, sizeof err) != VW_OK) {
+        fprintf(stderr, "gen spheres: %s\n", err);
+        return 1;
+    }
+    int dims[3] = {4, 4, 4};
+    rt_balance b;
+    balance_spec(&b, VW_BALANCE_DIVIDE);
+    b.stride = 4;
+    rt_job *j;
+    int64_t *sums = render(s, 128, 128, dims, 64, &b, &j);
+    int cells = vw_decomp_cell_count(vw_world_decomp(rt_job_world(j)));
+    printf("divide_rounds_render: 4x4x4 on 64 workers: %d cells, work lambda %.3f\n", cells,
+           rt_job_work_imbalance(j, NULL));
+    EXPECT(cells <= 64 + 4 * 64, "%d cells, more than 64 + 4 x 64", cells);
+    free(sums);
+    rt_job_free(j);
+    vw_scene_free(s);
+    return vw_test_failures ? 1 : 0;
+}
+
 int main(int argc, char **argv)
 {
     if (argc < 2) {
-        fprintf(stderr, "usage: bal_test identical|conserve|staggered8|divide16|rotate|map|duplicate|field|concurrent|thin|divide_thin|divide_hot|divide_stop [...]\n");
+        fprintf(stderr, "usage: bal_test identical|conserve|staggered8|divide16|rotate|map|duplicate|field|concurrent|thin|divide_thin|divide_hot|divide_stop|divide_rounds|divide_rounds_render [...]\n");
         return 2;
     }
     const char *cmd = argv[1];
@@ -1499,6 +1606,8 @@ int main(int argc, char **argv)
     if (!strcmp(cmd, "divide_thin")) return t_divide_thin();
     if (!strcmp(cmd, "divide_hot")) return t_divide_hot();
     if (!strcmp(cmd, "divide_stop")) return t_divide_stop();
+    if (!strcmp(cmd, "divide_rounds")) return t_divide_rounds();
+    if (!strcmp(cmd, "divide_rounds_render")) return t_divide_rounds_render();
     fprintf(stderr, "bal_test: unknown test '%s'\n", cmd);
     return 2;
 }

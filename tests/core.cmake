@@ -60,6 +60,7 @@ set_tests_properties(core_misuse_limits core_misuse_slowdown PROPERTIES TIMEOUT 
 foreach(case "send;sent message kind 1 to cell 0, but the kind has no handle"
              "output;sent message kind 0 to the output, but the kind has no output handler"
              "count;counted into counter 5 of 1"
+             "count-all;counted into counter 5 of 1"
              "face;sent message kind 0 to face 6 (faces are 0..5)"
              "build-send;sent message kind 0 from cell 0 outside a run"
              "send-null;sent message kind 0 of 4 bytes with no message (NULL)"

@@ -39,9 +39,13 @@ extern "C" {
 /* Handed to every callback that runs for a cell: who am I, and how to send. */
 typedef struct vw_ctx vw_ctx;
 
+/* vw_world_create refuses a kind without a name (one the table's initialiser left out
+   is all zeros), one with neither handle nor output, and unknown flags. */
 typedef struct vw_msg_kind {
     const char *name;
-    size_t size;    /* bytes of one message record, at most VW_MAX_MSG_BYTES */
+    size_t size;    /* bytes of one message record, at most VW_MAX_MSG_BYTES: every send
+                       copies this many bytes from the pointer it is given, so it must be
+                       sizeof the record sent (nothing can check that) */
     /* Runs on the worker hosting the destination cell. May send messages. */
     void (*handle)(vw_ctx *ctx, void *cell_state, const void *msg);
     /* For kinds sent with vw_send_output: runs on the output process. */

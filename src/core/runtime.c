@@ -27,6 +27,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+#include <unistd.h>
 
 struct vw_ctx {
     vw_world *w;
@@ -261,13 +262,22 @@ static int flush_all(vw__worker *wk)
     return any;
 }
 
-/* A module's misuse of the context is a bug in the module: it stops the process. */
+/* A module's misuse of the context is a bug in the module: it stops the process. The
+   line is written whole by one write(2), and by the first worker only: when several
+   made the same mistake at once, their pieces were interleaved on the terminal and the
+   first abort cut the others short. The others wait for that abort. */
 static void __attribute__((noreturn, noinline, cold))
 misuse(const vw_ctx *ctx, const char *fmt, int a, int b)
 {
-    fprintf(stderr, "vwalls: module '%s' ", ctx->w->m->name);
-    fprintf(stderr, fmt, a, b);
-    fprintf(stderr, " (worker %d)\n", ctx->wk->global);
+    static int reported;
+    if (__atomic_exchange_n(&reported, 1, __ATOMIC_ACQ_REL))
+        for (;;) pause();
+    char line[512], what[256];
+    snprintf(what, sizeof what, fmt, a, b);
+    int n = snprintf(line, sizeof line, "vwalls: module '%s' %s (worker %d, in cell %d)\n",
+                     ctx->w->m->name, what, ctx->wk->global, ctx->cell);
+    if (n > (int)sizeof line - 1) n = (int)sizeof line - 1;
+    if (n > 0 && write(STDERR_FILENO, line, (size_t)n) < 0) { /* nothing more to tell */ }
     abort();
 }
 

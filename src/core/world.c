@@ -323,10 +323,26 @@ vw_status vw_world_create(const vw_module *m, void *user, const vw_decomp *d, co
     if (m->object_size && !m->object_bounds)
         return create_failed(VW_E_INVAL, "module '%s': objects without object_bounds",
                              m->name ? m->name : "?");
-    for (int k = 0; k < m->nkinds; k++)
-        if (m->kinds[k].size > VW_MAX_MSG_BYTES)
+    for (int k = 0; k < m->nkinds; k++) {
+        const vw_msg_kind *K = &m->kinds[k];
+        if (K->size > VW_MAX_MSG_BYTES)
             return create_failed(VW_E_INVAL, "module '%s': message kind %d is %zu bytes (at most %d)",
-                                 m->name ? m->name : "?", k, m->kinds[k].size, (int)VW_MAX_MSG_BYTES);
+                                 m->name, k, K->size, (int)VW_MAX_MSG_BYTES);
+        /* A kind an initialiser left out (nkinds larger than the table's entries, or a
+           designated initialiser that skipped an index) is all zeros: it was accepted,
+           and its first send stopped the process ("the kind has no handle"). */
+        if (!K->name || !K->name[0])
+            return create_failed(VW_E_INVAL, "module '%s': message kind %d has no name (missing "
+                                 "from the kinds table? nkinds is %d)", m->name, k, m->nkinds);
+        if (!K->handle && !K->output)
+            return create_failed(VW_E_INVAL, "module '%s': message kind %d ('%s') has neither a "
+                                 "handle (sent to cells) nor an output (sent to the output)",
+                                 m->name, k, K->name);
+        if (K->flags & ~VW_MSG_INDEPENDENT)
+            return create_failed(VW_E_INVAL, "module '%s': message kind %d ('%s') has unknown "
+                                 "flags 0x%x (VW_MSG_INDEPENDENT is the only one)", m->name, k,
+                                 K->name, K->flags & ~VW_MSG_INDEPENDENT);
+    }
     vw_world *w = calloc(1, sizeof *w);
     if (!w) return create_failed(VW_E_NOMEM, "vw_world_create: out of memory");
     w->m = m;

@@ -30,6 +30,9 @@
  *            cell_build, and vw_world_traffic from step(): collectives under MPI, made
  *            from a worker thread in the middle of a run or a commit (they were let
  *            through: a hang or a mixed-up agreement under MPI)
+ *   count-all   every cell of eight, each on its own worker, counts into a counter that
+ *            does not exist at once: one whole line is printed, by one worker (the
+ *            workers' pieces were interleaved and cut short by the first abort)
  *   norestore-step | norestore-handle   a step() or a handler that hands off inline
  *            (vw_ctx_enter) and returns without vw_ctx_restore stops the process, as
  *            module.h requires the restore (it went unnoticed)
@@ -74,7 +77,8 @@ static vw_world *the_world; /* for the callbacks that call back into it */
 static int step(vw_ctx *ctx, void *state)
 {
     int *done = state;
-    if (*done || vw_ctx_cell(ctx) != 0) return 0;
+    /* count-all: every cell makes the mistake at once, on its own worker. */
+    if (*done || (vw_ctx_cell(ctx) != 0 && strcmp(mode, "count-all"))) return 0;
     *done = 1;
     int x = 0;
     obj o = {{0.5, 0.5, 0.5}};
@@ -89,7 +93,7 @@ static int step(vw_ctx *ctx, void *state)
     if (!strcmp(mode, "reenter-traffic")) vw_world_traffic(the_world, &t);
     if (!strcmp(mode, "send")) vw_send_cell(ctx, 0, 1, &x);   /* kind 1: output only */
     if (!strcmp(mode, "output")) vw_send_output(ctx, 0, &x);  /* kind 0: no output */
-    if (!strcmp(mode, "count")) vw_count(ctx, 5, 1);          /* one counter */
+    if (!strcmp(mode, "count") || !strcmp(mode, "count-all")) vw_count(ctx, 5, 1); /* one counter */
     if (!strcmp(mode, "face")) vw_send_face(ctx, 6, 0, &x);   /* faces 0..5 */
     if (!strcmp(mode, "bad-kind")) vw_send_cell(ctx, 0, 7, &x);
     if (!strcmp(mode, "bad-cell")) vw_send_cell(ctx, 99, 0, &x);
@@ -166,12 +170,14 @@ int main(int argc, char **argv)
     mode = argc > 1 ? argv[1] : "create";
     vw_box world = {{0, 0, 0}, {1, 1, 1}};
     int dims[3] = {2, 1, 1};
+    int all = !strcmp(mode, "count-all"); /* eight cells on eight workers */
+    if (all) dims[0] = 8;
     vw_decomp *d;
     CHECK(vw_decomp_create_grid(&world, dims, &d) == VW_OK);
     vw_module m = module();
     vw_config cfg;
     vw_config_init(&cfg);
-    cfg.workers = 2;
+    cfg.workers = all ? 8 : 2;
     vw_world *w = NULL;
     if (!strcmp(mode, "create")) {
         /* No world to agree on: the same answer with and without the MPI engine. */
@@ -207,6 +213,26 @@ int main(int argc, char **argv)
         CHECK(strstr(vw_world_errmsg(NULL), "the module has no name") != NULL);
         bad.name = "";
         CHECK(vw_world_create(&bad, NULL, d, &cfg, &w) == VW_E_INVAL && !w);
+        /* A kind the table's initialiser left out (all zeros), one that no handler
+           takes, flags the runtime does not know: refused here, not at the first send. */
+        vw_msg_kind k3[3] = {kinds[0], kinds[1]};
+        bad = m;
+        bad.kinds = k3;
+        bad.nkinds = 3;
+        CHECK(vw_world_create(&bad, NULL, d, &cfg, &w) == VW_E_INVAL && !w);
+        printf("kind: %s\n", vw_world_errmsg(NULL));
+        CHECK(strstr(vw_world_errmsg(NULL), "message kind 2 has no name (missing from the kinds "
+                                            "table? nkinds is 3)") != NULL);
+        k3[2] = (vw_msg_kind){.name = "idle", .size = 4};
+        CHECK(vw_world_create(&bad, NULL, d, &cfg, &w) == VW_E_INVAL && !w);
+        CHECK(strstr(vw_world_errmsg(NULL), "message kind 2 ('idle') has neither a handle") != NULL);
+        k3[2] = (vw_msg_kind){.name = "odd", .size = 4, .handle = handle, .flags = 0x81};
+        CHECK(vw_world_create(&bad, NULL, d, &cfg, &w) == VW_E_INVAL && !w);
+        CHECK(strstr(vw_world_errmsg(NULL), "message kind 2 ('odd') has unknown flags 0x80") != NULL);
+        k3[2].flags = VW_MSG_INDEPENDENT;
+        CHECK(vw_world_create(&bad, NULL, d, &cfg, &w) == VW_OK && w);
+        vw_world_free(w);
+        w = NULL;
         CHECK(vw_world_create(&m, NULL, d, &cfg, &w) == VW_OK);
         CHECK(!strcmp(vw_world_errmsg(NULL), "no world")); /* a success clears it */
     } else if (!strcmp(mode, "null")) {
@@ -430,7 +456,11 @@ int main(int argc, char **argv)
             printf("post: %s\n", vw_world_errmsg(w));
             CHECK(strstr(vw_world_errmsg(w), "has no handle") != NULL);
         } else {
-            /* The child makes the mistake with its stderr into a pipe. */
+            /* The child makes the mistake with its stderr into a pipe. count-all: every
+               worker makes it at once, twenty times over; the report must be one whole
+               line, from one worker (the lines of several were interleaved and cut). */
+            int tries = !strcmp(mode, "count-all") ? 20 : 1;
+            for (int t = 0; t < tries; t++) {
             int fd[2];
             CHECK(pipe(fd) == 0);
             fflush(NULL);
@@ -455,6 +485,12 @@ int main(int argc, char **argv)
             printf("%s: %s", mode, err);
             CHECK(WIFSIGNALED(status) && WTERMSIG(status) == SIGABRT);
             CHECK(argc > 2 && strstr(err, argv[2]) != NULL);
+            /* One line, whole: "vwalls: module 'misuse' WHAT (worker W, in cell C)\n". */
+            const char *at = strstr(err, "vwalls: module 'misuse' ");
+            if (all)
+                CHECK(at && !strstr(at + 1, "vwalls: module") && strstr(at, ", in cell ") &&
+                      strchr(at, '\n') && !strchr(at, '\n')[1] && strchr(at, '\n')[-1] == ')');
+            }
         }
     }
     vw_world_free(w);

@@ -240,25 +240,59 @@ static vw_status copy_speeds(vw_world *w)
     return VW_OK;
 }
 
-/* The module's shape as it reaches the wire, hashed: its name and record size, each
-   message kind's name, size, flags and handlers present, its counters, and the
-   runtime's own message header. Compared between processes when a world is created. */
-static uint64_t module_fingerprint(const vw_module *m)
+/* The module's shape as it reaches the wire, part by part (MODULE_PARTS numbers),
+   compared between processes when a world is created, so that a mismatch can say what
+   differs: the library's ABI and message header, the name, the record size, the
+   counts of kinds and counters, the counters' names, each kind's size (+ 1; 0: no such
+   kind) and each kind's name, flags and handlers present (hashed). */
+enum { PART_LIBRARY, PART_NAME, PART_OBJECT, PART_NKINDS, PART_NCOUNTERS, PART_COUNTERS,
+       PART_KIND_SIZE, PART_KIND = PART_KIND_SIZE + VW_MAX_KINDS,
+       MODULE_PARTS = PART_KIND + VW_MAX_KINDS };
+
+static void module_parts(const vw_module *m, uint64_t part[MODULE_PARTS])
 {
+    memset(part, 0, sizeof(uint64_t) * MODULE_PARTS);
+    part[PART_LIBRARY] = ((uint64_t)m->abi << 32) | sizeof(vw__msg_header);
+    part[PART_NAME] = vw__fnv1a(VW__FNV_OFFSET, m->name, strlen(m->name) + 1);
+    part[PART_OBJECT] = m->object_size;
+    part[PART_NKINDS] = (uint64_t)m->nkinds;
+    part[PART_NCOUNTERS] = (uint64_t)m->ncounters;
     uint64_t h = VW__FNV_OFFSET;
-    uint64_t head[5] = {m->abi, m->object_size, (uint64_t)m->nkinds, (uint64_t)m->ncounters,
-                        sizeof(vw__msg_header)};
-    h = vw__fnv1a(h, head, sizeof head);
-    if (m->name) h = vw__fnv1a(h, m->name, strlen(m->name) + 1);
+    for (int c = 0; c < m->ncounters; c++) h = vw__fnv1a(h, m->counters[c], strlen(m->counters[c]) + 1);
+    part[PART_COUNTERS] = h;
     for (int k = 0; k < m->nkinds; k++) {
         const vw_msg_kind *K = &m->kinds[k];
-        uint64_t v[4] = {K->size, K->flags, K->handle != NULL, K->output != NULL};
-        h = vw__fnv1a(h, v, sizeof v);
-        if (K->name) h = vw__fnv1a(h, K->name, strlen(K->name) + 1);
+        uint64_t v[3] = {K->flags, K->handle != NULL, K->output != NULL};
+        part[PART_KIND_SIZE + k] = K->size + 1;
+        part[PART_KIND + k] = vw__fnv1a(vw__fnv1a(VW__FNV_OFFSET, v, sizeof v), K->name, strlen(K->name) + 1);
     }
-    for (int c = 0; c < m->ncounters; c++)
-        if (m->counters[c]) h = vw__fnv1a(h, m->counters[c], strlen(m->counters[c]) + 1);
-    return h;
+}
+
+/* What part p of the module's shape is on process r (theirs) and on process 0 (first),
+   said for the message of a mismatch. */
+static void module_part_differs(const vw_module *m, int p, int r, uint64_t theirs, uint64_t first,
+                                char *buf, size_t len)
+{
+    unsigned long long t = theirs, f = first;
+    int k = p >= PART_KIND ? p - PART_KIND : p - PART_KIND_SIZE;
+    const char *kname = p >= PART_KIND_SIZE && k < m->nkinds ? m->kinds[k].name : "?";
+    if (p == PART_LIBRARY)
+        snprintf(buf, len, "another vwalls library (its module ABI or message header)");
+    else if (p == PART_NAME)
+        snprintf(buf, len, "another module name");
+    else if (p == PART_OBJECT)
+        snprintf(buf, len, "objects of %llu bytes on process %d, %llu on process 0", t, r, f);
+    else if (p == PART_NKINDS)
+        snprintf(buf, len, "%llu message kinds on process %d, %llu on process 0", t, r, f);
+    else if (p == PART_NCOUNTERS)
+        snprintf(buf, len, "%llu counters on process %d, %llu on process 0", t, r, f);
+    else if (p == PART_COUNTERS)
+        snprintf(buf, len, "other counter names");
+    else if (p < PART_KIND)
+        snprintf(buf, len, "message kind %d ('%s') of %llu bytes on process %d, %llu on process 0",
+                 k, kname, t - 1, r, f - 1);
+    else
+        snprintf(buf, len, "message kind %d ('%s') with another name, flags or handlers", k, kname);
 }
 
 /* The running program's GNU build ID (the linker's hash of the executable), hashed; 0
@@ -390,11 +424,16 @@ vw_status vw_world_create(const vw_module *m, void *user, const vw_decomp *d, co
        other builds (another message kind, another record size) would read each other's
        messages wrongly without a word. (Attached on every process or on none.) */
     if (st == VW_OK && w->transport) {
-        int r = vw__mpi_first_differing(w, module_fingerprint(w->m));
-        if (r >= 0)
+        uint64_t part[MODULE_PARTS], theirs = 0, first = 0;
+        module_parts(w->m, part);
+        int p = 0, r = vw__mpi_first_differing_n(w, part, MODULE_PARTS, &p, &theirs, &first);
+        if (r >= 0) {
+            char what[256];
+            module_part_differs(w->m, p, r, theirs, first, what, sizeof what);
             st = vw__world_error(w, VW_E_INVAL, "process %d runs another module than process 0 "
-                                 "(module '%s': its name, object size, message kinds or counters "
-                                 "differ): every process must run the same build", r, w->m->name);
+                                 "(module '%s': %s): every process must run the same build", r,
+                                 w->m->name, what);
+        }
     }
     /* The same module by its shape can still lay out a record's bytes otherwise (another
        version of the sources, another compiler): the programs' build IDs tell. A test
@@ -1440,6 +1479,13 @@ vw_status vw__mpi_attach(vw_world *w)
 int vw__mpi_first_differing(vw_world *w, uint64_t v)
 {
     (void)w, (void)v;
+    return -1;
+}
+
+int vw__mpi_first_differing_n(vw_world *w, const uint64_t *v, int n, int *part, uint64_t *theirs,
+                              uint64_t *first)
+{
+    (void)w, (void)v, (void)n, (void)part, (void)theirs, (void)first;
     return -1;
 }
 

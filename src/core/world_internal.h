@@ -407,6 +407,11 @@ vw_status vw__mpi_attach(vw_world *w);
 /* Collective over the world's processes: the lowest rank whose v differs from rank 0's,
    or -1 when all agree (always -1 without MPI). */
 int vw__mpi_first_differing(vw_world *w, uint64_t v);
+/* The same for n values at once (n at most 256): the lowest rank r any of whose v[i]
+   differs from rank 0's, or -1; then *part is the first such i on rank r, *theirs its
+   v[i] there and *first rank 0's, on every process. */
+int vw__mpi_first_differing_n(vw_world *w, const uint64_t *v, int n, int *part, uint64_t *theirs,
+                              uint64_t *first);
 /* Collective: the records a process lacks (share_records, world.c). First agrees on
    `local` (msg: why it failed); then, unless no process asks for any, finds the lowest
    process that keeps each record (one MPI_Allreduce of an int an object), and each

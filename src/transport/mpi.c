@@ -114,13 +114,30 @@ MPI_Comm vw__mpi_world_comm(const vw_world *w)
 
 int vw__mpi_first_differing(vw_world *w, uint64_t v)
 {
+    return vw__mpi_first_differing_n(w, &v, 1, NULL, NULL, NULL);
+}
+
+int vw__mpi_first_differing_n(vw_world *w, const uint64_t *v, int n, int *part, uint64_t *theirs,
+                              uint64_t *first)
+{
     MPI_Comm c = vw__mpi_world_comm(w);
-    if (c == MPI_COMM_NULL) return -1;
-    uint64_t v0 = v;
-    MPI_Bcast(&v0, 1, MPI_UINT64_T, 0, c);
-    int mine = v == v0 ? w->nprocs : w->rank, first = w->nprocs;
-    MPI_Allreduce(&mine, &first, 1, MPI_INT, MPI_MIN, c);
-    return first < w->nprocs ? first : -1;
+    if (c == MPI_COMM_NULL || n < 1 || n > 256) return -1;
+    uint64_t v0[256];
+    memcpy(v0, v, sizeof *v0 * (size_t)n);
+    MPI_Bcast(v0, n, MPI_UINT64_T, 0, c);
+    int i = 0;
+    while (i < n && v[i] == v0[i]) i++;
+    /* rank * n + part: the lowest rank first, then its first part. */
+    long long none = (long long)w->nprocs * n, mine = i < n ? (long long)w->rank * n + i : none, low = none;
+    MPI_Allreduce(&mine, &low, 1, MPI_LONG_LONG, MPI_MIN, c);
+    if (low == none) return -1;
+    int r = (int)(low / n), k = (int)(low % n);
+    uint64_t t = v[k];
+    MPI_Bcast(&t, 1, MPI_UINT64_T, r, c);
+    if (part) *part = k;
+    if (theirs) *theirs = t;
+    if (first) *first = v0[k];
+    return r;
 }
 
 vw_status vw__mpi_fetch_records(vw_world *w, vw_status local, const uint64_t *ask,

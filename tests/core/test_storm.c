@@ -527,11 +527,19 @@ static void test_module_mismatch(int workers)
         if (what == 0 || size == 1) {
             EXPECT(got == VW_OK, "%s: create %d: %s", what_name[what], (int)got, vw_world_errmsg(NULL));
         } else {
-            char want[64];
-            snprintf(want, sizeof want, "process %d runs another module than process 0", bad);
+            /* The message says what differs, with both processes' values. */
+            char want[256];
+            const char *detail[] = {
+                "", "4 message kinds on process %d, 3 on process 0",
+                "message kind 2 ('posted') of 16 bytes on process %d, 8 on process 0",
+                "objects of 24 bytes on process %d, 0 on process 0", "other counter names",
+                "another module name"};
+            int n = snprintf(want, sizeof want, "process %d runs another module than process 0 "
+                             "(module 'storm': ", bad);
+            snprintf(want + n, sizeof want - (size_t)n, detail[what], bad);
             EXPECT(got == VW_E_INVAL && !w && strstr(vw_world_errmsg(NULL), want),
-                   "rank %d, %s: create %d: '%s'", rank, what_name[what], (int)got,
-                   vw_world_errmsg(NULL));
+                   "rank %d, %s: create %d: '%s' (want '%s')", rank, what_name[what], (int)got,
+                   vw_world_errmsg(NULL), want);
         }
         vw_world_free(w);
         vw_decomp_free(d);

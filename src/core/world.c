@@ -922,7 +922,8 @@ vw_status vw_world_post(vw_world *w, int cell, int kind, const void *msg)
     if (!w) return VW_E_INVAL;
     vw__world_begin_step(w);
     if (cell < 0 || cell >= w->ncells)
-        return vw__world_error(w, VW_E_INVAL, "posted to cell %d of %d", cell, w->ncells);
+        return vw__world_error(w, VW_E_INVAL, "posted to cell %d, which does not exist (%d cells)",
+                               cell, w->ncells);
     if (kind < 0 || kind >= w->m->nkinds)
         return vw__world_error(w, VW_E_INVAL, "posted message kind %d, but module '%s' has %d kinds",
                                kind, w->m->name, w->m->nkinds);
@@ -930,8 +931,9 @@ vw_status vw_world_post(vw_world *w, int cell, int kind, const void *msg)
         return vw__world_error(w, VW_E_INVAL, "posted message kind %d of %zu bytes with no "
                                "message (NULL)", kind, w->m->kinds[kind].size);
     if (!w->m->kinds[kind].handle)
-        return vw__world_error(w, VW_E_INVAL, "posted message kind %d to cell %d, but the kind "
-                               "has no handle", kind, cell);
+        return vw__world_error(w, VW_E_INVAL, "posted message kind %d ('%s') to cell %d, but the "
+                               "kind has no handle (an output kind: sent with vw_send_output)",
+                               kind, w->m->kinds[kind].name, cell);
     /* Every process keeps the message and the run gives it to the cell's worker then:
        a remap or a new decomposition may still move the cell (to another worker, or
        another process) before the run, and the worker chosen now received a message

@@ -387,7 +387,7 @@ int main(int argc, char **argv)
             CHECK(strstr(vw_world_errmsg(w), "has no handle") != NULL);
             CHECK(vw_world_post(w, 5, 0, &x) == VW_E_INVAL);
             printf("post to cell 5: %s\n", vw_world_errmsg(w));
-            CHECK(strstr(vw_world_errmsg(w), "cell 5 of 2") != NULL);
+            CHECK(strstr(vw_world_errmsg(w), "cell 5, which does not exist (2 cells)") != NULL);
             CHECK(vw_world_post(w, 0, 9, &x) == VW_E_INVAL);
             CHECK(strstr(vw_world_errmsg(w), "kind 9") != NULL);
             CHECK(vw_world_post(w, 0, 0, NULL) == VW_E_INVAL);
@@ -454,7 +454,12 @@ int main(int argc, char **argv)
             int x = 0;
             CHECK(vw_world_post(w, 1, 1, &x) == VW_E_INVAL);
             printf("post: %s\n", vw_world_errmsg(w));
-            CHECK(strstr(vw_world_errmsg(w), "has no handle") != NULL);
+            CHECK(strstr(vw_world_errmsg(w), "posted message kind 1 ('to_output') to cell 1, but the "
+                                             "kind has no handle (an output kind") != NULL);
+            /* Said as a send to no such cell says it (it read "posted to cell 2 of 2"). */
+            CHECK(vw_world_post(w, 2, 0, &x) == VW_E_INVAL);
+            printf("post: %s\n", vw_world_errmsg(w));
+            CHECK(strstr(vw_world_errmsg(w), "posted to cell 2, which does not exist (2 cells)") != NULL);
         } else {
             /* The child makes the mistake with its stderr into a pipe. count-all: every
                worker makes it at once, twenty times over; the report must be one whole

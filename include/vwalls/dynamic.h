@@ -77,7 +77,9 @@ typedef struct vw_collider vw_collider;
    `start` sweeps along d (end must then be start translated by d). An obstacle that
    already interpenetrates `start` does not count for the sweep (so a resting object
    can be lifted off what it rests on), only for the end test: its contact says
-   VW_PROBE_START instead. The rule is the object's: a sweep that meets one shape of an
+   VW_PROBE_START instead; where a sphere is in the pair, only when the path takes it no
+   deeper than it starts (one sunk a hair in a floor cannot go through it), and never
+   where a box (a cone) is, whose box may hold the mover without touching the cone. The rule is the object's: a sweep that meets one shape of an
    obstacle whose other shape `start` interpenetrates (a floor of two triangles, the
    mover sunk in one) is no sweep hit either; the contacts of one tag and obstacle are
    merged (their bits or'ed), so a caller counts a sweep hit where a contact has

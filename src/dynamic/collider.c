@@ -119,9 +119,21 @@ int vw__probe_test(const vw_probe *p, const vw_shape *o, double tol)
     int how = 0;
     if ((p->flags & VW_PROBE_END) && vw_shape_collide(&p->end, NULL, o, tol)) how |= VW_PROBE_END;
     /* The swept volume holds the start, so a start that interpenetrates o sweeps into
-       it too: START, not SWEEP (the caller applies the rule per object). */
-    if ((p->flags & VW_PROBE_SWEEP) && vw_shape_collide(&p->start, p->d, o, tol))
-        how |= vw_shape_collide(&p->start, NULL, o, tol) ? VW_PROBE_START : VW_PROBE_SWEEP;
+       it too: START, not SWEEP (the caller applies the rule per object). Only where the
+       pair is tested exactly: a box (a cone) stands for a cone it may hold with room to
+       spare, and a mover starting in that room (not touching the cone) was let through
+       the cone itself, its whole path exempt; so a box's sweep hit is always SWEEP,
+       which keeps the cone's test conservative (no move that hits it is accepted). And
+       where a sphere is involved, only for a path that takes the mover no deeper into o
+       than it starts (leaving o, or sliding along it): a sphere sunk in a floor by a
+       hair more than tol (a scene written with six digits) went through the floor with
+       sweep on, where one resting on it exactly was stopped. */
+    if ((p->flags & VW_PROBE_SWEEP) && vw_shape_collide(&p->start, p->d, o, tol)) {
+        int exact = p->start.kind != VW_SHAPE_BOX && o->kind != VW_SHAPE_BOX;
+        int start = exact && vw_shape_collide(&p->start, NULL, o, tol) &&
+                    !vw__shape_sweep_deepens(&p->start, p->d, o, tol);
+        how |= start ? VW_PROBE_START : VW_PROBE_SWEEP;
+    }
     return how;
 }
 

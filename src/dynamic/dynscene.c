@@ -512,6 +512,13 @@ static int sweep_hits(int how)
     return (how & VW_PROBE_SWEEP) && !(how & VW_PROBE_START);
 }
 
+static int contact_cmp(const void *a, const void *b)
+{
+    const vw_contact *x = a, *y = b;
+    if (x->tag != y->tag) return x->tag < y->tag ? -1 : 1;
+    return (x->obstacle > y->obstacle) - (x->obstacle < y->obstacle);
+}
+
 /* Contacts by brute force: every probe against every slot (the reference). */
 static vw_status brute_contacts(vw_dynscene *ds, const batch *b, vw_contact **out, size_t *nout)
 {
@@ -540,25 +547,24 @@ static vw_status brute_contacts(vw_dynscene *ds, const batch *b, vw_contact **ou
             last = (int)n++;
         }
     }
-    /* Probes of one tag are consecutive, but a polygon obstacle's slots are consecutive
-       too, so (tag, obstacle) pairs may repeat across probes of one tag: merge. */
-    for (size_t i = 0; i < n; i++)
-        for (size_t j = i + 1; j < n && c[j].tag == c[i].tag; j++)
-            if (c[j].obstacle == c[i].obstacle) {
-                c[i].how |= c[j].how;
-                c[j] = c[--n];
-                j--;
-            }
+    /* A polygon mover is several probes of one tag, so (tag, obstacle) pairs repeat
+       across them (a mover's triangle 0 meets obstacles A and B, its triangle 1 A and B
+       again): sorted, then merged like the collider's, one contact per pair with its
+       bits or'ed. (The merge swapped the list's last contact into the hole, which in a
+       batch of several edits was another tag's: it ended the scan of this tag, and a
+       START and a SWEEP of one obstacle stayed apart, a sweep hit the cells do not
+       see.) */
+    if (n) qsort(c, n, sizeof *c, contact_cmp);
+    size_t m = 0;
+    for (size_t i = 0; i < n; i++) {
+        if (m && c[m - 1].tag == c[i].tag && c[m - 1].obstacle == c[i].obstacle)
+            c[m - 1].how |= c[i].how;
+        else
+            c[m++] = c[i];
+    }
     *out = c;
-    *nout = n;
+    *nout = m;
     return VW_OK;
-}
-
-static int contact_cmp(const void *a, const void *b)
-{
-    const vw_contact *x = a, *y = b;
-    if (x->tag != y->tag) return x->tag < y->tag ? -1 : 1;
-    return (x->obstacle > y->obstacle) - (x->obstacle < y->obstacle);
 }
 
 /* Commits an accepted edit: scene, shapes, collider. */

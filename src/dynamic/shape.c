@@ -5,7 +5,7 @@
  */
 #include <math.h>
 #include <string.h>
-#include "vwalls/dynamic.h"
+#include "dynamic/dynamic_internal.h"
 
 static double dot(const double a[3], const double b[3])
 {
@@ -335,4 +335,35 @@ int vw_shape_collide(const vw_shape *a, const double d[3], const vw_shape *b, do
     poly_of(a, d, &A);
     poly_of(b, NULL, &B);
     return polys_collide(&A, &B, tol);
+}
+
+/* Whether a, swept by d, goes deeper into b than it starts, by more than tol: for the
+   pairs with a sphere, whose nearest approach (centre to centre, or centre to triangle)
+   is a distance convex along the path, the path comes nearer than the start. Leaving
+   or sliding along keeps the start's distance; going through does not. 0 for the other
+   pairs (no depth is measured along their path). */
+int vw__shape_sweep_deepens(const vw_shape *a, const double d[3], const vw_shape *b, double tol)
+{
+    if (!a || !b || !d) return 0;
+    const vw_shape *sp, *o;
+    double dir[3];
+    if (a->kind == VW_SHAPE_SPHERE && (b->kind == VW_SHAPE_SPHERE || b->kind == VW_SHAPE_TRIANGLE)) {
+        sp = a, o = b;
+        for (int k = 0; k < 3; k++) dir[k] = d[k];
+    } else if (a->kind == VW_SHAPE_TRIANGLE && b->kind == VW_SHAPE_SPHERE) {
+        sp = b, o = a; /* the same relative motion, backwards */
+        for (int k = 0; k < 3; k++) dir[k] = -d[k];
+    } else {
+        return 0;
+    }
+    double e[3], d0, dm;
+    for (int k = 0; k < 3; k++) e[k] = sp->p[0][k] + dir[k];
+    if (o->kind == VW_SHAPE_SPHERE) {
+        d0 = dist2_seg_seg(sp->p[0], sp->p[0], o->p[0], o->p[0]);
+        dm = dist2_seg_seg(sp->p[0], e, o->p[0], o->p[0]);
+    } else {
+        d0 = dist2_point_tri(sp->p[0], o->p[0], o->p[1], o->p[2]);
+        dm = dist2_seg_tri(sp->p[0], e, o->p[0], o->p[1], o->p[2]);
+    }
+    return sqrt(dm) < sqrt(d0) - tol;
 }

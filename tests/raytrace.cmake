@@ -21,6 +21,9 @@ add_test(NAME raytrace_analytic_far COMMAND vw_test_raytrace analytic 1e10)
 # A small ball on a wide floor casts its shadow: a secondary ray's least t is set by the
 # float error, not by the scene's size (1e-4 of the diagonal skipped the ball).
 add_test(NAME raytrace_contact COMMAND vw_test_raytrace contact)
+# A light exactly on a surface (a floor, a ball) lights what faces it: the shadow ray
+# stops short of the light instead of finding the surface the light lies on.
+add_test(NAME raytrace_lighton COMMAND vw_test_raytrace lighton)
 # Rays aimed at the edges and vertices a mesh's triangles share do not slip through.
 add_test(NAME raytrace_watertight COMMAND vw_test_raytrace watertight)
 # MTL illum: Ks weights the mirror ray from illum 3 on (and without an illum), not for
@@ -44,6 +47,9 @@ add_test(NAME raytrace_identical_mixed COMMAND vw_test_raytrace identical ${VW_R
 # Hits on a wall: the overlap of a cell's search past its far wall (walk_ray).
 add_test(NAME raytrace_identical_wall_hit COMMAND vw_test_raytrace identical
          ${PROJECT_SOURCE_DIR}/tests/raytrace/wall_hit.nff 8x6)
+# The eye on two walls, and eye, shadow, mirror and refracted rays lying in them.
+add_test(NAME raytrace_identical_wall_eye COMMAND vw_test_raytrace identical
+         ${PROJECT_SOURCE_DIR}/tests/raytrace/wall_eye.nff 33x33)
 # The same under the stress switch (random delays and reordering of deliveries).
 add_test(NAME raytrace_stress_balls COMMAND vw_test_raytrace identical gen:balls:2 64x64)
 add_test(NAME raytrace_stress_mixed COMMAND vw_test_raytrace identical ${VW_RT_MIXED} 64x64)

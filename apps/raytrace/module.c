@@ -24,7 +24,7 @@ enum { RT_EYE = 0, RT_REFLECT = 1, RT_REFRACT = 2, RT_SHADOW = 3 };
 typedef struct rt_ray {
     double org[3], dir[3]; /* original, for the ray's whole life; dir is unit length */
     double t0, t1;         /* the segment in the cell that receives the ray */
-    double tmax;           /* end of the ray (INFINITY, or the light's distance); from
+    double tmax;           /* end of the ray (INFINITY, or short of its light); from
                               spawn() on, clipped to the world box (vw_decomp_clip) */
     double weight[3];      /* shadow ray: the contribution added if unoccluded */
     int32_t pixel, depth, kind;
@@ -293,7 +293,11 @@ static void shade(vw_ctx *ctx, rt_cell *c, const rt_ray *r, const rt_hit *h)
         }
         if (!any) continue;
         memcpy(s.org, p, sizeof s.org);
-        s.tmax = dist;
+        /* It stops short of the light as it starts off its surface: by the most a ray
+           may start off (64 eps, rt_ray_eps). A light on a surface (on a floor, on a
+           sphere) would otherwise be hidden by that surface, found at t = dist by
+           rounding half the time or more: everything it lights went dark. */
+        s.tmax = dist - 64.0 * sh->eps;
         s.pixel = r->pixel;
         s.depth = r->depth;
         s.kind = RT_SHADOW;

@@ -10,6 +10,7 @@
  *                         the float frame a job picks (rt_float_frame_of)
  *   watertight            rays aimed at a mesh's shared edges and vertices hit it
  *   concave SCENE         each polygon's triangle records cover it and nothing else
+ *   lighton               a light exactly on a surface lights what faces it
  *   hitcells              the overlay's map of the cells where eye rays hit
  *   view                  the eye rays span the angle an NFF 'v' block gives, all of
  *                         the range the reader accepts (0..180 degrees)
@@ -415,6 +416,48 @@ static int test_contact(void)
     EXPECT(fabs(got - 0.8) < 1e-6, "floor 0.01 below the eye: %.9g, expected 0.8", got);
     free(sums);
     vw_scene_free(s);
+    return vw_test_failures ? 1 : 0;
+}
+
+/* A light exactly on a surface lights what lies in front of that surface: a light on a
+   floor lights a ball above it, and a light on a ball's surface another ball. The
+   shadow ray ended at the light's distance, where it found the surface the light lies
+   on (Embree's tests take their far end), so both balls were black. */
+static int test_lighton(void)
+{
+    static const char *const scenes[2] = {
+        /* Ball point (0, -0.5, 1), normal -y; light (2, -2, 0) on the floor z = 0. */
+        "v\nfrom 0 -10 1\nat 0 0 1\nup 0 0 1\nangle 30\nresolution 9 9\nb 0 0 0\n"
+        "l 2 -2 0\nf 1 1 1 1 0 0 0 1\ns 0 0 1 0.5\n"
+        "p 4 -5 -5 0 5 -5 0 5 5 0 -5 5 0\n",
+        /* Ball point (-0.5, 0, 1), normal -x; light (-3, -2.5, 1) on the other ball,
+           where its normal points back at that point. */
+        "v\nfrom -10 0 1\nat 0 0 1\nup 0 0 1\nangle 30\nresolution 9 9\nb 0 0 0\n"
+        "l -3 -2.5 1\nf 1 1 1 0.8 0 0 0 1\ns 0 0 1 0.5\n"
+        "s -4 -3.5 1 1.4142135623730951\n"};
+    const double want[2] = {1.5 / sqrt(7.25), 0.8 * sqrt(0.5)};
+    for (int k = 0; k < 2; k++) {
+        char err[256];
+        vw_scene *s;
+        if (vw_scene_read_nff("lighton.nff", scenes[k], strlen(scenes[k]), &s, err, sizeof err) !=
+            VW_OK) {
+            fprintf(stderr, "%s\n", err);
+            return 1;
+        }
+        for (int layout = 0; layout < 2; layout++) {
+            int dims[3] = {layout ? 2 : 1, layout ? 2 : 1, 1};
+            int64_t c[RT_NCOUNTERS];
+            int64_t *sums = render(s, 9, 9, dims, 2, c, NULL);
+            for (int a = 0; a < 3; a++) {
+                double got = (double)sums[(4 * 9 + 4) * 3 + a] / RT_FIX_ONE;
+                EXPECT(fabs(got - want[k]) < 1e-5, "scene %d on %dx%dx1 cells, channel %d: "
+                       "%.9g, expected %.9g (the light on a surface)", k, dims[0], dims[1], a,
+                       got, want[k]);
+            }
+            free(sums);
+        }
+        vw_scene_free(s);
+    }
     return vw_test_failures ? 1 : 0;
 }
 
@@ -924,6 +967,7 @@ int main(int argc, char **argv)
     if (argc >= 3 && !strcmp(argv[1], "identical")) return test_identical(argv[2], argc > 3 ? argv[3] : NULL);
     if (argc >= 2 && !strcmp(argv[1], "analytic")) return test_analytic(argc > 2 ? atof(argv[2]) : 0);
     if (argc >= 2 && !strcmp(argv[1], "contact")) return test_contact();
+    if (argc >= 2 && !strcmp(argv[1], "lighton")) return test_lighton();
     if (argc >= 2 && !strcmp(argv[1], "cone")) return test_cone();
     if (argc >= 2 && !strcmp(argv[1], "scale")) return test_scale();
     if (argc >= 2 && !strcmp(argv[1], "view")) return test_view();

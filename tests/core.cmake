@@ -57,8 +57,8 @@ set_tests_properties(core_misuse_create core_misuse_post core_misuse_redecompose
   core_misuse_maperr PROPERTIES LABELS "core")
 # An overflowed size loops; a slow-down read from the caller's array spins: both hang.
 set_tests_properties(core_misuse_limits core_misuse_slowdown PROPERTIES TIMEOUT 30)
-foreach(case "send;sent message kind 1 to cell 0, but the kind has no handle"
-             "output;sent message kind 0 to the output, but the kind has no output handler"
+foreach(case "send;sent message kind 1 ('to_output') to cell 0, but the kind has no handle (an output kind: sent with vw_send_output)"
+             "output;sent message kind 0 ('to_cell') to the output, but the kind has no output handler"
              "count;counted into counter 5 of 1"
              "count-all;counted into counter 5 of 1"
              "face;sent message kind 0 to face 6 (faces are 0..5)"

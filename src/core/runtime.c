@@ -266,14 +266,17 @@ static int flush_all(vw__worker *wk)
    line is written whole by one write(2), and by the first worker only: when several
    made the same mistake at once, their pieces were interleaved on the terminal and the
    first abort cut the others short. The others wait for that abort. */
-static void __attribute__((noreturn, noinline, cold))
-misuse(const vw_ctx *ctx, const char *fmt, int a, int b)
+static void __attribute__((noreturn, noinline, cold, format(printf, 2, 3)))
+misuse(const vw_ctx *ctx, const char *fmt, ...)
 {
     static int reported;
     if (__atomic_exchange_n(&reported, 1, __ATOMIC_ACQ_REL))
         for (;;) pause();
-    char line[512], what[256];
-    snprintf(what, sizeof what, fmt, a, b);
+    char line[512], what[320];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(what, sizeof what, fmt, ap);
+    va_end(ap);
     int n = snprintf(line, sizeof line, "vwalls: module '%s' %s (worker %d, in cell %d)\n",
                      ctx->w->m->name, what, ctx->wk->global, ctx->cell);
     if (n > (int)sizeof line - 1) n = (int)sizeof line - 1;
@@ -644,7 +647,8 @@ void vw_send_cell(vw_ctx *ctx, int cell, int kind, const void *msg)
     if (cell < 0 || cell >= w->ncells)
         misuse(ctx, "sent to cell %d, which does not exist (%d cells)", cell, w->ncells);
     if (kind >= 0 && kind < w->m->nkinds && !w->m->kinds[kind].handle)
-        misuse(ctx, "sent message kind %d to cell %d, but the kind has no handle", kind, cell);
+        misuse(ctx, "sent message kind %d ('%s') to cell %d, but the kind has no handle (an "
+               "output kind: sent with vw_send_output)", kind, w->m->kinds[kind].name, cell);
     int dest = w->cell_worker[cell];
     const vw__cell *c = &w->cells[cell];
     if (c->nreps && kind >= 0 && kind < w->m->nkinds &&
@@ -704,7 +708,8 @@ void vw_send_output(vw_ctx *ctx, int kind, const void *msg)
 {
     const vw_module *m = ctx->w->m;
     if (kind >= 0 && kind < m->nkinds && !m->kinds[kind].output)
-        misuse(ctx, "sent message kind %d to the output, but the kind has no output handler", kind, 0);
+        misuse(ctx, "sent message kind %d ('%s') to the output, but the kind has no output handler",
+               kind, m->kinds[kind].name);
     enqueue(ctx, ctx->w->gworkers, VW__OUTPUT, -1, kind, msg);
 }
 
@@ -712,7 +717,7 @@ void vw_ctx_fail(vw_ctx *ctx, vw_status status, const char *fmt, ...)
 {
     if (!ctx->in_run)
         misuse(ctx, "called vw_ctx_fail from cell %d outside a run (cell_build returns its "
-                    "status instead)", ctx->cell, 0);
+                    "status instead)", ctx->cell);
     char what[360];
     va_list ap;
     va_start(ap, fmt);

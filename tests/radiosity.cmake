@@ -5,7 +5,7 @@ add_executable(test_radiosity ${PROJECT_SOURCE_DIR}/tests/radiosity/test_radiosi
 target_include_directories(test_radiosity PRIVATE ${PROJECT_SOURCE_DIR}/tests)
 target_link_libraries(test_radiosity PRIVATE vwalls_apps m)
 
-foreach(t ffsum parallel perpendicular box layouts checkpoint subdivide concave placement manycells)
+foreach(t ffsum parallel perpendicular box furnace twosided layouts checkpoint subdivide concave placement manycells)
   add_test(NAME radiosity_${t} COMMAND test_radiosity ${t})
   set_tests_properties(radiosity_${t} PROPERTIES LABELS "radiosity;threads" TIMEOUT 60)
 endforeach()

@@ -83,6 +83,14 @@ void rad_hemicube_raster(const rad_hemicube *h, const double (*hv)[3], int nv, c
     vw_polygon_normal(hv, nv, m);
     double c = rad_dot(m, hv[0]);
     if (fabs(c) <= 1e-300) return; /* the plane passes through the shooter: seen edge-on */
+    /* A polygon seen from behind (the shooter on its back side: c > 0, as the module's
+       facing test) loses a depth tie to one seen from the front: its depth counts
+       RAD_BACK_BIAS (relative) farther. A two-sided panel is two coincident polygons
+       back to back, and a tie decided by the order of the elements gave the light to
+       the back face whenever it came first, which absorbs it: the side facing the
+       shooter stayed dark, whatever its reflectance. A back face nearer than that
+       (1e-9 of the distance) still hides a front face behind it. */
+    const double bias = c > 0 ? 1 + RAD_BACK_BIAS : 1;
     for (int f = 0; f < 5; f++) {
         double P[RAD_MAXV + 6][3], Q[RAD_MAXV + 6][3];
         int np = 0, any = 0;
@@ -186,6 +194,7 @@ void rad_hemicube_raster(const rad_hemicube *h, const double (*hv)[3], int nv, c
                 if (md == 0) continue;
                 double depth = c / md;
                 if (!(depth > 0)) continue;
+                depth *= bias;
                 if (z->stamp[p] != z->cur || depth < z->depth[p]) {
                     if (z->written && z->stamp[p] != z->cur) z->written[p >> 6] |= (uint64_t)1 << (p & 63);
                     z->stamp[p] = z->cur;

@@ -358,6 +358,9 @@ vw_status rad_write_csv(const char *path, const rad_mesh *m, const vw_scene *sc,
 
 /* ---- the image: perspective z-buffer over triangles with Gouraud colour ---- */
 
+/* Relative depth handicap of an element seen from behind (float depths: 8 ulps). */
+#define RAD_IMAGE_BACK_BIAS 1e-6
+
 vw_status rad_write_image(const char *path, const vw_camera *cam, const rad_mesh *m,
                           const rad_elem_result *e, size_t n, const double ambient[3], char *err,
                           size_t errlen)
@@ -391,6 +394,16 @@ vw_status rad_write_image(const char *path, const vw_camera *cam, const rad_mesh
         /* Camera space (x right, y up, z forward), clipped at the near plane. */
         double P[RAD_MAXV + 2][6], Q[RAD_MAXV + 2][6];
         int nv = sh.nv[i], nq = 0;
+        /* Seen from behind, an element loses a depth tie (RAD_IMAGE_BACK_BIAS relative,
+           above float rounding) to one seen from the front: a two-sided panel (two
+           coincident polygons back to back) showed the side listed first in the
+           scene, from both sides. */
+        double bias = 1;
+        if (e[i].piece >= 0 && (size_t)e[i].piece < m->npieces && nv > 0) {
+            double r0[3];
+            rad_sub(cam->from, sh.v[sh.first[i]], r0);
+            if (!(rad_dot(r0, m->pieces[e[i].piece].normal) > 0)) bias = 1 + RAD_IMAGE_BACK_BIAS;
+        }
         for (int k = 0; k < nv; k++) {
             double r[3];
             rad_sub(sh.v[sh.first[i] + k], cam->from, r);
@@ -431,7 +444,7 @@ vw_status rad_write_image(const char *path, const vw_camera *cam, const rad_mesh
                     if (w0 < -1e-9 || w1 < -1e-9 || w2 < -1e-9) continue;
                     /* Perspective-correct: interpolate attribute/z and 1/z. */
                     double izp = w0 * iz[a] + w1 * iz[b] + w2 * iz[c];
-                    float depth = (float)(1 / izp);
+                    float depth = (float)(bias / izp);
                     size_t pix = (size_t)y * (size_t)W + (size_t)x;
                     if (!(depth < zb[pix])) continue;
                     zb[pix] = depth;

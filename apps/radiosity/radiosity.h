@@ -188,7 +188,11 @@ void rad_hemicube_pixel_dir(const rad_hemicube *h, int px, double d[3]);
    mask is clear and whose stored depth is larger take depth and id. stamp/cur mark the
    pixels written in this shot (depth is valid only where stamp == cur); when written is
    not NULL, the first write of pixel p in a shot also sets bit p of it (npix bits in
-   64-bit words), so that the pixels written are found without visiting all npix. */
+   64-bit words), so that the pixels written are found without visiting all npix.
+   A polygon seen from behind (the origin on its back side) counts RAD_BACK_BIAS
+   (relative) farther, so it loses a depth tie to one seen from the front (two-sided
+   panels: two coincident polygons back to back). */
+#define RAD_BACK_BIAS 1e-9
 typedef struct rad_zbuf {
     double *depth;
     int32_t *owner;

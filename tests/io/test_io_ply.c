@@ -98,7 +98,7 @@ static void bad(const char *text, size_t len, const char *want)
    ..."), at the line of its first short face, and 16-bit colours. */
 static void warn_file(const char *data)
 {
-    char path[4096], line[512], want[512] = "", err[512] = "";
+    char path[4096], line[512], want[sizeof path + sizeof line + 32] = "", err[512] = "";
     snprintf(path, sizeof path, "%s/warn/ply_degenerate.ply", data);
     FILE *f = fopen(path, "r");
     CHECK(f != NULL);

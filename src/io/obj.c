@@ -148,10 +148,14 @@ static span rest_of_line(span line)
     return line;
 }
 
+static int span_eq(span a, span b)
+{
+    return a.n == b.n && memcmp(a.s, b.s, a.n) == 0;
+}
+
 static int span_is(span t, const char *kw)
 {
-    size_t n = strlen(kw);
-    return t.n == n && memcmp(t.s, kw, n) == 0;
+    return span_eq(t, (span){kw, strlen(kw)});
 }
 
 static const char *show(span t, char buf[48])
@@ -397,11 +401,6 @@ static span without_comment(span name)
     return name;
 }
 
-static int span_eq(span a, span b)
-{
-    return a.n == b.n && memcmp(a.s, b.s, a.n) == 0;
-}
-
 /* The newest material called name, or -1: a later library's definition of a name
    replaces an earlier one for the usemtl statements after it.
    A name is the rest of its line, blanks and '#' included, as Blender and Assimp read
@@ -413,13 +412,13 @@ static int span_eq(span a, span b)
 static long find_named_material(const obj *O, span name)
 {
     for (size_t i = O->nnames; i-- > 0;)
-        if (strlen(O->mat_names[i]) == name.n && memcmp(O->mat_names[i], name.s, name.n) == 0)
+        if (span_is(name, O->mat_names[i]))
             return (long)i;
     span cut = without_comment(name);
     for (size_t i = O->nnames; i-- > 0;) {
-        span have = {O->mat_names[i], strlen(O->mat_names[i])};
-        if ((cut.n != name.n && span_eq(cut, have)) ||
-            (cut.n == name.n && span_eq(without_comment(have), name)))
+        if ((cut.n != name.n && span_is(cut, O->mat_names[i])) ||
+            (cut.n == name.n &&
+             span_eq(without_comment((span){O->mat_names[i], strlen(O->mat_names[i])}), name)))
             return (long)i;
     }
     return -1;
@@ -537,7 +536,7 @@ static vw_status parse_mtl(obj *O, const char *text, size_t len)
                 m = &O->b.s->materials[O->mat_ids[i]];
                 /* Matched without a comment (find_named_material): the material takes
                    the name its definition gives, which later usemtl lines look up. */
-                if (strlen(O->mat_names[i]) != name.n || memcmp(O->mat_names[i], name.s, name.n)) {
+                if (!span_is(name, O->mat_names[i])) {
                     if ((st = vw__sb_add_string(&O->b, name.s, name.n, &m->name)) != VW_OK)
                         return fail_status(O, st);
                     O->mat_names[i] = O->b.s->strings[m->name - 1];

@@ -99,12 +99,11 @@ static vw_status cell_build(vw_ctx *ctx, const void *objects, size_t n, void **s
 {
     const ex_params *pp = vw_ctx_user(ctx);
     const vw_decomp *d = vw_ctx_decomp(ctx);
-    const double h = 2 * pp->rmax;
     const int self = vw_ctx_cell(ctx), ncells = vw_decomp_cell_count(d);
     const size_t m1 = n ? n : 1;
     ex_cell *ec = calloc(1, sizeof *ec);
     int *cells = malloc(sizeof(int) * (size_t)ncells);
-    if (!ec || !cells || ex_bins_build(&ec->bins, ctx, objects, n, h) != VW_OK) goto nomem;
+    if (!ec || !cells || ex_bins_build(&ec->bins, ctx, objects, n, pp->rmax) != VW_OK) goto nomem;
     ec->parent = malloc(sizeof *ec->parent * m1);
     ec->label = malloc(sizeof *ec->label * m1);
     ec->bstart = calloc(m1 + 1, sizeof *ec->bstart);
@@ -134,17 +133,13 @@ static vw_status cell_build(vw_ctx *ctx, const void *objects, size_t n, void **s
     }
     vw_count(ctx, EX_COMPONENTS_CNT_LOCAL, local);
 
-    /* Destinations of every own sphere: the other cells its reach (its box widened by
-       its radius and the largest radius) overlaps. Touching is symmetric and so is
-       reach, so a cell hears about every foreign sphere touching one of its own. */
+    /* Destinations of every own sphere: the other cells within its reach (its box
+       widened by its radius and the largest radius: ex_reach_cells). Touching is
+       symmetric and reach covers it, so a cell hears about every foreign sphere touching
+       one of its own. */
     size_t ndest = 0, cap = 0;
     for (size_t i = 0; i < m; i++) {
-        vw_box reach;
-        for (int k = 0; k < 3; k++) {
-            reach.lo[k] = own[i].c[k] - own[i].r - pp->rmax;
-            reach.hi[k] = own[i].c[k] + own[i].r + pp->rmax;
-        }
-        int nc = vw_decomp_cells_overlapping(d, &reach, 0, cells, ncells);
+        int nc = ex_reach_cells(d, &own[i], pp->rmax, cells, ncells);
         for (int k = 0; k < nc; k++) {
             if (cells[k] == self) continue;
             if (ndest == cap) {
@@ -286,11 +281,17 @@ vw_status ex_components_label(const ex_sphere *s, size_t n, double rmax, const v
                               const vw_config *cfg, int64_t *labels, int64_t *ncomponents,
                               vw_world **out_world)
 {
+    if (out_world) *out_world = NULL;
+    /* Agreed: a process out of memory for the check alone would leave the others
+       waiting for it in vw_world_create. */
+    char why[256] = "";
+    vw_status st = ex_spheres_check(s, n, rmax, d, 1, why, sizeof why);
+    if ((st = vw_config_agree(cfg, st, why, sizeof why)) != VW_OK) return st;
     /* The world keeps a pointer to params: a world handed back is for reading stats,
        not for running again. */
     ex_params params = {rmax, labels, n};
     vw_world *w;
-    vw_status st = vw_world_create(&components_module, &params, d, cfg, &w);
+    st = vw_world_create(&components_module, &params, d, cfg, &w);
     if (st != VW_OK) return st;
     struct timespec t[5];
     clock_gettime(CLOCK_MONOTONIC, &t[0]);

@@ -8,13 +8,14 @@
  */
 #include "pairs.h"
 
+#include <float.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <time.h>
 
 #include "sphere_bins.h"
 
-enum { MSG_GHOST, NKINDS };                 /* message kinds */
-enum { CNT_PAIRS, CNT_GHOSTS, NCOUNTERS };  /* counters */
+enum { MSG_GHOST, NKINDS };                 /* message kinds; counters: pairs.h */
 
 typedef struct pairs_params {
     double rmax;                            /* reach of a ghost */
@@ -55,10 +56,10 @@ static void sphere_bounds(const void *obj, vw_box *out, void *user)
 
 static vw_status cell_build(vw_ctx *ctx, const void *objects, size_t n, void **state)
 {
-    const double h = 2 * ((const pairs_params *)vw_ctx_user(ctx))->rmax;
+    const double rmax = ((const pairs_params *)vw_ctx_user(ctx))->rmax;
     pairs_cell *pc = calloc(1, sizeof *pc);
     if (!pc) return VW_E_NOMEM;
-    if (ex_bins_build(&pc->bins, ctx, objects, n, h) != VW_OK) {
+    if (ex_bins_build(&pc->bins, ctx, objects, n, rmax) != VW_OK) {
         free(pc);
         return VW_E_NOMEM;
     }
@@ -83,22 +84,20 @@ static int step(vw_ctx *ctx, void *state)
     const pairs_params *pp = vw_ctx_user(ctx);
     int64_t local = 0;
     for (size_t i = 0; i < pc->bins.n; i++) local += count_near(&pc->bins, &pc->bins.own[i]);
-    vw_count(ctx, CNT_PAIRS, local);
+    vw_count(ctx, EX_PAIRS_CNT_PAIRS, local);
     int *cells = malloc(sizeof(int) * (size_t)vw_decomp_cell_count(vw_ctx_decomp(ctx)));
-    if (!cells) abort();
+    if (!cells) { /* fails the run: vw_world_run returns VW_E_NOMEM with this message */
+        vw_ctx_fail(ctx, VW_E_NOMEM, "no memory for the cells a ghost reaches");
+        return 0;
+    }
     for (size_t i = 0; i < pc->bins.n; i++) {
         const ex_sphere *s = &pc->bins.own[i];
-        vw_box reach;
-        for (int k = 0; k < 3; k++) {
-            reach.lo[k] = s->c[k] - s->r - pp->rmax;
-            reach.hi[k] = s->c[k] + s->r + pp->rmax;
-        }
-        int n = vw_decomp_cells_overlapping(vw_ctx_decomp(ctx), &reach, 0, cells,
-                                            vw_decomp_cell_count(vw_ctx_decomp(ctx)));
+        int n = ex_reach_cells(vw_ctx_decomp(ctx), s, pp->rmax, cells,
+                               vw_decomp_cell_count(vw_ctx_decomp(ctx)));
         for (int k = 0; k < n; k++) {
             if (cells[k] == vw_ctx_cell(ctx)) continue;
             vw_send_cell(ctx, cells[k], MSG_GHOST, s);
-            vw_count(ctx, CNT_GHOSTS, 1);
+            vw_count(ctx, EX_PAIRS_CNT_GHOSTS, 1);
         }
     }
     free(cells);
@@ -108,13 +107,16 @@ static int step(vw_ctx *ctx, void *state)
 static void on_ghost(vw_ctx *ctx, void *state, const void *msg)
 {
     const pairs_cell *pc = state;
-    vw_count(ctx, CNT_PAIRS, count_near(&pc->bins, msg));
+    vw_count(ctx, EX_PAIRS_CNT_PAIRS, count_near(&pc->bins, msg));
 }
 
 static const vw_msg_kind kinds[NKINDS] = {
     [MSG_GHOST] = {"ghost", sizeof(ex_sphere), on_ghost, NULL},
 };
-static const char *const counters[NCOUNTERS] = {"pairs", "ghosts"};
+static const char *const counters[EX_PAIRS_NCOUNTERS] = {
+    [EX_PAIRS_CNT_PAIRS] = "pairs",
+    [EX_PAIRS_CNT_GHOSTS] = "ghosts",
+};
 
 static const vw_module pairs_module = {
     .abi = VW_MODULE_ABI,
@@ -124,7 +126,7 @@ static const vw_module pairs_module = {
     .kinds = kinds,
     .nkinds = NKINDS,
     .counters = counters,
-    .ncounters = NCOUNTERS,
+    .ncounters = EX_PAIRS_NCOUNTERS,
     .cell_build = cell_build,
     .cell_free = cell_free,
     .step = step,
@@ -133,11 +135,17 @@ static const vw_module pairs_module = {
 vw_status ex_pairs_count(const ex_sphere *s, size_t n, double rmax, const vw_decomp *d,
                          const vw_config *cfg, int64_t *pairs, vw_world **out_world)
 {
+    if (out_world) *out_world = NULL;
+    /* Agreed: a process out of memory for the check alone would leave the others
+       waiting for it in vw_world_create. */
+    char why[256] = "";
+    vw_status st = ex_spheres_check(s, n, rmax, d, 0, why, sizeof why);
+    if ((st = vw_config_agree(cfg, st, why, sizeof why)) != VW_OK) return st;
     /* The world keeps a pointer to params: a world handed back is for reading stats,
        not for running again. */
     pairs_params params = {rmax};
     vw_world *w;
-    vw_status st = vw_world_create(&pairs_module, &params, d, cfg, &w);
+    st = vw_world_create(&pairs_module, &params, d, cfg, &w);
     if (st != VW_OK) return st;
     struct timespec t[4];
     clock_gettime(CLOCK_MONOTONIC, &t[0]);
@@ -151,7 +159,7 @@ vw_status ex_pairs_count(const ex_sphere *s, size_t n, double rmax, const vw_dec
     for (int i = 0; i < 3; i++)
         vw_world_add_time(w, phase[i], (double)(t[i + 1].tv_sec - t[i].tv_sec) +
                                            1e-9 * (double)(t[i + 1].tv_nsec - t[i].tv_nsec));
-    *pairs = vw_world_counter(w, CNT_PAIRS);
+    *pairs = vw_world_counter(w, EX_PAIRS_CNT_PAIRS);
     if (out_world)
         *out_world = w;
     else
@@ -159,7 +167,74 @@ vw_status ex_pairs_count(const ex_sphere *s, size_t n, double rmax, const vw_dec
     return st;
 }
 
-/* ---- the sequential side: scene and reference ---- */
+/* ---- the sequential side: checks, scene and reference ---- */
+
+static int cmp_id(const void *a, const void *b)
+{
+    int64_t x = *(const int64_t *)a, y = *(const int64_t *)b;
+    return (x > y) - (x < y);
+}
+
+/* The first id that appears twice in s[0..n), in *dup; -1 when out of memory. Ids all
+   in 0..n-1 (every sphere set this file makes) take a bitmap, others a sorted copy. */
+static int id_twice(const ex_sphere *s, size_t n, int64_t *dup)
+{
+    int small = 1;
+    for (size_t i = 0; i < n && small; i++) small = s[i].id >= 0 && (uint64_t)s[i].id < n;
+    if (small) {
+        unsigned char *seen = calloc(n / 8 + 1, 1);
+        if (!seen) return -1;
+        for (size_t i = 0; i < n; i++) {
+            uint64_t id = (uint64_t)s[i].id;
+            if (seen[id / 8] & (1u << id % 8)) {
+                *dup = s[i].id;
+                free(seen);
+                return 1;
+            }
+            seen[id / 8] |= (unsigned char)(1u << id % 8);
+        }
+        free(seen);
+        return 0;
+    }
+    int64_t *ids = malloc(sizeof *ids * n);
+    if (!ids) return -1;
+    for (size_t i = 0; i < n; i++) ids[i] = s[i].id;
+    qsort(ids, n, sizeof *ids, cmp_id);
+    int found = 0;
+    for (size_t i = 1; i < n && !found; i++)
+        if (ids[i] == ids[i - 1]) *dup = ids[i], found = 1;
+    free(ids);
+    return found;
+}
+
+vw_status ex_spheres_check(const ex_sphere *s, size_t n, double rmax, const vw_decomp *d,
+                           int ids_are_indices, char *why, size_t len)
+{
+    char msg[256] = "";
+    int64_t dup = 0;
+    int twice = 0;
+    if (!(rmax >= 0 && rmax <= DBL_MAX))
+        snprintf(msg, sizeof msg, "largest radius %g: not a finite number >= 0", rmax);
+    for (size_t i = 0; !*msg && i < n; i++) {
+        const ex_sphere *e = &s[i];
+        if (!(e->r >= 0 && e->r <= rmax))
+            snprintf(msg, sizeof msg, "sphere %zu (id %lld): radius %g is not from 0 to the largest "
+                     "radius %g", i, (long long)e->id, e->r, rmax);
+        else if (vw_decomp_locate(d, e->c, NULL) < 0)
+            snprintf(msg, sizeof msg, "sphere %zu (id %lld): centre (%g, %g, %g) is not in the world box",
+                     i, (long long)e->id, e->c[0], e->c[1], e->c[2]);
+        else if (ids_are_indices && !(e->id >= 0 && (uint64_t)e->id < n))
+            snprintf(msg, sizeof msg, "sphere %zu: id %lld is not from 0 to %zu", i, (long long)e->id,
+                     n - 1);
+    }
+    if (!*msg && n > 1 && (twice = id_twice(s, n, &dup)) < 0) {
+        if (why && len) snprintf(why, len, "out of memory checking the ids of %zu spheres", n);
+        return VW_E_NOMEM;
+    }
+    if (twice) snprintf(msg, sizeof msg, "id %lld is given to two spheres", (long long)dup);
+    if (why && len) snprintf(why, len, "%s", msg);
+    return *msg ? VW_E_INVAL : VW_OK;
+}
 
 static double uniform(uint64_t *x)
 {

@@ -1,6 +1,7 @@
-/* sphere_bins.h - the neighbour search both example modules use: a cell's own spheres
- * sorted by the key of a grid bin of spacing h = 2*rmax, so that the spheres touching
- * a query sphere are found in O(log n) whatever the layout of cells.
+/* sphere_bins.h - what both example modules share: the meaning of "touching", the cells
+ * a sphere must be sent to, and the neighbour search: a cell's own spheres sorted by the
+ * key of a grid bin at least 2*rmax wide, so that the spheres touching a query sphere are
+ * found in O(log n) whatever the layout of cells.
  */
 #ifndef VW_EXAMPLE_SPHERE_BINS_H
 #define VW_EXAMPLE_SPHERE_BINS_H
@@ -14,9 +15,12 @@ typedef struct ex_bins {
     ex_sphere *own;   /* spheres whose centre lies in this cell, sorted by key */
     uint64_t *key;
     size_t n;
-    double h;
+    double h, lo[3];  /* bin width and the grid's origin (the world box's low corner) */
 } ex_bins;
 
+/* Touching, as pairs.h defines it: |a - b|^2 <= (ra + rb)^2, evaluated in double exactly
+   so. It is symmetric bit for bit (the differences only change sign), so every cell,
+   whatever the layout, decides a pair alike. */
 static inline int ex_touching(const ex_sphere *a, const ex_sphere *b)
 {
     double d2 = 0;
@@ -24,16 +28,45 @@ static inline int ex_touching(const ex_sphere *a, const ex_sphere *b)
     return d2 <= (a->r + b->r) * (a->r + b->r);
 }
 
-/* Two touching spheres lie in adjacent bins. Keys order bins with z fastest, so the
-   bins (x+dx, y+dy, z-1..z+1) are one run of the sorted array. */
-static inline uint64_t ex_bin_key(const double c[3], double h, int dx, int dy, int dz)
+/* The cells that may own the centre of a sphere touching s (any radius up to rmax): those
+   whose box overlaps s's box widened by rmax. That box's ends are rounded: a sphere
+   exactly touching s with its centre on a wall could lie an ulp beyond them, and the cell
+   across the wall would never hear of s (the pair then counted on one layout and not on
+   another). So the box is padded by far more than rounding (1e-12 of the coordinates'
+   size): a cell too many costs a message, never a wrong result, as every receiver tests
+   touching itself. Returns the number of cells (self included), ids in cells[0..max). */
+static inline int ex_reach_cells(const vw_decomp *d, const ex_sphere *s, double rmax, int *cells,
+                                 int max)
 {
-    uint64_t k = 0;
-    for (int a = 0; a < 3; a++) {
-        int64_t i = (int64_t)floor(c[a] / h) + 1 + (a == 0 ? dx : a == 1 ? dy : dz);
-        k = (k << 21) | (uint64_t)(i < 0 ? 0 : i);
+    vw_box reach, world = vw_decomp_world(d);
+    double size = s->r + rmax;
+    for (int k = 0; k < 3; k++) {
+        reach.lo[k] = s->c[k] - s->r - rmax;
+        reach.hi[k] = s->c[k] + s->r + rmax;
+        size += fabs(s->c[k]) + fabs(world.lo[k]) + fabs(world.hi[k]);
     }
-    return k;
+    return vw_decomp_cells_overlapping(d, &reach, 1e-12 * size, cells, max);
+}
+
+/* Bins: indices 0 .. EX_BIN_MAX per axis, 21 bits each in a 64-bit key, z fastest, so the
+   bins (x, y, z-1..z+1) are one run of the sorted keys. Index = floor((c - lo) / h),
+   clamped: clamping keeps the order of indices and never moves two of them further apart,
+   so spheres in adjacent bins stay in adjacent (or the same) bins. */
+#define EX_BIN_MAX ((int64_t)(1 << 21) - 1)
+
+static inline int64_t ex_bin_clamp(double t)
+{
+    return !(t >= 0) ? 0 : t >= (double)EX_BIN_MAX ? EX_BIN_MAX : (int64_t)t;
+}
+
+static inline int64_t ex_bin_index(const ex_bins *b, const double c[3], int a)
+{
+    return ex_bin_clamp(floor((c[a] - b->lo[a]) / b->h));
+}
+
+static inline uint64_t ex_bin_key(int64_t x, int64_t y, int64_t z)
+{
+    return (uint64_t)x << 42 | (uint64_t)y << 21 | (uint64_t)z;
 }
 
 static inline int ex_bins_cmp(const void *a, const void *b)
@@ -43,24 +76,39 @@ static inline int ex_bins_cmp(const void *a, const void *b)
 }
 
 /* Keeps the spheres of s[0..n) whose centre the cell owns (a centre on a wall goes to
-   the + side; near a wall a centre is placed in two cells, so this choice matters). */
+   the + side; near a wall a centre is placed in two cells, so this choice matters).
+   Bins are 2*rmax wide and a hair more (touching in double may exceed 2*rmax by a few
+   ulps: the hair keeps such a pair in adjacent bins), and at least 2^-20 of the world's
+   extent, so the indices of centres in the world fit their 21 bits (and rmax 0 is no
+   division by 0). */
 static inline vw_status ex_bins_build(ex_bins *b, vw_ctx *ctx, const ex_sphere *s, size_t n,
-                                      double h)
+                                      double rmax)
 {
     static const double dir[3] = {1, 1, 1};
+    const vw_decomp *d = vw_ctx_decomp(ctx);
+    vw_box world = vw_decomp_world(d);
+    double extent = 0;
+    for (int k = 0; k < 3; k++) {
+        b->lo[k] = world.lo[k];
+        if (world.hi[k] - world.lo[k] > extent) extent = world.hi[k] - world.lo[k];
+    }
+    b->h = fmax(2 * rmax * (1 + 1e-9), extent * 0x1p-20);
+    if (!(b->h > 0)) b->h = 1;
     uint64_t (*tmp)[2] = malloc(sizeof *tmp * (n ? n : 1)); /* (key, index) to sort */
     b->own = malloc(sizeof *b->own * (n ? n : 1));
     b->key = malloc(sizeof *b->key * (n ? n : 1));
     b->n = 0;
-    b->h = h;
     if (!tmp || !b->own || !b->key) {
         free(tmp), free(b->own), free(b->key);
         b->own = NULL, b->key = NULL;
         return VW_E_NOMEM;
     }
     for (size_t i = 0; i < n; i++)
-        if (vw_decomp_locate(vw_ctx_decomp(ctx), s[i].c, dir) == vw_ctx_cell(ctx))
-            tmp[b->n][0] = ex_bin_key(s[i].c, h, 0, 0, 0), tmp[b->n++][1] = i;
+        if (vw_decomp_locate(d, s[i].c, dir) == vw_ctx_cell(ctx)) {
+            tmp[b->n][0] = ex_bin_key(ex_bin_index(b, s[i].c, 0), ex_bin_index(b, s[i].c, 1),
+                                      ex_bin_index(b, s[i].c, 2));
+            tmp[b->n++][1] = i;
+        }
     qsort(tmp, b->n, sizeof *tmp, ex_bins_cmp);
     for (size_t i = 0; i < b->n; i++) b->key[i] = tmp[i][0], b->own[i] = s[tmp[i][1]];
     free(tmp);
@@ -83,14 +131,21 @@ static inline size_t ex_bins_lower_bound(const ex_bins *b, uint64_t key)
     return lo;
 }
 
-/* Calls fn(j, arg) for every own sphere j that touches q. */
+/* Calls fn(j, arg) once for every own sphere j that touches q. The bins visited are
+   distinct, so no sphere is visited twice, even where clamping merged bins. */
 static inline void ex_bins_for_touching(const ex_bins *b, const ex_sphere *q,
                                         void (*fn)(size_t j, void *arg), void *arg)
 {
-    for (int dx = -1; dx <= 1; dx++)
-        for (int dy = -1; dy <= 1; dy++) {
-            uint64_t last = ex_bin_key(q->c, b->h, dx, dy, 1);
-            for (size_t j = ex_bins_lower_bound(b, ex_bin_key(q->c, b->h, dx, dy, -1));
+    int64_t lo[3], hi[3];
+    for (int a = 0; a < 3; a++) {
+        int64_t i = ex_bin_index(b, q->c, a);
+        lo[a] = i > 0 ? i - 1 : 0;
+        hi[a] = i < EX_BIN_MAX ? i + 1 : EX_BIN_MAX;
+    }
+    for (int64_t x = lo[0]; x <= hi[0]; x++)
+        for (int64_t y = lo[1]; y <= hi[1]; y++) {
+            uint64_t last = ex_bin_key(x, y, hi[2]);
+            for (size_t j = ex_bins_lower_bound(b, ex_bin_key(x, y, lo[2]));
                  j < b->n && b->key[j] <= last; j++)
                 if (ex_touching(&b->own[j], q)) fn(j, arg);
         }

@@ -1,7 +1,9 @@
 # examples.cmake - tests of the second example module (examples/components.c): the
 # distributed components equal the sequential reference, label for label, for every
 # layout and worker count, under the stress switches, and under mpirun when MPI is found.
-# (The first example, pairs, is tested in core.cmake and mpi.cmake.)
+# (The first example, pairs, is tested in core.cmake and mpi.cmake; both examples against
+# a brute force on sphere sets made to stress them, their command line and vwalls bench's
+# rays check at the end of this file.)
 
 set(VW_EX_ARGS --spheres 3000 --radius 0.05 --seed 5 --check --quiet)
 foreach(layout 1 2x4 2x2x2 4x4x4)
@@ -113,4 +115,57 @@ if(VW_HAVE_MPI)
   endforeach()
   set_tests_properties(tutorial_hello_mpi_np2 tutorial_own_mpi_np2 tutorial_own_mpi_np4 PROPERTIES
                        LABELS "examples;mpi" TIMEOUT 120 PROCESSORS 2 ENVIRONMENT "${_vw_ex_env}")
+endif()
+
+# Both example modules against an O(n^2) reference written in the test itself, on sphere
+# sets made to stress them (tests/examples/test_example_spheres.c): uniform, clustered,
+# exactly touching across a wall, larger than a cell, duplicated, zero radii, all radii
+# zero, a world below the origin, centres on the world's faces; on the layouts 1, 2,
+# 2x2x2, 4x4x4 and 1x1x8 with 1, 2 and 4 workers, also under mpirun; and sphere sets the
+# modules cannot count (a radius above rmax, a centre outside the world, an id twice, ...)
+# refused with VW_E_INVAL rather than counted wrong ("invalid").
+add_executable(test_example_spheres ${PROJECT_SOURCE_DIR}/tests/examples/test_example_spheres.c)
+target_link_libraries(test_example_spheres PRIVATE vwalls_apps m)
+foreach(case uniform clustered walls chains large duplicates zero allzero negative faces invalid)
+  add_test(NAME example_spheres_${case} COMMAND test_example_spheres --case ${case})
+  set_tests_properties(example_spheres_${case} PROPERTIES LABELS "examples;threads" TIMEOUT 300)
+endforeach()
+add_test(NAME example_spheres_stress
+         COMMAND test_example_spheres --case walls --cells 2x2x2,4x4x4 --workers 4)
+set_tests_properties(example_spheres_stress PROPERTIES LABELS "examples;threads" TIMEOUT 300
+                     ENVIRONMENT "VW_STRESS=11;VW_STRESS_SPLIT=1")
+if(VW_HAVE_MPI)
+  foreach(np 2 3)
+    add_test(NAME example_spheres_mpi_np${np}
+             COMMAND ${MPIEXEC_EXECUTABLE} ${MPIEXEC_NUMPROC_FLAG} ${np} ${MPIEXEC_PREFLAGS}
+                     $<TARGET_FILE:test_example_spheres> --cells 2,2x2x2,4x4x4,1x1x8 --workers 1,2
+                     ${MPIEXEC_POSTFLAGS})
+    set_tests_properties(example_spheres_mpi_np${np} PROPERTIES LABELS "examples;mpi" TIMEOUT 300
+                         PROCESSORS 2 ENVIRONMENT "${_vw_ex_env}")
+  endforeach()
+  add_test(NAME example_spheres_invalid_mpi_np3
+           COMMAND ${MPIEXEC_EXECUTABLE} ${MPIEXEC_NUMPROC_FLAG} 3 ${MPIEXEC_PREFLAGS}
+                   $<TARGET_FILE:test_example_spheres> --case invalid --workers 1,2 ${MPIEXEC_POSTFLAGS})
+  set_tests_properties(example_spheres_invalid_mpi_np3 PROPERTIES LABELS "examples;mpi" TIMEOUT 120
+                       PROCESSORS 2 ENVIRONMENT "${_vw_ex_env}")
+endif()
+
+# The example commands' command line (tests/examples/cli.sh): help, stdout and stderr,
+# bad options, the stats, a failed --check leaving no stats.
+add_test(NAME example_cli
+         COMMAND sh ${PROJECT_SOURCE_DIR}/tests/examples/cli.sh $<TARGET_FILE:vwalls_tool>
+                 ${CMAKE_CURRENT_BINARY_DIR}/example_cli)
+set_tests_properties(example_cli PROPERTIES LABELS "examples" TIMEOUT 120)
+# vwalls bench checks that every configuration traced the same rays (tests/examples/bench.sh).
+add_test(NAME example_bench_rays
+         COMMAND sh ${PROJECT_SOURCE_DIR}/tests/examples/bench.sh $<TARGET_FILE:vwalls_tool>
+                 ${CMAKE_CURRENT_BINARY_DIR}/example_bench_rays)
+set_tests_properties(example_bench_rays PROPERTIES LABELS "examples" TIMEOUT 240)
+if(VW_HAVE_MPI)
+  add_test(NAME example_bench_rays_mpi
+           COMMAND sh ${PROJECT_SOURCE_DIR}/tests/examples/bench.sh $<TARGET_FILE:vwalls_tool>
+                   ${CMAKE_CURRENT_BINARY_DIR}/example_bench_rays_mpi
+                   "${MPIEXEC_EXECUTABLE} ${MPIEXEC_NUMPROC_FLAG} 2 ${VW_MPI_PREFLAGS}")
+  set_tests_properties(example_bench_rays_mpi PROPERTIES LABELS "examples;mpi" TIMEOUT 240
+                       PROCESSORS 2 ENVIRONMENT "${_vw_ex_env}")
 endif()

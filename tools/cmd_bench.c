@@ -5,8 +5,9 @@
  * alike; the table gives each one's best times, its speedup and efficiency against the
  * first configuration, and what does not depend on the core count (the imbalance lambda
  * of the workers' busy time, ray-cell visits per ray, messages). Every configuration
- * must make the same image, bit for bit (the fixed-point pixel sums): the design's
- * promise, checked on every run; a difference is a failure (exit status 1).
+ * must make the same image, bit for bit (the fixed-point pixel sums), by tracing the
+ * same rays (which is what makes the rows' visits per ray comparable): the design's
+ * promise, checked on every render; a difference is a failure (exit status 1).
  */
 #define _POSIX_C_SOURCE 200809L
 #include <stdio.h>
@@ -33,10 +34,11 @@ static void help(void)
            "rounds, the speedup (compute, best of rounds; and the median of the ratios\n"
            "within each round) and the efficiency against the first configuration, the\n"
            "imbalance lambda of the workers' busy time, ray-cell visits per ray and the\n"
-           "messages. Every configuration must render the same image, bit for bit: a\n"
-           "difference is reported and fails the command (exit status 1).\n"
+           "messages. Every configuration must render the same image, bit for bit, and\n"
+           "trace the same number of rays: a difference is reported and fails the command\n"
+           "(exit status 1).\n"
            "  SCENE            the scene (default: the generated sphereflake, vwalls gen\n"
-           "                   balls: 7382 spheres, 3 lights)\n"
+           "                   balls: 7381 spheres on a floor polygon, 3 lights)\n"
            "  --cells LIST     comma-separated layouts (default 1,2x2x2)\n"
            "  --workers LIST   comma-separated worker counts per process, 1 to 1024\n"
            "                   (default 1 and the cores, when there are more than one)\n"
@@ -55,7 +57,7 @@ static void help(void)
            "%d. Under mpirun every process runs its workers; the first process prints.\n"
            "Timings depend on what else the machine runs; lambda and visits do not.\n"
            "\nexit status: 0 success, 2 bad input or usage, 1 any other failure (also: two\n"
-           "configurations rendered different images)\n",
+           "configurations rendered different images or traced different numbers of rays)\n",
            MAX_ROUNDS, MAX_CONFIGS);
 }
 
@@ -166,10 +168,13 @@ static int rounds_json(char **buf, size_t *len, size_t *cap, const char *name, c
 /* One render of configuration c (its times go to round `round`; last: it is the last
    configuration); the output process keeps the pixel sums of the first render in *ref
    (allocated here) and compares every later render's with them: the first pixel that
-   differs goes to *bad_pixel. */
+   differs goes to *bad_pixel. The rays of the first render go to *ref_rays (-1 before
+   it); a later render that traced another number sets *bad_rays (every process alike:
+   the counters are summed over the processes). */
 static vw_status run_one(const vw_scene *scene, const vw_camera *cam, int width, int height,
                          long depth, int farm, bench_config *c, int round, int last, int64_t **ref,
-                         size_t *nref, long long *bad_pixel, char *err, size_t errlen)
+                         size_t *nref, long long *bad_pixel, long long *ref_rays, int *bad_rays,
+                         char *err, size_t errlen)
 {
     rt_params p;
     memset(&p, 0, sizeof p);
@@ -198,6 +203,12 @@ static vw_status run_one(const vw_scene *scene, const vw_camera *cam, int width,
     c->lambda = vw_world_imbalance(w);
     c->rays = vw_world_counter(w, RT_C_EYE) + vw_world_counter(w, RT_C_REFLECT) +
               vw_world_counter(w, RT_C_REFRACT) + vw_world_counter(w, RT_C_SHADOW);
+    /* VW_FAULT=bench-rays (tests): the last configuration taken as one ray more. */
+    if (last && vw_cli_fault("bench-rays")) c->rays++;
+    if (*ref_rays < 0)
+        *ref_rays = c->rays;
+    else if (c->rays != *ref_rays)
+        *bad_rays = 1;
     c->segments = vw_world_counter(w, RT_C_SEGMENTS);
     vw_traffic tr;
     vw_world_traffic(w, &tr); /* collective */
@@ -365,22 +376,24 @@ int vw_cmd_bench(int argc, char **argv)
     vw_progress_begin(&bar, "bench", quiet || !out ? VW_PROGRESS_OFF : VW_PROGRESS_AUTO);
     int64_t *ref = NULL;
     size_t nref = 0;
-    long long bad_pixel = -1;
-    int bad_conf = -1;
+    long long bad_pixel = -1, ref_rays = -1, bad_rays_count = 0;
+    int bad_conf = -1, bad_rays_conf = -1;
     /* A first render, not counted, pays what only the first render of a process pays
        (Embree's start, the first touch of the heap), which the first configuration
        would otherwise carry in round 1. */
     bench_config warm = conf[0];
     long long px0 = -1;
+    int rays0 = 0;
     vw_status st = run_one(scene, &cam, width, height, depth, farm, &warm, 0, 0, &ref, &nref, &px0,
-                           err, sizeof err);
+                           &ref_rays, &rays0, err, sizeof err);
     for (int r = 0; r < repeat && st == VW_OK; r++)
         for (int k = 0; k < nconf && st == VW_OK; k++) {
             long long px = -1;
+            int bad_rays = 0;
             st = run_one(scene, &cam, width, height, depth, farm, &conf[k], r, k == nconf - 1, &ref,
-                         &nref, &px,
-                         err, sizeof err);
+                         &nref, &px, &ref_rays, &bad_rays, err, sizeof err);
             if (px >= 0 && bad_conf < 0) bad_conf = k, bad_pixel = px;
+            if (bad_rays && bad_rays_conf < 0) bad_rays_conf = k, bad_rays_count = conf[k].rays;
             char note[64];
             snprintf(note, sizeof note, "round %d of %ld", r + 1, repeat);
             vw_progress_update(&bar, (double)(r * nconf + k + 1) / (double)(repeat * nconf), note);
@@ -482,6 +495,18 @@ int vw_cmd_bench(int argc, char **argv)
                 rc = VW_EXIT_FAIL;
             } else if (!quiet) {
                 printf("images: identical in all %d configurations (fixed-point pixel sums)\n", nconf);
+            }
+            if (bad_rays_conf >= 0) {
+                char name[64];
+                const bench_config *c = &conf[bad_rays_conf];
+                layout_name(c->dims, name, sizeof name);
+                vw_cli_error(CMD, "cells %s on %ld worker%s traced %lld rays, the first configuration "
+                                  "%lld (every layout and worker count must trace the same rays)",
+                             name, c->workers, c->workers == 1 ? "" : "s", bad_rays_count, ref_rays);
+                rc = VW_EXIT_FAIL;
+            } else if (!quiet) {
+                printf("rays: %lld in every configuration (eye, reflected, refracted and shadow "
+                       "rays: the same rays, so visits per ray compare)\n", ref_rays);
             }
             /* A failed run leaves no output, as every command's; the CSV and the stats
                appear together or not at all. */

@@ -37,7 +37,7 @@ for x in povray python3; do
     { echo "raytrace.sh: $x is needed (scripts/setup.sh bench installs it)" >&2; exit 1; }
 done
 
-# The scene: SPD "balls" (sphereflake, level 4: 7382 spheres, 3 lights).
+# The scene: SPD "balls" (sphereflake, level 4: 7381 spheres on a floor polygon, 3 lights).
 if "$VW" gen balls > "$T/balls.nff" 2>/dev/null; then :; else
   "$B/vw_test_raytrace" nff gen:balls:4 > "$T/balls.nff"
 fi

@@ -3,8 +3,9 @@
  * of cells and a number of workers) renders the same scene in each round, the rounds
  * interleaving the configurations so that a shared machine's drift in speed hits them
  * alike; the table gives each one's best times, its speedup and efficiency against the
- * first configuration, and what does not depend on the core count (the imbalance lambda
- * of the workers' busy time, ray-cell visits per ray, messages). Every configuration
+ * first configuration, the imbalance lambda of the workers' busy time (of the round whose
+ * compute time it gives), and what the machine's load does not change (ray-cell visits
+ * per ray, messages). Every configuration
  * must make the same image, bit for bit (the fixed-point pixel sums), by tracing the
  * same rays (which is what makes the rows' visits per ray comparable): the design's
  * promise, checked on every render; a difference is a failure (exit status 1).
@@ -33,10 +34,10 @@ static void help(void)
            "them alike. For each it prints the best build and compute times over the\n"
            "rounds, the speedup (compute, best of rounds; and the median of the ratios\n"
            "within each round) and the efficiency against the first configuration, the\n"
-           "imbalance lambda of the workers' busy time, ray-cell visits per ray and the\n"
-           "messages. Every configuration must render the same image, bit for bit, and\n"
-           "trace the same number of rays: a difference is reported and fails the command\n"
-           "(exit status 1).\n"
+           "imbalance lambda of the workers' busy time (in the round of the best compute\n"
+           "time), ray-cell visits per ray and the messages. Every configuration must\n"
+           "render the same image, bit for bit, and trace the same number of rays: a\n"
+           "difference is reported and fails the command (exit status 1).\n"
            "  SCENE            the scene (default: the generated sphereflake, vwalls gen\n"
            "                   balls: 7381 spheres on a floor polygon, 3 lights)\n"
            "  --cells LIST     comma-separated layouts (default 1,2x2x2)\n"
@@ -55,7 +56,8 @@ static void help(void)
            "Configurations: every layout with every worker count, in the order given; the\n"
            "first is the reference of the speedups (by default 1 cell on 1 worker). At most\n"
            "%d. Under mpirun every process runs its workers; the first process prints.\n"
-           "Timings depend on what else the machine runs; lambda and visits do not.\n"
+           "Timings, and lambda (a ratio of busy times), depend on what else the machine runs;\n"
+           "visits, rays and messages do not.\n"
            "\nexit status: 0 success, 2 bad input or usage, 1 any other failure (also: two\n"
            "configurations rendered different images or traced different numbers of rays)\n",
            MAX_ROUNDS, MAX_CONFIGS);
@@ -66,8 +68,10 @@ typedef struct bench_config {
     long workers;
     /* per round */
     double build[MAX_ROUNDS], compute[MAX_ROUNDS];
-    /* from the last round (the same every round but for timing) */
-    double lambda;
+    /* the imbalance of the workers' busy time: a timing too, so the table gives the one
+       of the round whose compute time it gives (the best) */
+    double lambda[MAX_ROUNDS];
+    /* from the last round (the same every round) */
     long long rays, segments;
     unsigned long long messages;
     int cells, copies, all_workers;
@@ -131,13 +135,16 @@ static void layout_name(const int dims[3], char *buf, size_t len)
     else snprintf(buf, len, "%d", dims[0]);
 }
 
-static double best(const double *v, int n)
+/* The round with the least v (the first of equals). */
+static int best_round(const double *v, int n)
 {
-    double b = v[0];
+    int b = 0;
     for (int i = 1; i < n; i++)
-        if (v[i] < b) b = v[i];
+        if (v[i] < v[b]) b = i;
     return b;
 }
+
+static double best(const double *v, int n) { return v[best_round(v, n)]; }
 
 static int cmp_double(const void *a, const void *b)
 {
@@ -200,7 +207,7 @@ static vw_status run_one(const vw_scene *scene, const vw_camera *cam, int width,
     c->build[round] = t1 - t0;
     c->compute[round] = t2 - t1;
     vw_world *w = rt_job_world(job);
-    c->lambda = vw_world_imbalance(w);
+    c->lambda[round] = vw_world_imbalance(w);
     c->rays = vw_world_counter(w, RT_C_EYE) + vw_world_counter(w, RT_C_REFLECT) +
               vw_world_counter(w, RT_C_REFRACT) + vw_world_counter(w, RT_C_SHADOW);
     /* VW_FAULT=bench-rays (tests): the last configuration taken as one ray more. */
@@ -448,13 +455,14 @@ int vw_cmd_bench(int argc, char **argv)
             double med = median_ratio(b->compute, c->compute, (int)repeat);
             double eff = c->all_workers > 0 ? speedup * b->all_workers / c->all_workers : 0;
             double visits = c->rays > 0 ? (double)c->segments / (double)c->rays : 0;
+            double lambda = c->lambda[best_round(c->compute, (int)repeat)];
             ok &= vw_cli_appendf(&table, &tl, &tc,
                                  "%-10s %5d %7d %6d %8.3f %9.3f %8.2f %7.2f %10.2f %7.3f %10.2f %9llu\n",
                                  name, c->cells, c->all_workers, c->copies, bb, cb, speedup, med, eff,
-                                 c->lambda, visits, c->messages);
+                                 lambda, visits, c->messages);
             ok &= vw_cli_appendf(&csvtext, &cl, &cc, "%s,%d,%d,%d,%.6f,%.6f,%.4f,%.4f,%.4f,%.4f,%.4f,%llu\n",
                                  name, c->cells, c->all_workers, c->copies, bb, cb, speedup, med, eff,
-                                 c->lambda, visits, c->messages);
+                                 lambda, visits, c->messages);
             if (js) {
                 char n[7][32];
                 jok = jok && vw_cli_appendf(&js, &jl, &jc,
@@ -465,10 +473,11 @@ int vw_cmd_bench(int argc, char **argv)
                     k ? "," : "", name, c->cells, c->all_workers, c->workers, c->copies,
                     vw_cli_json_number(bb, n[0]), vw_cli_json_number(cb, n[1]),
                     vw_cli_json_number(speedup, n[2]), vw_cli_json_number(med, n[3]),
-                    vw_cli_json_number(eff, n[4]), vw_cli_json_number(c->lambda, n[5]), c->rays,
+                    vw_cli_json_number(eff, n[4]), vw_cli_json_number(lambda, n[5]), c->rays,
                     c->segments, vw_cli_json_number(visits, n[6]), c->messages);
                 jok = jok && rounds_json(&js, &jl, &jc, "build_rounds_s", c->build, (int)repeat);
                 jok = jok && rounds_json(&js, &jl, &jc, "compute_rounds_s", c->compute, (int)repeat);
+                jok = jok && rounds_json(&js, &jl, &jc, "imbalance_rounds", c->lambda, (int)repeat);
                 jok = jok && vw_cli_appendf(&js, &jl, &jc, "}");
             }
         }

@@ -66,3 +66,10 @@ add_test(NAME balance_slowest
          COMMAND sh ${PROJECT_SOURCE_DIR}/tests/balance/slowest.sh $<TARGET_FILE:vwalls_tool>
                  ${CMAKE_CURRENT_BINARY_DIR}/balance_slowest)
 set_tests_properties(balance_slowest PROPERTIES LABELS "balance" TIMEOUT 120)
+
+# Tensor and staggered cut each cell at its worker's share of the load where the mapping
+# gives the workers unequal numbers of cells (3 on 2 workers, 4 on 3): equal cells left
+# lambda at 4/3 and 3/2 whatever the load.
+add_test(NAME balance_shares COMMAND vw_test_balance shares)
+set_tests_properties(balance_shares PROPERTIES LABELS "balance;threads" ENVIRONMENT "${VW_BAL_TSAN}")
+

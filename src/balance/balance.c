@@ -191,6 +191,63 @@ static vw_status balance_duplicate(vw_world *w, const double *load, const vw_bal
     return st;
 }
 
+/* Tensor, rotate and staggered cut cells of equal load, which balances the workers only
+   when each gets as many cells (at equal speeds). Where the mapping *nd got (map) puts
+   unequal numbers on them (3 cells on 2 workers: 2 and 1; 4 on 3; a block mapping of 8
+   on 6), or their speeds differ, lambda stayed at the busiest worker's cells over the
+   mean (4/3 for 3 cells on 2 workers, 3/2 for 4 on 3) whatever the load. So the layout is
+   also cut with each cell's share of the load its worker's (its speed, by the number of
+   cells it holds) and mapped the same way; it replaces *nd (with its loads, mapping and
+   *lam) when its predicted lambda is lower. In a rotated frame the walls are cut again
+   in that frame. Kinds other than a grid or a staggered tree (tensor keeping a layout it
+   cannot cut) are left as they are. */
+static vw_status shaped(vw_world *w, const vw_load_field *f, const vw_balance_params *p,
+                        vw_map_kind mk, const double *speeds, vw_decomp **nd, double *load,
+                        int *map, double *lam)
+{
+    vw_decomp_kind kind = vw_decomp_get_kind(*nd);
+    int want = p->strategy == VW_BALANCE_STAGGERED ? VW_DECOMP_STAGGERED : VW_DECOMP_GRID;
+    if ((int)kind != want) return VW_OK;
+    int dims[3];
+    if (kind == VW_DECOMP_STAGGERED)
+        staggered_dims(*nd, dims);
+    else
+        vw_decomp_dims(*nd, dims);
+    int nc = vw_decomp_cell_count(*nd), gw = w->gworkers;
+    if ((long)dims[0] * dims[1] * dims[2] != nc || nc < 2) return VW_OK;
+    int *held = calloc((size_t)gw, sizeof *held);
+    double *share = malloc(sizeof(double) * (size_t)nc);
+    double *load2 = malloc(sizeof(double) * VW_MAX_CELLS);
+    int *map2 = malloc(sizeof(int) * VW_MAX_CELLS);
+    vw_decomp *d2 = NULL;
+    vw_status st = held && share && load2 && map2 ? VW_OK : VW_E_NOMEM;
+    int equal = 1;
+    for (int c = 0; st == VW_OK && c < nc; c++)
+        if (map[c] >= 0 && map[c] < gw) held[map[c]]++;
+    for (int c = 0; st == VW_OK && c < nc; c++) {
+        int g = map[c] >= 0 && map[c] < gw ? map[c] : 0;
+        share[c] = (speeds ? speeds[g] : 1.0) / (held[g] > 0 ? held[g] : 1);
+        equal &= share[c] == share[0];
+    }
+    if (st == VW_OK && !equal) st = vw__balance_shaped(*nd, f, p, dims, kind, share, &d2);
+    if (st == VW_OK && d2) {
+        vw_load_field_cell_loads(f, d2, load2);
+        st = vw_map_compute(mk, d2, load2, w->nprocs, w->nworkers, speeds, map2);
+        double lam2 = st == VW_OK ? vw_balance_imbalance(load2, map2, nc, gw, speeds) : 0;
+        if (st == VW_OK && lam2 < *lam - 1e-9) {
+            vw_decomp_free(*nd);
+            *nd = d2;
+            d2 = NULL;
+            memcpy(load, load2, sizeof(double) * (size_t)nc);
+            memcpy(map, map2, sizeof(int) * (size_t)nc);
+            *lam = lam2;
+        }
+    }
+    vw_decomp_free(d2);
+    free(held), free(share), free(load2), free(map2);
+    return st;
+}
+
 vw_status vw_balance_world(vw_world *w, const vw_load_field *f, const vw_balance_params *p,
                            const vw_balance_apply *a, vw_balance_report *rep)
 {
@@ -250,8 +307,13 @@ vw_status vw_balance_world(vw_world *w, const vw_load_field *f, const vw_balance
             st = vw_map_compute(mk, nd, load, w->nprocs, w->nworkers, speeds, map);
         }
     }
+    double lam = st == VW_OK ? vw_balance_imbalance(load, map, nc, w->gworkers, speeds) : 0;
+    if (st == VW_OK && p->strategy != VW_BALANCE_DIVIDE) {
+        vw_map_kind mk = a ? (vw_map_kind)a->map : VW_MAP_BLOCK;
+        st = shaped(w, f, &pp, mk, speeds, &nd, load, map, &lam);
+    }
     if (st == VW_OK) {
-        r.imbalance_predicted = vw_balance_imbalance(load, map, nc, w->gworkers, speeds);
+        r.imbalance_predicted = lam;
         r.cells = nc;
         r.max_neighbours = vw_decomp_max_neighbours(nd);
         /* Does it pay? The expected gain is the part of the last compute time the

@@ -32,11 +32,18 @@ long vw__field_points(const vw_load_field *f, const double *F, vw__lpt **out);
    keeps the walls it has), else 1. Reorders pts (sorted along axis). */
 int vw__cut(vw__lpt *pts, long n, int axis, double lo, double hi, int parts, double minw,
             double *walls);
+/* vw__cut with the pieces' shares of the load: piece k gets share[k] / (sum of the
+   shares) of it (share NULL: equal pieces, vw__cut). */
+int vw__cut_shares(vw__lpt *pts, long n, int axis, double lo, double hi, int parts,
+                   const double *share, double minw, double *walls);
 
 /* Tensor walls in frame F over world box (frame coordinates) wb: walls[a] dims[a]-1.
-   *fits 0 when some axis of wb is too thin for its cells (vw__cut). */
+   *fits 0 when some axis of wb is too thin for its cells (vw__cut). share: NULL (every
+   cell an equal load), or each cell's wanted share of the load (dims[0] * dims[1] *
+   dims[2] entries, cell i + nx (j + ny k)); a slab's share is the sum of its cells'. */
 vw_status vw__tensor_walls(const vw_load_field *f, const double *F, const vw_box *wb,
-                           const int dims[3], double minw_frac, double *walls[3], int *fits);
+                           const int dims[3], double minw_frac, const double *share,
+                           double *walls[3], int *fits);
 
 vw_status vw__balance_tensor(const vw_decomp *cur, const vw_load_field *f,
                              const vw_balance_params *p, const int dims[3], vw_decomp **out);
@@ -44,6 +51,20 @@ vw_status vw__balance_rotate(const vw_decomp *cur, const vw_load_field *f,
                              const vw_balance_params *p, const int dims[3], vw_decomp **out);
 vw_status vw__balance_staggered(const vw_decomp *cur, const vw_load_field *f,
                                 const vw_balance_params *p, const int dims[3], vw_decomp **out);
+/* Tensor walls (kind VW_DECOMP_GRID: in cur's frame, over its world box) or a staggered
+   decomposition (VW_DECOMP_STAGGERED) of dims whose cells get the shares of the load in
+   share (as vw__tensor_walls), not equal ones: the mapping puts unequal numbers of cells
+   on the workers (3 cells on 2 workers, 4 on 3) or the workers' speeds differ, and equal
+   cells then leave lambda at (cells on the busiest worker) / (cells / workers). *out is
+   NULL (VW_OK) where the walls do not fit (cells a few doubles wide). */
+vw_status vw__balance_shaped(const vw_decomp *cur, const vw_load_field *f,
+                             const vw_balance_params *p, const int dims[3], vw_decomp_kind kind,
+                             const double *share, vw_decomp **out);
+/* The staggered half of vw__balance_shaped (staggered.c): slabs, columns and cells at
+   their shares' quantiles; *out NULL where they do not fit. */
+vw_status vw__staggered_shaped(const vw_decomp *cur, const vw_load_field *f,
+                               const vw_balance_params *p, const int dims[3],
+                               const double *share, vw_decomp **out);
 /* Duplication plan on the current cells (load per cell, its master's worker): npairs
    copies (pair_cell[i] gets a copy on pair_worker[i]; arrays of max_extra entries) and
    the predicted lambda with each cell's load shared by its copies in proportion to

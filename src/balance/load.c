@@ -277,7 +277,18 @@ static int clamp_walls(double *walls, int parts, double lo, double hi, double mi
 int vw__cut(vw__lpt *pts, long n, int axis, double lo, double hi, int parts, double minw,
             double *walls)
 {
+    return vw__cut_shares(pts, n, axis, lo, hi, parts, NULL, minw, walls);
+}
+
+int vw__cut_shares(vw__lpt *pts, long n, int axis, double lo, double hi, int parts,
+                   const double *share, double minw, double *walls)
+{
     if (parts < 2) return 1;
+    /* The pieces' shares of the load, as fractions of their sum (equal without them, or
+       when they sum to no positive number). */
+    double ssum = 0;
+    for (int k = 0; share && k < parts; k++) ssum += share[k] > 0 ? share[k] : 0;
+    if (!(ssum > 0) || !isfinite(ssum)) share = NULL;
     if (n > 1) qsort(pts, (size_t)n, sizeof *pts, axis == 0 ? cmp_x : axis == 1 ? cmp_y : cmp_z);
     /* Points with equal coordinates form one group (a cell's k x k sub-grid points share
        their x): each group's mass is spread evenly between the midpoints to the groups
@@ -296,11 +307,14 @@ int vw__cut(vw__lpt *pts, long n, int axis, double lo, double hi, int parts, dou
         total += pts[i].w;
     }
     long i = 0;
-    double cum = 0;
+    double cum = 0, before = 0; /* before: the shares of the pieces below wall k */
     for (int k = 1; k < parts; k++) {
-        double target = total * k / parts, x;
+        before += share ? (share[k - 1] > 0 ? share[k - 1] : 0) / ssum : 1.0 / parts;
+        double frac = fmin(1.0, before);
+        double target = share ? total * frac : total * k / parts, x;
         if (!(total > 0) || !gx || !gw) {
-            x = lo + (hi - lo) * k / parts; /* no load known here: equal widths */
+            /* no load known here: widths in proportion to the shares */
+            x = share ? lo + (hi - lo) * frac : lo + (hi - lo) * k / parts;
         } else {
             while (i < ng && cum + gw[i] < target) cum += gw[i++];
             if (i >= ng) i = ng - 1, cum = total - gw[i];

@@ -5,7 +5,9 @@
  *
  * Tensor keeps a grid a grid: every cell keeps exactly one neighbour per face, because
  * a wall is moved as a whole. Per axis, the walls go where the marginal load (the load
- * projected onto that axis) splits into equal slabs; load that is concentrated in one
+ * projected onto that axis) splits into equal slabs (or, where the workers hold unequal
+ * numbers of cells or differ in speed, slabs at their cells' shares: vw__balance_shaped,
+ * chosen by vw_balance_world); load that is concentrated in one
  * corner therefore cannot be evened out per cell, which is what rotation and the
  * staggered balancer improve on.
  */
@@ -17,18 +19,36 @@
 #include <string.h>
 
 vw_status vw__tensor_walls(const vw_load_field *f, const double *F, const vw_box *wb,
-                           const int dims[3], double minw_frac, double *walls[3], int *fits)
+                           const int dims[3], double minw_frac, const double *share,
+                           double *walls[3], int *fits)
 {
     vw__lpt *pts;
     *fits = 1;
     long n = vw__field_points(f, F, &pts);
     if (n < 0) return VW_E_NOMEM;
+    double *slab = NULL;
+    if (share) {
+        int most = dims[0] > dims[1] ? dims[0] : dims[1];
+        most = most > dims[2] ? most : dims[2];
+        if (!(slab = malloc(sizeof(double) * (size_t)most))) {
+            free(pts);
+            return VW_E_NOMEM;
+        }
+    }
     for (int a = 0; a < 3; a++) {
         if (dims[a] < 2) continue;
+        /* A slab's share: its cells' (the wall is one for the whole slab). */
+        for (int i = 0; slab && i < dims[a]; i++) slab[i] = 0;
+        for (long c = 0; slab && c < (long)dims[0] * dims[1] * dims[2]; c++) {
+            long ix[3] = {c % dims[0], (c / dims[0]) % dims[1], c / ((long)dims[0] * dims[1])};
+            slab[ix[a]] += share[c];
+        }
         double ext = wb->hi[a] - wb->lo[a];
-        if (!vw__cut(pts, n, a, wb->lo[a], wb->hi[a], dims[a], minw_frac * ext, walls[a]))
+        if (!vw__cut_shares(pts, n, a, wb->lo[a], wb->hi[a], dims[a], slab, minw_frac * ext,
+                            walls[a]))
             *fits = 0;
     }
+    free(slab);
     free(pts);
     return VW_OK;
 }
@@ -36,7 +56,8 @@ vw_status vw__tensor_walls(const vw_load_field *f, const double *F, const vw_box
 /* The tensor walls in frame F over wb as a grid; *out NULL (and VW_OK) when they do not
    fit: wb is too thin on some axis for its cells at the resolution of the doubles. */
 static vw_status tensor_in_frame(const vw_load_field *f, const double *F, const vw_box *wb,
-                                 const int dims[3], double minw, vw_decomp **out)
+                                 const int dims[3], double minw, const double *share,
+                                 vw_decomp **out)
 {
     double *walls[3] = {0};
     vw_status st = VW_OK;
@@ -46,7 +67,7 @@ static vw_status tensor_in_frame(const vw_load_field *f, const double *F, const 
         walls[a] = malloc(sizeof(double) * (size_t)(dims[a] > 1 ? dims[a] - 1 : 1));
         if (!walls[a]) st = VW_E_NOMEM;
     }
-    if (st == VW_OK) st = vw__tensor_walls(f, F, wb, dims, minw, walls, &fits);
+    if (st == VW_OK) st = vw__tensor_walls(f, F, wb, dims, minw, share, walls, &fits);
     if (st == VW_OK && fits) {
         const double *cw[3] = {walls[0], walls[1], walls[2]};
         st = vw_decomp_create_grid_walls(wb, dims, cw, F, out);
@@ -70,10 +91,20 @@ vw_status vw__balance_tensor(const vw_decomp *cur, const vw_load_field *f,
                              const vw_balance_params *p, const int dims[3], vw_decomp **out)
 {
     vw_box wb = vw_decomp_world(cur);
-    vw_status st = tensor_in_frame(f, vw_decomp_frame(cur), &wb, dims, p->min_width, out);
+    vw_status st = tensor_in_frame(f, vw_decomp_frame(cur), &wb, dims, p->min_width, NULL, out);
     /* Walls that cannot be moved are kept: a balancer that cannot improve is no error. */
     if (st == VW_OK && !*out) st = vw_decomp_clone(cur, out);
     return st;
+}
+
+vw_status vw__balance_shaped(const vw_decomp *cur, const vw_load_field *f,
+                             const vw_balance_params *p, const int dims[3], vw_decomp_kind kind,
+                             const double *share, vw_decomp **out)
+{
+    *out = NULL;
+    if (kind == VW_DECOMP_STAGGERED) return vw__staggered_shaped(cur, f, p, dims, share, out);
+    vw_box wb = vw_decomp_world(cur);
+    return tensor_in_frame(f, vw_decomp_frame(cur), &wb, dims, p->min_width, share, out);
 }
 
 /* Eigen-decomposition of a symmetric 3x3 matrix by Jacobi rotations: columns of V are
@@ -245,7 +276,7 @@ vw_status vw__balance_rotate(const vw_decomp *cur, const vw_load_field *f,
                 wb.hi[a] += pad;
             }
             vw_decomp *d = NULL;
-            st = tensor_in_frame(f, F, &wb, dims, p->min_width, &d);
+            st = tensor_in_frame(f, F, &wb, dims, p->min_width, NULL, &d);
             if (st != VW_OK) break;
             if (!d) continue; /* too thin in this frame for its cells: not a candidate */
             double lam = cells_lambda(f, d, p, ld, map);

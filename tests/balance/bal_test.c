@@ -9,6 +9,9 @@
  *   staggered8            staggered on 2x2x2 keeps 2 slabs x 2 columns x 2 cells round
  *                         after round, and reaches lambda <= 1.30, below tensor's, on the
  *                         counted work of a 50%-clustered 1000-sphere scene
+ *   shares                tensor and staggered with unequal numbers of cells a worker
+ *                         (3x1x1 on 2 workers, 2x2x1 on 3): lambda of counted work <= 1.25,
+ *                         below what equal cells allow (4/3, 3/2); the sums unchanged
  *   divide16              divide (with its extra rounds) reaches lambda <= 1.06 on the
  *                         counted work of a 100%-clustered 1000-sphere scene, 16 cells
  *   rotate                the principal-axis frame of an oblique line of load is the line;
@@ -418,6 +421,52 @@ static int t_staggered8(void)
        hot spot within one cell can be split.) */
     EXPECT(lam[2] <= 1.30, "staggered lambda %.3f > 1.30 (none: %.3f)", lam[2], lam[0]);
     EXPECT(lam[2] < lam[1], "staggered lambda %.3f not below tensor's %.3f", lam[2], lam[1]);
+    vw_scene_free(s);
+    return vw_test_failures ? 1 : 0;
+}
+
+/* ---- shares: cells of unequal load where the workers hold unequal numbers of cells ----- */
+
+/* Tensor and staggered cut cells of equal load. With 3 cells on 2 workers (block: 2 and
+   1) or 4 on 3 (2, 1, 1), equal cells leave lambda at 4/3 and 3/2 whatever the load; cut
+   at each worker's share (its cells get half, or a third, of the load between them) they
+   balance the workers. Uniform 1000 spheres, 128x128, counted work; the sums stay the
+   unbalanced render's. */
+static int t_shares(void)
+{
+    vw_scene *s = load_scene("spheres:0:1");
+    static const struct {
+        int dims[3], workers;
+        double bound; /* lambda of equal cells on this mapping */
+    } cases[] = {{{3, 1, 1}, 2, 4.0 / 3}, {{2, 2, 1}, 3, 1.5}};
+    static const vw_balance_strategy strat[2] = {VW_BALANCE_TENSOR, VW_BALANCE_STAGGERED};
+    for (size_t k = 0; k < sizeof cases / sizeof *cases; k++) {
+        const int *dims = cases[k].dims;
+        int one[3] = {1, 1, 1};
+        int64_t *ref = render(s, 128, 128, one, 1, NULL, NULL);
+        rt_job *j0;
+        int64_t *plain = render(s, 128, 128, dims, cases[k].workers, NULL, &j0);
+        double lam0 = rt_job_work_imbalance(j0, NULL);
+        rt_job_free(j0);
+        free(plain);
+        for (int si = 0; si < 2; si++) {
+            rt_balance b;
+            balance_spec(&b, strat[si]);
+            rt_job *j;
+            int64_t *sums = render(s, 128, 128, dims, cases[k].workers, &b, &j);
+            double lam = rt_job_work_imbalance(j, NULL);
+            printf("shares: %dx%dx%d on %d workers, %s: work lambda %.3f (none %.3f, equal "
+                   "cells at best %.3f)\n", dims[0], dims[1], dims[2], cases[k].workers,
+                   vw_balance_strategy_name(strat[si]), lam, lam0, cases[k].bound);
+            EXPECT(lam <= 1.25, "%dx%dx%d on %d workers, %s: lambda %.3f > 1.25", dims[0],
+                   dims[1], dims[2], cases[k].workers, vw_balance_strategy_name(strat[si]), lam);
+            EXPECT(!memcmp(sums, ref, sizeof(int64_t) * 128 * 128 * 3), "%s: sums differ",
+                   vw_balance_strategy_name(strat[si]));
+            free(sums);
+            rt_job_free(j);
+        }
+        free(ref);
+    }
     vw_scene_free(s);
     return vw_test_failures ? 1 : 0;
 }
@@ -1589,7 +1638,7 @@ static int t_divide_rounds_render(void)
 int main(int argc, char **argv)
 {
     if (argc < 2) {
-        fprintf(stderr, "usage: bal_test identical|conserve|staggered8|divide16|rotate|map|duplicate|field|concurrent|thin|divide_thin|divide_hot|divide_stop|divide_rounds|divide_rounds_render [...]\n");
+        fprintf(stderr, "usage: bal_test identical|conserve|staggered8|divide16|rotate|map|duplicate|field|concurrent|thin|divide_thin|divide_hot|divide_stop|divide_rounds|divide_rounds_render|shares [...]\n");
         return 2;
     }
     const char *cmd = argv[1];
@@ -1598,6 +1647,7 @@ int main(int argc, char **argv)
     if (!strcmp(cmd, "staggered8")) return t_staggered8();
     if (!strcmp(cmd, "rotate")) return t_rotate();
     if (!strcmp(cmd, "divide16")) return t_divide16();
+    if (!strcmp(cmd, "shares")) return t_shares();
     if (!strcmp(cmd, "map")) return t_map();
     if (!strcmp(cmd, "duplicate")) return t_duplicate();
     if (!strcmp(cmd, "field")) return t_field();

@@ -41,13 +41,18 @@ VW_API void vw_map_dims(int n, const int cells[3], int dims[3]);
 /* Block mapping: a grid decomposition is cut into nprocs blocks (process grid matched
    to the cell grid) and each block into wpp worker blocks, so that most neighbour
    traffic stays inside a worker, then inside a process. Non-grid decompositions are
-   mapped in kd-tree leaf order (cells close in the tree are close in space). */
+   mapped in kd-tree leaf order (cells close in the tree are close in space). No worker
+   gets more than ceil(cells / workers) cells, no process more than ceil(cells /
+   nprocs), and every worker gets one when there are as many cells as workers: where
+   no blocks are that even, runs of the grid's leaf order instead. */
 VW_API vw_status vw_map_block(const vw_decomp *d, int nprocs, int wpp, int *cell_worker);
 
 /* Greedy (over-decomposition): cells sorted by load, longest first, each to the worker
    that finishes it first (load / speed); among workers within `slack` (relative) of the
    best, one already hosting a face neighbour is preferred. speeds NULL = all equal;
-   VW_E_INVAL for a speed that is not positive and finite, or a negative slack. */
+   VW_E_INVAL for a speed that is not positive and finite, or a negative slack. A load
+   that is not a positive number (0, negative, NaN) counts as none; cell_load NULL, or
+   no cell with a load, counts every cell alike (1 each). */
 VW_API vw_status vw_map_greedy(const vw_decomp *d, const double *cell_load, int gworkers,
                                const double *speeds, double slack, int *cell_worker);
 
@@ -77,9 +82,10 @@ VW_API vw_status vw_world_remap(vw_world *w, const int *cell_worker);
    and inside its machine (messages and bytes, from the runtime's counters by
    destination class) since the last vw_world_reset_stats. Only messages sent count:
    work a module does in a cell of its own worker through vw_ctx_enter is no message
-   (the ray tracer hands every ray on that way, so its msgs_worker stays 0 unless
-   VW_STRESS refuses hand-offs). VW_E_INVAL when out is NULL, VW_E_NOMEM for the table
-   of machines, VW_E_MPI as vw_world_machines. Collective under MPI, and ends in
+   (the ray tracer hands a ray on that way as it crosses a wall, so its msgs_worker is
+   only the few rays spawned in a cell whose walk starts in another cell of the same
+   worker, which it sends, unless VW_STRESS refuses hand-offs). VW_E_INVAL when out is
+   NULL, VW_E_NOMEM for the table of machines, VW_E_MPI as vw_world_machines. Collective under MPI, and ends in
    agreement like a step of the world's life (world.h): a failure on one process only
    (out NULL there, no memory there) fails the call on every process with the lowest
    failing one's status, vw_world_errmsg saying "rank R: <its message>" everywhere, and

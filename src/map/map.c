@@ -112,24 +112,39 @@ static long largest_block(const int cells[3], const int d[3])
     return m;
 }
 
+/* The smallest block of the same cut (0 as above). */
+static long smallest_block(const int cells[3], const int d[3])
+{
+    long m = 1;
+    for (int a = 0; a < 3; a++) {
+        if (d[a] > cells[a]) return 0;
+        m *= cells[a] / d[a];
+    }
+    return m;
+}
+
 /* The parts a side for n blocks of the cells: of the factorisations whose largest block is
-   the fewest cells n blocks can have (ceil(cells / n)), the one cutting fewest faces
-   (vw_map_dims' choice wherever n divides the cells evenly). 0 when no factorisation is
-   that even: a prime n over sides shorter than it, or uneven sides (8 cells 2x2x2 on 3
-   workers were 4, 4, 0; 3x3x3 on 4 were 12, 6, 6, 3); the caller cuts runs instead. */
-static int even_dims(int n, const int cells[3], int dims[3])
+   the fewest cells n blocks can have (ceil(cells / n)) and whose smallest block has at
+   least `least` cells, the one cutting fewest faces (vw_map_dims' choice wherever n
+   divides the cells evenly). 0 when no factorisation is that even: a prime n over sides
+   shorter than it, or uneven sides (8 cells 2x2x2 on 3 workers were 4, 4, 0; 3x3x3 on 4
+   were 12, 6, 6, 3); the caller cuts runs instead. `least` is what the next level
+   needs: a process block with fewer cells than the process has workers leaves one of
+   them without a cell (2x5x1 on 3 processes of 3 workers were blocks of 4, 4 and 2
+   cells, and worker 8 had none where runs give every worker one or two). */
+static int even_dims(int n, const int cells[3], long least, int dims[3])
 {
     long total = (long)cells[0] * cells[1] * cells[2];
     long want = (total + n - 1) / n;
     vw_map_dims(n, cells, dims);
-    if (largest_block(cells, dims) == want) return 1;
+    if (largest_block(cells, dims) == want && smallest_block(cells, dims) >= least) return 1;
     double best = INFINITY;
     for (int a = 1; a <= n; a++) {
         if (n % a) continue;
         for (int b = 1; b <= n / a; b++) {
             if ((n / a) % b) continue;
             int d[3] = {a, b, n / a / b};
-            if (largest_block(cells, d) != want) continue;
+            if (largest_block(cells, d) != want || smallest_block(cells, d) < least) continue;
             double score = 0;
             for (int x = 0; x < 3; x++)
                 score += (d[x] - 1) * (double)cells[(x + 1) % 3] * cells[(x + 2) % 3];
@@ -168,10 +183,11 @@ vw_status vw_map_block(const vw_decomp *d, int nprocs, int wpp, int *cell_worker
     vw_decomp_dims(d, cells);
     /* Blocks as even as runs would be, or runs: a block mapping that left workers empty
        and others with twice the mean was worse than the plain one, and a balancer whose
-       walls it mapped was refused for it (tensor on 2x2x2 and 3 workers). The runs are
+       walls it mapped was refused for it (tensor on 2x2x2 and 3 workers). Every process
+       block holds a cell for each of its workers when the grid has enough. The runs are
        of the grid's leaf order, so each is a slab or part of one. */
     int zero[3] = {0, 0, 0};
-    if (!even_dims(nprocs, cells, pd)) {
+    if (!even_dims(nprocs, cells, nc >= g ? wpp : 1, pd)) {
         for (int c = 0; c < nc; c++) {
             int ix[3] = {c % cells[0], (c / cells[0]) % cells[1], c / (cells[0] * cells[1])};
             cell_worker[c] = (int)(block_rank(ix, zero, cells) * g / nc);
@@ -189,7 +205,7 @@ vw_status vw_map_block(const vw_decomp *d, int nprocs, int wpp, int *cell_worker
             sub[a] = hi[a] - lo[a];
         }
         int proc = pb[0] + pd[0] * (pb[1] + pd[1] * pb[2]), local;
-        if (even_dims(wpp, sub, wd)) {
+        if (even_dims(wpp, sub, 1, wd)) {
             for (int a = 0; a < 3; a++)
                 wb[a] = (int)((long)(ix[a] - lo[a]) * wd[a] / (sub[a] ? sub[a] : 1));
             local = wb[0] + wd[0] * (wb[1] + wd[1] * wb[2]);
@@ -236,26 +252,32 @@ vw_status vw_map_greedy(const vw_decomp *d, const double *cell_load, int gworker
     }
     int nc = vw_decomp_cell_count(d);
     ranked_cell *order = malloc(sizeof *order * (size_t)nc);
-    double *ones = NULL, *t = calloc((size_t)gworkers, sizeof *t);
-    if (!cell_load) {
-        ones = malloc(sizeof(double) * (size_t)nc);
-        if (ones)
-            for (int c = 0; c < nc; c++) ones[c] = 1.0;
-        cell_load = ones;
-    }
-    if (!order || !t || !cell_load) {
-        free(order), free(t), free(ones);
+    double *t = calloc((size_t)gworkers, sizeof *t);
+    if (!order || !t) {
+        free(order), free(t);
         return VW_E_NOMEM;
     }
+    /* Cells are placed and sorted by the same load: a load that is not a positive number
+       (0, negative, NaN) counts as none. Sorted by the given loads, a NaN compared
+       unordered with every other, qsort's order was no longer by load, and longest
+       first was lost: 8x8 cells on 4 workers, with NaN for the loads of 13 cells, got
+       up to 78 where the same loads with 0 for them get at most 76. And where no cell
+       has a load (a pre-pass that counted nothing) the cells count alike, as with no
+       loads (NULL): with no load to go by, every worker was as good as any and the
+       neighbours alone placed the cells, all 64 on one worker of 4. */
+    int loaded = 0;
     for (int c = 0; c < nc; c++) {
-        order[c] = (ranked_cell){cell_load[c], c};
+        double l = !cell_load ? 1.0 : cell_load[c] > 0 ? cell_load[c] : 0.0;
+        order[c] = (ranked_cell){l, c};
+        loaded |= l > 0;
         cell_worker[c] = -1;
     }
+    for (int c = 0; !loaded && c < nc; c++) order[c].load = 1.0;
     qsort(order, (size_t)nc, sizeof *order, cmp_load_desc);
     int nb[64];
     for (int i = 0; i < nc; i++) {
         int c = order[i].cell;
-        double l = cell_load[c] > 0 ? cell_load[c] : 0;
+        double l = order[i].load;
         /* Longest processing time first: the worker that would finish this cell first. */
         double best = INFINITY;
         for (int g = 0; g < gworkers; g++) {
@@ -283,7 +305,7 @@ vw_status vw_map_greedy(const vw_decomp *d, const double *cell_load, int gworker
         cell_worker[c] = pick;
         t[pick] += l;
     }
-    free(order), free(t), free(ones);
+    free(order), free(t);
     return VW_OK;
 }
 

@@ -54,3 +54,10 @@ add_test(NAME dynamic_cli_shown
          COMMAND sh ${PROJECT_SOURCE_DIR}/tests/dynamic/cli_shown.sh $<TARGET_FILE:vwalls_tool>
                  ${CMAKE_CURRENT_BINARY_DIR}/dynamic_cli_shown)
 set_tests_properties(dynamic_cli_shown PROPERTIES TIMEOUT 60)
+
+# A frame that would replace an input (the script, the scene or a material library through
+# a link) is refused before any frame; vwalls edit goes on after a frame it cannot write.
+add_test(NAME dynamic_anim_inputs
+         COMMAND sh ${PROJECT_SOURCE_DIR}/tests/dynamic/anim_inputs.sh $<TARGET_FILE:vwalls_tool>
+                 ${CMAKE_CURRENT_BINARY_DIR}/dynamic_anim_inputs)
+set_tests_properties(dynamic_anim_inputs PROPERTIES TIMEOUT 120)

@@ -5,6 +5,7 @@
  */
 #define _POSIX_C_SOURCE 200809L
 #include <errno.h>
+#include <limits.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -48,6 +49,7 @@ struct vw_anim_session {
     size_t total_acc, total_coll, total_sweep, total_invalid;
     int frame, failed;           /* failed: 2 bad input, 1 other */
     int bad_lines;               /* lines refused (parsed or applied): exit status 2 */
+    int frame_errors;            /* vwalls edit's frames not written: exit status 1 */
     frame_rec *frames;
     size_t nframes, capframes;
 };
@@ -188,6 +190,14 @@ static int do_frame(vw_anim_session *s)
        edit's collective calls forever. */
     if (vw_engine_agree(wst, err, sizeof err) != VW_OK) {
         vw_cli_error(s->cmd, "%s", err);
+        /* vwalls edit goes on (every process knows, from the agreement): the session's
+           edits are not lost for a frame its user can make room for (a directory removed
+           since the start, a full disk); the number is not used, so the next 'frame'
+           writes it, and the exit status is 1. */
+        if (s->interactive) {
+            s->frame_errors++;
+            return 0;
+        }
         return s->failed = 1;
     }
     frame_rec *f = &s->frames[s->nframes++];
@@ -511,6 +521,84 @@ static int precheck(vw_anim_session *s, const edits_src *ed)
     return bad;
 }
 
+/* The number of 'frame' lines of the script (those that parse): the frames a run can
+   write. */
+static long script_frames(const vw_anim_session *s, const edits_src *ed)
+{
+    long n = 0;
+    int lineno = 0;
+    for (size_t pos = 0; ed->text && pos < ed->len;) {
+        const char *p = ed->text + pos, *nl = memchr(p, '\n', ed->len - pos);
+        const char *end = nl ? nl + 1 : ed->text + ed->len;
+        pos = (size_t)(end - ed->text);
+        while (p < end) {
+            const char *q = piece_end(p, end);
+            vw_edit e;
+            char err[8];
+            if (!memchr(p, '\0', (size_t)(q - p)) &&
+                vw_edit_parse(p, s->name, ++lineno, &e, err, sizeof err) == VW_OK && e.op == VW_EDIT_FRAME)
+                n++;
+            p = q + 1;
+        }
+    }
+    return n;
+}
+
+/* Would a frame replace one of the inputs (the scene, its material libraries, animate's
+   EDITS)? That is a usage error found before the work, like an output that names an
+   input (vw_cli_check_files, which sees -o as a pattern, not as its frames): with -o
+   'e%d.png' the script e1.png was replaced at frame 1, and a frame name that is a link
+   to the scene replaced the scene. Compared by device and inode: the frames 0 to
+   nframes-1 (the script's; vwalls edit's are not known in advance), and the frame whose
+   number an input's name holds (vw_cli_frame_file). VW_EXIT_OK, or VW_EXIT_USAGE on
+   every process with the message printed once (inputs NULL: out of memory, VW_EXIT_FAIL).
+   Collective under MPI. */
+static int frames_spare_inputs(const char *cmd, const char *pattern, const char *const *inputs,
+                               int nin, long nframes)
+{
+    char err[1024] = "";
+    vw_status st = VW_OK;
+    if (!inputs) { /* no room for their list */
+        snprintf(err, sizeof err, "%s", vw_status_message(VW_E_NOMEM));
+        st = VW_E_NOMEM;
+    } else if (pattern && vw_cli_is_output()) {
+        struct stat *in = calloc((size_t)nin + 1, sizeof *in);
+        int *ok = calloc((size_t)nin + 1, sizeof *ok);
+        if (!in || !ok) {
+            snprintf(err, sizeof err, "%s", vw_status_message(VW_E_NOMEM));
+            st = VW_E_NOMEM;
+        }
+        for (int k = 0; st == VW_OK && k < nin; k++)
+            ok[k] = inputs[k] && stat(inputs[k], &in[k]) == 0 && S_ISREG(in[k].st_mode);
+        for (int k = 0; st == VW_OK && k < nin; k++) {
+            int frame;
+            if (ok[k] && vw_cli_frame_file(pattern, inputs[k], &frame)) {
+                snprintf(err, sizeof err, "-o %s: frame %d is the input file %s: it would be overwritten",
+                         pattern, frame, inputs[k]);
+                st = VW_E_INPUT;
+            }
+        }
+        for (long f = 0; st == VW_OK && f < nframes && f <= INT_MAX; f++) {
+            char path[4096];
+            struct stat sb;
+            if (snprintf(path, sizeof path, pattern, (int)f) >= (int)sizeof path) break;
+            if (stat(path, &sb) != 0 || !S_ISREG(sb.st_mode)) continue;
+            for (int k = 0; st == VW_OK && k < nin; k++)
+                if (ok[k] && sb.st_dev == in[k].st_dev && sb.st_ino == in[k].st_ino) {
+                    snprintf(err, sizeof err, "-o %s: frame %ld is the input file %s: it would be "
+                             "overwritten", pattern, f, inputs[k]);
+                    st = VW_E_INPUT;
+                }
+        }
+        free(in);
+        free(ok);
+    }
+    st = vw_engine_agree(st, err, sizeof err);
+    if (st == VW_OK) return VW_EXIT_OK;
+    vw_cli_error(cmd, "%s", err);
+    return st == VW_E_INPUT ? VW_EXIT_USAGE : VW_EXIT_FAIL;
+}
+
 /* The whole command, for both animate (edits from a file) and edit (from stdin). */
 int vw_anim_main(const char *cmd, int argc, char **argv)
 {
@@ -652,6 +740,21 @@ int vw_anim_main(const char *cmd, int argc, char **argv)
         const char *opts[] = {"--stats", "--log"};
         const char *paths[] = {stats, log_path};
         int crc = vw_cli_check_scene_files(cmd, scene, opts, paths, 2);
+        /* ... and no frame is one of the inputs. */
+        const char **in = crc == VW_EXIT_OK ? calloc(scene->nmaterials + 3, sizeof *in) : NULL;
+        if (crc == VW_EXIT_OK) {
+            int nin = 0;
+            if (in) in[nin++] = scene_path;
+            if (in && edits_path) in[nin++] = edits_path;
+            for (size_t m = 0; in && m < scene->nmaterials; m++) {
+                const char *lib = scene->materials[m].file > 0 ? vw_scene_string(scene, scene->materials[m].file) : NULL;
+                int seen = !lib;
+                for (int k = 0; !seen && k < nin; k++) seen = !strcmp(in[k], lib);
+                if (!seen) in[nin++] = lib;
+            }
+            crc = frames_spare_inputs(cmd, s->pattern, in, nin, script_frames(s, &ed));
+        }
+        free(in);
         if (crc != VW_EXIT_OK) {
             rc = crc;
             vw_scene_free(scene);
@@ -732,7 +835,7 @@ int vw_anim_main(const char *cmd, int argc, char **argv)
         }
     }
     /* A bad line is bad input even when the session went on past it (--keep-going, edit). */
-    rc = s->failed ? s->failed : s->bad_lines ? VW_EXIT_USAGE : VW_EXIT_OK;
+    rc = s->failed ? s->failed : s->frame_errors ? VW_EXIT_FAIL : s->bad_lines ? VW_EXIT_USAGE : VW_EXIT_OK;
 done:
     free(ed.text);
     free(ed.line);

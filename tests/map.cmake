@@ -2,7 +2,8 @@
 # worker without a cell when the grid has enough (and none over what runs of cells give),
 # greedy placing by the loads it sorts whatever they are (NaN, negative, none at all),
 # and the command line under mpirun giving every worker of 3 processes of 3 a cell of
-# 2x5x1 with --map block (worker 8 had none) with the image unchanged.
+# 2x5x1 with --map block (worker 8 had none) with the image unchanged; and render's
+# default mapping being block's, as its stats say.
 
 add_executable(vw_test_map ${PROJECT_SOURCE_DIR}/tests/map/map_test.c)
 target_include_directories(vw_test_map PRIVATE ${PROJECT_SOURCE_DIR}/tests)
@@ -11,6 +12,11 @@ foreach(t block greedy_nan greedy_zero)
   add_test(NAME map_${t} COMMAND vw_test_map ${t})
   set_tests_properties(map_${t} PROPERTIES LABELS "map" TIMEOUT 60)
 endforeach()
+
+add_test(NAME map_default_block
+         COMMAND sh ${PROJECT_SOURCE_DIR}/tests/map/default_block.sh $<TARGET_FILE:vwalls_tool>
+                 ${CMAKE_CURRENT_BINARY_DIR}/map_default_block)
+set_tests_properties(map_default_block PROPERTIES LABELS "map;threads" TIMEOUT 60)
 
 if(VW_HAVE_MPI AND MPIEXEC_EXECUTABLE)
   add_test(NAME map_block_mpi

@@ -400,6 +400,16 @@ vw_status rt_job_create(const vw_scene *s, const rt_params *p, rt_job **out, cha
         rt_job_free(j);
         return st;
     }
+    /* The initial mapping is the block mapping (docs/balancing.md, Mapping), made before
+       any object is added, so nothing moves. The world's own, runs of cell ids, was in
+       use while the stats said "block": 4x4x1 cells on 4 workers with --farm none sent
+       7143 messages between workers, 3873 mapped by blocks, and a balancer's "before"
+       was measured on one mapping and its "after" on the other. */
+    if (!cfg.cell_worker) st = rt_job_map(j, VW_MAP_BLOCK, NULL, NULL, err, errlen);
+    if (st != VW_OK) {
+        rt_job_free(j);
+        return st;
+    }
     /* The copies first, when the caller farms the initial mapping: then under MPI each
        process keeps, as the objects come, the records its copies need (those of its own
        cells; a process that hosts no cell farms every cell, and keeps every record), and

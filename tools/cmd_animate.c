@@ -499,33 +499,12 @@ static const char *piece_end(const char *p, const char *end)
     return p;
 }
 
-/* animate without --keep-going: every line of the script is parsed before the first
-   edit, so a line that does not parse (a typo at the end of a long script) stops the
-   run before any frame is written, and every such line is reported at once. Lines that
-   parse but cannot be applied (an id already removed, a move out of the world box)
-   are found only when they are reached. Returns the number of bad lines. */
-static int precheck(vw_anim_session *s, const edits_src *ed)
+/* Calls fn(arg, piece, its length, its number) on every line piece of the whole script
+   (a line, its newline included, or the part of one up to a lone CR), numbered from 1
+   as the session numbers them. */
+static void each_piece(const edits_src *ed, void (*fn)(void *arg, const char *p, size_t len, int lineno),
+                       void *arg)
 {
-    int lineno = 0, bad = 0;
-    for (size_t pos = 0; pos < ed->len;) {
-        const char *p = ed->text + pos, *nl = memchr(p, '\n', ed->len - pos);
-        const char *end = nl ? nl + 1 : ed->text + ed->len;
-        pos = (size_t)(end - ed->text);
-        while (p < end) {
-            const char *q = piece_end(p, end);
-            vw_edit e;
-            bad += parse_line(s, p, (size_t)(q - p), ++lineno, &e) != VW_OK;
-            p = q + 1;
-        }
-    }
-    return bad;
-}
-
-/* The number of 'frame' lines of the script (those that parse): the frames a run can
-   write. */
-static long script_frames(const vw_anim_session *s, const edits_src *ed)
-{
-    long n = 0;
     int lineno = 0;
     for (size_t pos = 0; ed->text && pos < ed->len;) {
         const char *p = ed->text + pos, *nl = memchr(p, '\n', ed->len - pos);
@@ -533,15 +512,58 @@ static long script_frames(const vw_anim_session *s, const edits_src *ed)
         pos = (size_t)(end - ed->text);
         while (p < end) {
             const char *q = piece_end(p, end);
-            vw_edit e;
-            char err[8];
-            if (!memchr(p, '\0', (size_t)(q - p)) &&
-                vw_edit_parse(p, s->name, ++lineno, &e, err, sizeof err) == VW_OK && e.op == VW_EDIT_FRAME)
-                n++;
+            fn(arg, p, (size_t)(q - p), ++lineno);
             p = q + 1;
         }
     }
-    return n;
+}
+
+typedef struct precheck_arg {
+    vw_anim_session *s;
+    int bad;
+} precheck_arg;
+
+static void precheck_piece(void *arg, const char *p, size_t len, int lineno)
+{
+    precheck_arg *a = arg;
+    vw_edit e;
+    a->bad += parse_line(a->s, p, len, lineno, &e) != VW_OK;
+}
+
+/* animate without --keep-going: every line of the script is parsed before the first
+   edit, so a line that does not parse (a typo at the end of a long script) stops the
+   run before any frame is written, and every such line is reported at once. Lines that
+   parse but cannot be applied (an id already removed, a move out of the world box)
+   are found only when they are reached. Returns the number of bad lines. */
+static int precheck(vw_anim_session *s, const edits_src *ed)
+{
+    precheck_arg a = {s, 0};
+    each_piece(ed, precheck_piece, &a);
+    return a.bad;
+}
+
+typedef struct frames_arg {
+    const char *name;
+    long frames;
+} frames_arg;
+
+static void count_frame(void *arg, const char *p, size_t len, int lineno)
+{
+    frames_arg *a = arg;
+    vw_edit e;
+    char err[8];
+    if (!memchr(p, '\0', len) && vw_edit_parse(p, a->name, lineno, &e, err, sizeof err) == VW_OK &&
+        e.op == VW_EDIT_FRAME)
+        a->frames++;
+}
+
+/* The number of 'frame' lines of the script (those that parse): the frames a run can
+   write. */
+static long script_frames(const vw_anim_session *s, const edits_src *ed)
+{
+    frames_arg a = {s->name, 0};
+    each_piece(ed, count_frame, &a);
+    return a.frames;
 }
 
 /* Would a frame replace one of the inputs (the scene, its material libraries, animate's

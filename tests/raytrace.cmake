@@ -83,6 +83,13 @@ add_test(NAME raytrace_cli
           -P ${PROJECT_SOURCE_DIR}/tests/raytrace/cli.cmake)
 set_tests_properties(raytrace_cli PROPERTIES ENVIRONMENT "${VW_RT_TSAN}")
 
+# No message to a cell of the sender's own worker: crossings and new rays go inline.
+add_test(NAME raytrace_inline_spawn
+         COMMAND sh ${PROJECT_SOURCE_DIR}/tests/raytrace/inline_spawn.sh $<TARGET_FILE:vwalls_tool>
+                 ${CMAKE_CURRENT_BINARY_DIR}/raytrace_inline_spawn)
+set_tests_properties(raytrace_inline_spawn PROPERTIES LABELS "threads" TIMEOUT 60
+                     ENVIRONMENT "${VW_RT_TSAN}")
+
 # vwalls bench: a row per configuration in order, the images checked identical (a
 # difference fails it), bad options refused with nothing written (tests/raytrace/cli_bench.sh).
 add_test(NAME raytrace_cli_bench

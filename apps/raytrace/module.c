@@ -151,6 +151,7 @@ static void output_pixels(void *user, const void *msg)
 /* ---- tracing ------------------------------------------------------------------------- */
 
 static void trace(vw_ctx *ctx, rt_cell *c, rt_ray *r, vw_walk *w);
+static int walk_ray(vw_ctx *ctx, rt_cell *c, rt_ray *r, vw_walk *w);
 
 /* The ray left the world or reached its light without a hit. */
 static void finish_free(vw_ctx *ctx, rt_cell *c, const rt_ray *r)
@@ -185,10 +186,21 @@ static void spawn(vw_ctx *ctx, rt_cell *c, rt_ray *r)
     r->tmax = w.tmax;
     r->t0 = w.seg.t0;
     r->t1 = w.seg.t1;
-    if (w.seg.cell == me)
+    if (w.seg.cell == me) {
         trace(ctx, c, r, &w);
-    else
+        return;
+    }
+    /* A ray from a hit just past this cell's wall (within the overlap) starts in the next
+       cell: entered inline when this worker hosts it, as a crossing is (it was sent,
+       a few messages a render to the worker's own cells). */
+    int replica = vw_ctx_replica(ctx);
+    rt_cell *next = vw_ctx_enter(ctx, w.seg.cell, RT_K_RAY);
+    if (next) {
+        walk_ray(ctx, next, r, &w);
+        vw_ctx_restore(ctx, me, replica);
+    } else {
         vw_send_cell(ctx, w.seg.cell, RT_K_RAY, r);
+    }
 }
 
 /* Unit geometric normal (outward) and shading normal at hit point p. */

@@ -82,9 +82,9 @@ VW_API vw_status vw_world_remap(vw_world *w, const int *cell_worker);
    and inside its machine (messages and bytes, from the runtime's counters by
    destination class) since the last vw_world_reset_stats. Only messages sent count:
    work a module does in a cell of its own worker through vw_ctx_enter is no message
-   (the ray tracer hands a ray on that way as it crosses a wall, so its msgs_worker is
-   only the few rays spawned in a cell whose walk starts in another cell of the same
-   worker, which it sends, unless VW_STRESS refuses hand-offs). VW_E_INVAL when out is
+   (the ray tracer hands every ray on that way, one crossing a wall and one whose walk
+   starts in the next cell, so its msgs_worker stays 0 unless VW_STRESS refuses
+   hand-offs). VW_E_INVAL when out is
    NULL, VW_E_NOMEM for the table of machines, VW_E_MPI as vw_world_machines. Collective under MPI, and ends in
    agreement like a step of the world's life (world.h): a failure on one process only
    (out NULL there, no memory there) fails the call on every process with the lowest

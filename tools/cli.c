@@ -528,7 +528,7 @@ int vw_cli_check_scene_files(const char *cmd, const vw_scene *scene, const char 
     return rc;
 }
 
-int vw_cli_frame_file(const char *pattern, const char *path, int *frame)
+int vw_cli_frame_file(const char *pattern, const char *path, long nframes, int *frame)
 {
     file_id out;
     if (!pattern || !path || !file_identify(path, &out)) return 0;
@@ -556,6 +556,18 @@ int vw_cli_frame_file(const char *pattern, const char *path, int *frame)
             free(id.path);
         }
     }
+    /* And the frames a run will write, whatever the name says (a link named otherwise). */
+    for (long f = 0; !found && f < nframes && f <= INT_MAX; f++) {
+        char name[4096];
+        file_id id;
+        int w = snprintf(name, sizeof name, pattern, (int)f);
+        if (w < 0 || (size_t)w >= sizeof name || !file_identify(name, &id)) continue;
+        if (file_same(&out, &id)) {
+            found = 1;
+            if (frame) *frame = (int)f;
+        }
+        free(id.path);
+    }
     free(out.path);
     return found;
 }
@@ -567,7 +579,7 @@ int vw_cli_check_frames(const char *cmd, const char *pattern, const char *const 
     vw_status st = VW_OK;
     for (int k = 0; pattern && k < n && st == VW_OK && vw_cli_is_output(); k++) {
         int frame;
-        if (paths[k] && vw_cli_frame_file(pattern, paths[k], &frame)) {
+        if (paths[k] && vw_cli_frame_file(pattern, paths[k], 0, &frame)) {
             snprintf(err, sizeof err, "%s %s: frame %d of -o %s: one would overwrite the other",
                      opts[k], paths[k], frame, pattern);
             st = VW_E_INPUT;

@@ -112,9 +112,10 @@ int vw_cli_check_files(const char *cmd, const char *const *inputs, const char *c
 int vw_cli_check_scene_files(const char *cmd, const vw_scene *scene, const char *const *opts,
                              const char *const *paths, int n);
 /* Is path one of the frame files of pattern (animate's and edit's -o, valid by
-   vw_cli_frame_pattern): the same file as the pattern's name for some frame number? 1
-   and the number in *frame, else 0. Devices are nobody's frames (0). */
-int vw_cli_frame_file(const char *pattern, const char *path, int *frame);
+   vw_cli_frame_pattern): the same file as the pattern's name for a frame number its
+   name holds, or for one of the frames 0 to nframes-1 (those a run will write; 0 when
+   not known)? 1 and the number in *frame, else 0. Devices are nobody's frames (0). */
+int vw_cli_frame_file(const char *pattern, const char *path, long nframes, int *frame);
 /* The outputs other than the frames (--log, --stats) against the frame files of
    pattern (NULL: none): VW_EXIT_OK, or VW_EXIT_USAGE on every process with "vwalls CMD:
    OPT PATH: frame N of -o PATTERN: one would overwrite the other" printed once.

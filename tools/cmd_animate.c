@@ -5,7 +5,6 @@
  */
 #define _POSIX_C_SOURCE 200809L
 #include <errno.h>
-#include <limits.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -583,37 +582,14 @@ static int frames_spare_inputs(const char *cmd, const char *pattern, const char 
     if (!inputs) { /* no room for their list */
         snprintf(err, sizeof err, "%s", vw_status_message(VW_E_NOMEM));
         st = VW_E_NOMEM;
-    } else if (pattern && vw_cli_is_output()) {
-        struct stat *in = calloc((size_t)nin + 1, sizeof *in);
-        int *ok = calloc((size_t)nin + 1, sizeof *ok);
-        if (!in || !ok) {
-            snprintf(err, sizeof err, "%s", vw_status_message(VW_E_NOMEM));
-            st = VW_E_NOMEM;
+    }
+    for (int k = 0; st == VW_OK && pattern && vw_cli_is_output() && k < nin; k++) {
+        int frame;
+        if (inputs[k] && vw_cli_frame_file(pattern, inputs[k], nframes, &frame)) {
+            snprintf(err, sizeof err, "-o %s: frame %d is the input file %s: it would be overwritten",
+                     pattern, frame, inputs[k]);
+            st = VW_E_INPUT;
         }
-        for (int k = 0; st == VW_OK && k < nin; k++)
-            ok[k] = inputs[k] && stat(inputs[k], &in[k]) == 0 && S_ISREG(in[k].st_mode);
-        for (int k = 0; st == VW_OK && k < nin; k++) {
-            int frame;
-            if (ok[k] && vw_cli_frame_file(pattern, inputs[k], &frame)) {
-                snprintf(err, sizeof err, "-o %s: frame %d is the input file %s: it would be overwritten",
-                         pattern, frame, inputs[k]);
-                st = VW_E_INPUT;
-            }
-        }
-        for (long f = 0; st == VW_OK && f < nframes && f <= INT_MAX; f++) {
-            char path[4096];
-            struct stat sb;
-            if (snprintf(path, sizeof path, pattern, (int)f) >= (int)sizeof path) break;
-            if (stat(path, &sb) != 0 || !S_ISREG(sb.st_mode)) continue;
-            for (int k = 0; st == VW_OK && k < nin; k++)
-                if (ok[k] && sb.st_dev == in[k].st_dev && sb.st_ino == in[k].st_ino) {
-                    snprintf(err, sizeof err, "-o %s: frame %ld is the input file %s: it would be "
-                             "overwritten", pattern, f, inputs[k]);
-                    st = VW_E_INPUT;
-                }
-        }
-        free(in);
-        free(ok);
     }
     st = vw_engine_agree(st, err, sizeof err);
     if (st == VW_OK) return VW_EXIT_OK;

@@ -84,6 +84,28 @@ foreach(case "send;sent message kind 1 ('to_output') to cell 0, but the kind has
   set_tests_properties(core_misuse_${m} PROPERTIES LABELS "core" TIMEOUT 30)
 endforeach()
 
+# The sized sends (VW_SEND_CELL, ...): records of the kind's size arrive whole through
+# every one; a record of another size (shorter: every message was cut; longer: the send
+# read past it) stops the process naming the call, the kind and both sizes.
+vw_core_test(test_sized)
+add_test(NAME core_sized_ok COMMAND test_sized ok)
+set_tests_properties(core_sized_ok PROPERTIES LABELS "core;threads" TIMEOUT 30)
+foreach(case "cell-small;gave vw_send_cell_sized a record of 24 bytes for message kind 0 ('rec'), whose size is 32 bytes"
+             "cell-large;gave vw_send_cell_sized a record of 40 bytes for message kind 0 ('rec'), whose size is 32 bytes"
+             "pointer;gave vw_send_cell_sized a record of 8 bytes for message kind 0 ('rec'), whose size is 32 bytes"
+             "point;gave vw_send_point_sized a record of 24 bytes for message kind 0 ('rec'), whose size is 32 bytes"
+             "point-outside;gave vw_send_point_sized a record of 40 bytes for message kind 0 ('rec'), whose size is 32 bytes"
+             "face;gave vw_send_face_sized a record of 24 bytes for message kind 0 ('rec'), whose size is 32 bytes"
+             "face-wall;gave vw_send_face_sized a record of 24 bytes for message kind 0 ('rec'), whose size is 32 bytes"
+             "neighbours;gave vw_send_neighbours_sized a record of 40 bytes for message kind 0 ('rec'), whose size is 32 bytes"
+             "output;gave vw_send_output_sized a record of 24 bytes for message kind 1 ('out'), whose size is 32 bytes"
+             "signal;gave vw_send_cell_sized a record of 24 bytes for message kind 2 ('signal'), whose size is 0 bytes")
+  list(GET case 0 m)
+  list(GET case 1 want)
+  add_test(NAME core_sized_${m} COMMAND test_sized ${m} ${want})
+  set_tests_properties(core_sized_${m} PROPERTIES LABELS "core" TIMEOUT 30)
+endforeach()
+
 # The example module equals the O(n^2) count for every layout and worker count.
 foreach(layout 1 2x4 2x2x2 4x4x4)
   foreach(workers 1 2 4)

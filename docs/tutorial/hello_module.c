@@ -72,7 +72,7 @@ static void report_if_complete(vw_ctx *ctx, ex_cell *c)
     if (c->reported || c->heard < c->expected) return;
     c->reported = 1;
     ex_summary_msg s = {vw_ctx_cell(ctx), c->own, c->neighbours};
-    vw_send_output(ctx, MSG_SUMMARY, &s);
+    VW_SEND_OUTPUT(ctx, MSG_SUMMARY, s);                 /* checks sizeof s: module.h */
 }
 
 static int step(vw_ctx *ctx, void *state)
@@ -82,7 +82,7 @@ static int step(vw_ctx *ctx, void *state)
     c->started = 1;
     vw_count(ctx, EX_HELLO_CNT_POINTS, c->own);
     ex_count_msg m = {c->own};
-    int sent = vw_send_neighbours(ctx, MSG_COUNT, &m);   /* copied: m may go out of scope */
+    int sent = VW_SEND_NEIGHBOURS(ctx, MSG_COUNT, m);    /* copied: m may go out of scope */
     vw_count(ctx, EX_HELLO_CNT_MESSAGES, sent);
     report_if_complete(ctx, c);                          /* a cell with no neighbours */
     return 1;

@@ -45,7 +45,8 @@ typedef struct vw_msg_kind {
     const char *name;
     size_t size;    /* bytes of one message record, at most VW_MAX_MSG_BYTES: every send
                        copies this many bytes from the pointer it is given, so it must be
-                       sizeof the record sent (nothing can check that) */
+                       sizeof the record sent: vw_send_cell and the others cannot check
+                       that; the sized sends (VW_SEND_CELL, ... below) do */
     /* Runs on the worker hosting the destination cell. May send messages. */
     void (*handle)(vw_ctx *ctx, void *cell_state, const void *msg);
     /* For kinds sent with vw_send_output: runs on the output process. */
@@ -159,6 +160,39 @@ VW_API int vw_send_face(vw_ctx *ctx, int face, int kind, const void *msg);
 VW_API int vw_send_neighbours(vw_ctx *ctx, int kind, const void *msg);
 /* To the output process, where the kind's output handler receives it. */
 VW_API void vw_send_output(vw_ctx *ctx, int kind, const void *msg);
+
+/* Sized sends: the same five, told the size of the record they are given, which must be
+   the kind's size. The sends above copy the kind's size from msg whatever msg points
+   to: a kind whose size is smaller than the record truncates every message silently,
+   one whose size is larger reads past the sender's variable. A sized send whose size
+   differs stops the process with a message on stderr, like the misuses above, naming
+   the call, the kind, the size given and the kind's size ("vwalls: module 'M' gave
+   vw_send_cell_sized a record of 12 bytes for message kind 0 ('count'), whose size is 8
+   bytes (worker W, in cell C)"), also when the send reaches no cell. The check is one
+   comparison per send, and only here: vw_send_cell, a hot path (a ray tracer's rays),
+   stays as it was. A signal (a kind of size 0) is sent with msg NULL and size 0. */
+VW_API void vw_send_cell_sized(vw_ctx *ctx, int cell, int kind, const void *msg, size_t size);
+VW_API int vw_send_point_sized(vw_ctx *ctx, const double p[3], const double dir[3], int kind,
+                               const void *msg, size_t size);
+VW_API int vw_send_face_sized(vw_ctx *ctx, int face, int kind, const void *msg, size_t size);
+VW_API int vw_send_neighbours_sized(vw_ctx *ctx, int kind, const void *msg, size_t size);
+VW_API void vw_send_output_sized(vw_ctx *ctx, int kind, const void *msg, size_t size);
+
+/* The sized sends of a record variable (an lvalue: a variable, a struct member, *ptr),
+   written once: VW_SEND_CELL(ctx, cell, MSG_RAY, ray) passes &(ray) and sizeof(ray).
+   Give the record, not a pointer to it (a pointer p is sent as *p: with p itself the
+   size is that of the pointer, which the check catches unless the kind is as small).
+   Each returns what its function returns. */
+#define VW_SEND_CELL(ctx, cell, kind, rec) \
+    vw_send_cell_sized((ctx), (cell), (kind), &(rec), sizeof(rec))
+#define VW_SEND_POINT(ctx, p, dir, kind, rec) \
+    vw_send_point_sized((ctx), (p), (dir), (kind), &(rec), sizeof(rec))
+#define VW_SEND_FACE(ctx, face, kind, rec) \
+    vw_send_face_sized((ctx), (face), (kind), &(rec), sizeof(rec))
+#define VW_SEND_NEIGHBOURS(ctx, kind, rec) \
+    vw_send_neighbours_sized((ctx), (kind), &(rec), sizeof(rec))
+#define VW_SEND_OUTPUT(ctx, kind, rec) \
+    vw_send_output_sized((ctx), (kind), &(rec), sizeof(rec))
 
 /* Inline hand-off, "a message of kind `kind` delivered by a function call": when this
    worker hosts `cell` (or, if the kind is independent and every worker of the process

@@ -713,6 +713,48 @@ void vw_send_output(vw_ctx *ctx, int kind, const void *msg)
     enqueue(ctx, ctx->w->gworkers, VW__OUTPUT, -1, kind, msg);
 }
 
+/* The sized sends: the size of the record the module gives is checked against its kind's
+   (which the plain sends copy, whatever the record's size), then the plain send does the
+   rest, checks included. An unknown kind is left to the plain send to report. */
+static inline void check_size(const vw_ctx *ctx, const char *call, int kind, size_t size)
+{
+    const vw_module *m = ctx->w->m;
+    if (kind >= 0 && kind < m->nkinds && m->kinds[kind].size != size)
+        misuse(ctx, "gave %s a record of %zu bytes for message kind %d ('%s'), whose size is %zu bytes",
+               call, size, kind, m->kinds[kind].name, m->kinds[kind].size);
+}
+
+void vw_send_cell_sized(vw_ctx *ctx, int cell, int kind, const void *msg, size_t size)
+{
+    check_size(ctx, "vw_send_cell_sized", kind, size);
+    vw_send_cell(ctx, cell, kind, msg);
+}
+
+int vw_send_point_sized(vw_ctx *ctx, const double p[3], const double dir[3], int kind,
+                        const void *msg, size_t size)
+{
+    check_size(ctx, "vw_send_point_sized", kind, size);
+    return vw_send_point(ctx, p, dir, kind, msg);
+}
+
+int vw_send_face_sized(vw_ctx *ctx, int face, int kind, const void *msg, size_t size)
+{
+    check_size(ctx, "vw_send_face_sized", kind, size);
+    return vw_send_face(ctx, face, kind, msg);
+}
+
+int vw_send_neighbours_sized(vw_ctx *ctx, int kind, const void *msg, size_t size)
+{
+    check_size(ctx, "vw_send_neighbours_sized", kind, size);
+    return vw_send_neighbours(ctx, kind, msg);
+}
+
+void vw_send_output_sized(vw_ctx *ctx, int kind, const void *msg, size_t size)
+{
+    check_size(ctx, "vw_send_output_sized", kind, size);
+    vw_send_output(ctx, kind, msg);
+}
+
 void vw_ctx_fail(vw_ctx *ctx, vw_status status, const char *fmt, ...)
 {
     if (!ctx->in_run)

@@ -192,7 +192,7 @@ static int step(vw_ctx *ctx, void *state)
             size_t i = ec->bsph[b];
             ex_label_msg msg = {ec->bins.own[i], ec->label[r]};
             for (size_t k = ec->dstart[i]; k < ec->dstart[i + 1]; k++)
-                vw_send_cell(ctx, ec->dest[k], MSG_LABEL, &msg);
+                VW_SEND_CELL(ctx, ec->dest[k], MSG_LABEL, msg);
             vw_count(ctx, EX_COMPONENTS_CNT_LABEL_MSGS, (int64_t)(ec->dstart[i + 1] - ec->dstart[i]));
         }
     }
@@ -233,7 +233,7 @@ static void on_report(vw_ctx *ctx, void *state, const void *msg)
     (void)msg;
     for (size_t i = 0; i < ec->bins.n; i++) {
         ex_result_msg res = {ec->bins.own[i].id, ec->label[ec->parent[i]]};
-        vw_send_output(ctx, MSG_RESULT, &res);
+        VW_SEND_OUTPUT(ctx, MSG_RESULT, res);
         if (res.label == res.id) vw_count(ctx, EX_COMPONENTS_CNT_COMPONENTS, 1);
     }
 }
@@ -282,17 +282,14 @@ vw_status ex_components_label(const ex_sphere *s, size_t n, double rmax, const v
                               vw_world **out_world)
 {
     if (out_world) *out_world = NULL;
-    /* Agreed: a process out of memory for the check alone would leave the others
-       waiting for it in vw_world_create. */
-    char why[256] = "";
-    vw_status st = ex_spheres_check(s, n, rmax, d, 1, why, sizeof why);
-    if ((st = vw_config_agree(cfg, st, why, sizeof why)) != VW_OK) return st;
+    vw_status st = ex__spheres_agree(s, n, rmax, d, 1, cfg);
+    if (st != VW_OK) return st;
     /* The world keeps a pointer to params: a world handed back is for reading stats,
        not for running again. */
     ex_params params = {rmax, labels, n};
     vw_world *w;
     st = vw_world_create(&components_module, &params, d, cfg, &w);
-    if (st != VW_OK) return st;
+    if (st != VW_OK) return ex__world_failed(st, NULL);
     struct timespec t[5];
     clock_gettime(CLOCK_MONOTONIC, &t[0]);
     st = vw_world_add_objects(w, s, n);          /* placement into cells */
@@ -306,6 +303,7 @@ vw_status ex_components_label(const ex_sphere *s, size_t n, double rmax, const v
         st = vw_world_post(w, c, MSG_REPORT, &dummy);
     if (st == VW_OK) st = vw_world_run(w);       /* final labels to the output process */
     clock_gettime(CLOCK_MONOTONIC, &t[4]);
+    ex__world_failed(st, w);
     const char *phase[4] = {"place", "build", "compute", "report"};
     for (int i = 0; i < 4; i++) vw_world_add_time(w, phase[i], seconds_between(&t[i], &t[i + 1]));
     *ncomponents = vw_world_counter(w, EX_COMPONENTS_CNT_COMPONENTS);

@@ -16,9 +16,10 @@ int64_t ex_components_reference(const ex_sphere *s, size_t n, int64_t *labels);
 
 /* The distributed labelling on decomposition d, with the same meaning of labels. Sphere
    ids must be 0..n-1 and every radius at most rmax (ex_spheres_check, pairs.h; else
-   VW_E_INVAL before any world is made). labels (n entries) is filled on the output
-   process only; *ncomponents is valid on every process. If out_world is not NULL the
-   world is handed back (for stats, and the counters below), else freed. */
+   VW_E_INVAL before any world is made, ex_errmsg saying why). labels (n entries) is
+   filled on the output process only; *ncomponents is valid on every process. If
+   out_world is not NULL the world is handed back (for stats, and the counters below),
+   else freed. */
 vw_status ex_components_label(const ex_sphere *s, size_t n, double rmax, const vw_decomp *d,
                               const vw_config *cfg, int64_t *labels, int64_t *ncomponents,
                               vw_world **out_world);

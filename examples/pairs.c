@@ -96,7 +96,7 @@ static int step(vw_ctx *ctx, void *state)
                                vw_decomp_cell_count(vw_ctx_decomp(ctx)));
         for (int k = 0; k < n; k++) {
             if (cells[k] == vw_ctx_cell(ctx)) continue;
-            vw_send_cell(ctx, cells[k], MSG_GHOST, s);
+            VW_SEND_CELL(ctx, cells[k], MSG_GHOST, *s);
             vw_count(ctx, EX_PAIRS_CNT_GHOSTS, 1);
         }
     }
@@ -136,17 +136,14 @@ vw_status ex_pairs_count(const ex_sphere *s, size_t n, double rmax, const vw_dec
                          const vw_config *cfg, int64_t *pairs, vw_world **out_world)
 {
     if (out_world) *out_world = NULL;
-    /* Agreed: a process out of memory for the check alone would leave the others
-       waiting for it in vw_world_create. */
-    char why[256] = "";
-    vw_status st = ex_spheres_check(s, n, rmax, d, 0, why, sizeof why);
-    if ((st = vw_config_agree(cfg, st, why, sizeof why)) != VW_OK) return st;
+    vw_status st = ex__spheres_agree(s, n, rmax, d, 0, cfg);
+    if (st != VW_OK) return st;
     /* The world keeps a pointer to params: a world handed back is for reading stats,
        not for running again. */
     pairs_params params = {rmax};
     vw_world *w;
     st = vw_world_create(&pairs_module, &params, d, cfg, &w);
-    if (st != VW_OK) return st;
+    if (st != VW_OK) return ex__world_failed(st, NULL);
     struct timespec t[4];
     clock_gettime(CLOCK_MONOTONIC, &t[0]);
     st = vw_world_add_objects(w, s, n);          /* placement into cells */
@@ -155,6 +152,7 @@ vw_status ex_pairs_count(const ex_sphere *s, size_t n, double rmax, const vw_dec
     clock_gettime(CLOCK_MONOTONIC, &t[2]);
     if (st == VW_OK) st = vw_world_run(w);       /* steps and ghosts until quiescence */
     clock_gettime(CLOCK_MONOTONIC, &t[3]);
+    ex__world_failed(st, w);
     const char *phase[3] = {"place", "build", "compute"};
     for (int i = 0; i < 3; i++)
         vw_world_add_time(w, phase[i], (double)(t[i + 1].tv_sec - t[i].tv_sec) +
@@ -169,34 +167,42 @@ vw_status ex_pairs_count(const ex_sphere *s, size_t n, double rmax, const vw_dec
 
 /* ---- the sequential side: checks, scene and reference ---- */
 
+/* ex_errmsg's message: one a thread, as the calls it explains may run in several. */
+static _Thread_local char errmsg[512];
+
+const char *ex_errmsg(void) { return errmsg[0] ? errmsg : "no error"; }
+
+/* Agreed: a process out of memory for the check alone would leave the others waiting
+   for it in vw_world_create. The reason is ex_spheres_check's, written straight into
+   ex_errmsg's message: one text, wherever it is read. */
+vw_status ex__spheres_agree(const ex_sphere *s, size_t n, double rmax, const vw_decomp *d,
+                            int ids_are_indices, const vw_config *cfg)
+{
+    errmsg[0] = 0;
+    vw_status st = ex_spheres_check(s, n, rmax, d, ids_are_indices, errmsg, sizeof errmsg);
+    st = vw_config_agree(cfg, st, errmsg, sizeof errmsg);
+    if (st == VW_OK) errmsg[0] = 0;
+    return st;
+}
+
+vw_status ex__world_failed(vw_status st, const vw_world *w)
+{
+    if (st != VW_OK) snprintf(errmsg, sizeof errmsg, "%s", vw_world_errmsg(w));
+    return st;
+}
+
 static int cmp_id(const void *a, const void *b)
 {
     int64_t x = *(const int64_t *)a, y = *(const int64_t *)b;
     return (x > y) - (x < y);
 }
 
-/* The first id that appears twice in s[0..n), in *dup; -1 when out of memory. Ids all
-   in 0..n-1 (every sphere set this file makes) take a bitmap, others a sorted copy. */
+/* The smallest id that appears twice in s[0..n), in *dup; -1 when out of memory. A
+   sorted copy of the ids: right for every id (a bitmap would need ids in 0..n-1), in
+   8n bytes whatever they are. */
 static int id_twice(const ex_sphere *s, size_t n, int64_t *dup)
 {
-    int small = 1;
-    for (size_t i = 0; i < n && small; i++) small = s[i].id >= 0 && (uint64_t)s[i].id < n;
-    if (small) {
-        unsigned char *seen = calloc(n / 8 + 1, 1);
-        if (!seen) return -1;
-        for (size_t i = 0; i < n; i++) {
-            uint64_t id = (uint64_t)s[i].id;
-            if (seen[id / 8] & (1u << id % 8)) {
-                *dup = s[i].id;
-                free(seen);
-                return 1;
-            }
-            seen[id / 8] |= (unsigned char)(1u << id % 8);
-        }
-        free(seen);
-        return 0;
-    }
-    int64_t *ids = malloc(sizeof *ids * n);
+    int64_t *ids = malloc(sizeof *ids * (n ? n : 1));
     if (!ids) return -1;
     for (size_t i = 0; i < n; i++) ids[i] = s[i].id;
     qsort(ids, n, sizeof *ids, cmp_id);

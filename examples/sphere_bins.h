@@ -11,6 +11,16 @@
 
 #include "pairs.h"
 
+/* The two modules' entry points, ex_pairs_count and ex_components_label, begin and end
+   alike; pairs.c keeps ex_errmsg's message (pairs.h). ex__spheres_agree: the spheres
+   checked (ex_spheres_check, its reason becoming the message) and the verdict agreed on
+   before the world is made (vw_config_agree). ex__world_failed: st returned, and when it
+   is not VW_OK the message becomes vw_world_errmsg(w) (w NULL: why vw_world_create
+   failed), taken before the world is freed. */
+vw_status ex__spheres_agree(const ex_sphere *s, size_t n, double rmax, const vw_decomp *d,
+                            int ids_are_indices, const vw_config *cfg);
+vw_status ex__world_failed(vw_status st, const vw_world *w);
+
 typedef struct ex_bins {
     ex_sphere *own;   /* spheres whose centre lies in this cell, sorted by key */
     uint64_t *key;

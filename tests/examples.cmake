@@ -123,7 +123,7 @@ endif()
 # zero, a world below the origin, centres on the world's faces; on the layouts 1, 2,
 # 2x2x2, 4x4x4 and 1x1x8 with 1, 2 and 4 workers, also under mpirun; and sphere sets the
 # modules cannot count (a radius above rmax, a centre outside the world, an id twice, ...)
-# refused with VW_E_INVAL rather than counted wrong ("invalid").
+# refused with VW_E_INVAL rather than counted wrong, ex_errmsg saying why ("invalid").
 add_executable(test_example_spheres ${PROJECT_SOURCE_DIR}/tests/examples/test_example_spheres.c)
 target_link_libraries(test_example_spheres PRIVATE vwalls_apps m)
 foreach(case uniform clustered walls chains large duplicates zero allzero negative faces invalid)
@@ -141,6 +141,16 @@ if(VW_HAVE_MPI)
                      $<TARGET_FILE:test_example_spheres> --cells 2,2x2x2,4x4x4,1x1x8 --workers 1,2
                      ${MPIEXEC_POSTFLAGS})
     set_tests_properties(example_spheres_mpi_np${np} PROPERTIES LABELS "examples;mpi" TIMEOUT 300
+                         PROCESSORS 2 ENVIRONMENT "${_vw_ex_env}")
+  endforeach()
+  # A --check that fails is the output process's verdict alone: every process must exit
+  # with it (1), each rank's status read from a file its own shell writes
+  # (tests/examples/check_ranks.sh).
+  foreach(np 2 3)
+    add_test(NAME example_check_ranks_np${np}
+             COMMAND sh ${PROJECT_SOURCE_DIR}/tests/examples/check_ranks.sh $<TARGET_FILE:vwalls_tool>
+                     ${np} "${MPIEXEC_EXECUTABLE} ${MPIEXEC_NUMPROC_FLAG} ${np} ${VW_MPI_PREFLAGS}")
+    set_tests_properties(example_check_ranks_np${np} PROPERTIES LABELS "examples;mpi" TIMEOUT 240
                          PROCESSORS 2 ENVIRONMENT "${_vw_ex_env}")
   endforeach()
   add_test(NAME example_spheres_invalid_mpi_np3

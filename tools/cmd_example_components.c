@@ -77,8 +77,8 @@ int vw_cmd_example_components(int argc, char **argv)
     st = ex_components_label(s, (size_t)n, rmax, d, &cfg, labels, &ncomp, &w);
     double t2 = vw_cli_now();
     if (st != VW_OK) {
-        /* With w NULL, vw_world_errmsg says why the world was not made. */
-        vw_cli_error(CMD, "run failed: %s", vw_world_errmsg(w));
+        /* Spheres refused, a world not made, a step that failed: ex_errmsg says which. */
+        vw_cli_error(CMD, "run failed: %s", ex_errmsg());
         rc = VW_EXIT_FAIL;
     }
     if (rc == VW_EXIT_OK && vw_world_is_output(w)) {
@@ -102,6 +102,8 @@ int vw_cmd_example_components(int argc, char **argv)
                    "report %.3f s\n", t1 - t0, vw_world_time(w, "place"), vw_world_time(w, "build"),
                    vw_world_time(w, "compute"), vw_world_time(w, "report"));
         }
+        /* The output process alone checks; every process exits with its verdict, agreed
+           when the command has returned (vw_cli_job_status, tools/vwalls.c). */
         if (check) {
             int64_t nref = ex_components_reference(s, (size_t)n, ref);
             /* VW_FAULT=example-mismatch (tests): one component more in the reference. */

@@ -7,7 +7,8 @@
  * every layout and worker count asked for; the pair count must equal the brute force's,
  * the components' labels the smallest id of each component, and the number and sizes of
  * the components a union-find's over the brute-force pairs. Case "invalid": sphere sets
- * the modules cannot count are refused with VW_E_INVAL, not counted wrong.
+ * the modules cannot count are refused with VW_E_INVAL, not counted wrong, and
+ * ex_errmsg says why in ex_spheres_check's words.
  *
  * "Touching" is pairs.h's definition: |c1 - c2|^2 <= (r1 + r2)^2, evaluated in double as
  * written there. It is written out here again on purpose, so that the reference does not
@@ -297,6 +298,29 @@ static const test_case cases[] = {
     {"allzero", make_allzero},   {"negative", make_negative},     {"faces", make_faces},
 };
 
+/* After a call of one of the modules that returned st: a refusal gives ex_errmsg in
+   ex_spheres_check's own words (under MPI after "rank R: ", every process refusing
+   alike), a success "no error". Returns 1 (and says so) when it does not. */
+static int errmsg_is_why(vw_status st, const ex_sphere *s, size_t n, double rmax,
+                         const vw_decomp *d, int ids_are_indices, const char *module,
+                         const char *what, int workers)
+{
+    char why[256] = "";
+    ex_spheres_check(s, n, rmax, d, ids_are_indices, why, sizeof why);
+    const char *got = ex_errmsg();
+    size_t lg = strlen(got), lw = strlen(why);
+    int ok = st == VW_OK ? !strcmp(got, "no error")
+                         : lw && lg >= lw && !strcmp(got + lg - lw, why) &&
+                               (lg == lw || (vw_engine_size() > 1 && !strncmp(got, "rank 0: ", 8) &&
+                                             lg == lw + 8));
+    if (!ok)
+        fprintf(stderr, "invalid w%d: %s, %s: %s, ex_errmsg \"%s\", expected \"%s%s\"\n", workers,
+                module, what, vw_status_message(st), got,
+                st == VW_OK ? "no error" : vw_engine_size() > 1 ? "rank 0: " : "",
+                st == VW_OK ? "" : why);
+    return !ok;
+}
+
 /* Sphere sets the modules cannot count right are refused (VW_E_INVAL, no world), not
    counted wrong: a radius above the rmax given (its ghosts would not reach far enough), a
    negative radius, a centre outside the world box (in no cell) or not a number, rmax not
@@ -346,6 +370,7 @@ static int run_invalid(int workers)
                     st != VW_OK && w ? " (and a world handed back)" : "");
             bad = 1;
         }
+        bad |= errmsg_is_why(st, s, N, rmax, d, 0, "pairs", what[k], workers);
         if (st == VW_OK) vw_world_free(w);
         want = k == NWHAT - 1 ? VW_OK : VW_E_INVAL;
         st = ex_components_label(s, N, rmax, d, &cfg, labels, &ncomp, NULL);
@@ -354,12 +379,29 @@ static int run_invalid(int workers)
                     vw_status_message(st), vw_status_message(want));
             bad = 1;
         }
+        bad |= errmsg_is_why(st, s, N, rmax, d, 1, "components", what[k], workers);
         char why[256] = "";
         if (k < NWHAT - 1 && ex_spheres_check(s, N, rmax, d, 1, why, sizeof why) == VW_OK) {
             fprintf(stderr, "invalid w%d: ex_spheres_check passes %s\n", workers, what[k]);
             bad = 1;
         }
-        if (vw_engine_rank() == 0 && k < NWHAT - 1) printf("invalid w%d: %s: %s\n", workers, what[k], why);
+        if (vw_engine_rank() == 0 && k < NWHAT - 1)
+            printf("invalid w%d: %s: %s\n", workers, what[k], ex_errmsg());
+    }
+    /* Valid spheres and a world vw_world_create refuses: its reason, kept by ex_errmsg
+       (the world is gone). */
+    ex_sphere one = {0, {0.5, 0.5, 0.5}, 0.1};
+    vw_config many = cfg;
+    many.workers = 5000;
+    int64_t pairs = -1, ncomp = -1, label;
+    for (int m = 0; m < 2; m++) {
+        vw_status st = m ? ex_components_label(&one, 1, 0.1, d, &many, &label, &ncomp, NULL)
+                         : ex_pairs_count(&one, 1, 0.1, d, &many, &pairs, NULL);
+        if (st == VW_OK || !strstr(ex_errmsg(), "5000 workers (at most 1024)")) {
+            fprintf(stderr, "invalid w%d: %s, 5000 workers: %s, ex_errmsg \"%s\"\n", workers,
+                    m ? "components" : "pairs", vw_status_message(st), ex_errmsg());
+            bad = 1;
+        }
     }
     vw_decomp_free(d);
     return bad;

@@ -34,13 +34,21 @@ VW_API const char *vw_map_kind_name(vw_map_kind k);
 VW_API vw_status vw_map_kind_parse(const char *s, vw_map_kind *out);
 
 /* Factor n into dims[0]*dims[1]*dims[2] matched to the cell grid cells[3] (as
-   MPI_Dims_create does, but preferring factors that divide the cell counts and the
-   longest cell axes), so that each part is a compact block. */
-VW_API void vw_map_dims(int n, const int cells[3], int dims[3]);
+   MPI_Dims_create does, but preferring factors that divide the cell counts), so that
+   each part is a compact block: of the factorisations that leave no part empty and
+   divide the most sides evenly, the one whose cuts have the least area (within 5 %),
+   then the fewest cell faces. Without sizes the cells are taken as cubes (so the area
+   is the faces cut: the cuts go across the axes of most cells); vw_map_block scores
+   the same way with the grid's real walls. VW_E_INVAL for n < 1 or cells or dims
+   NULL, with dims (if given) 1x1x1 (n < 1 gave {0, 1, 1}). */
+VW_API vw_status vw_map_dims(int n, const int cells[3], int dims[3]);
 
 /* Block mapping: a grid decomposition is cut into nprocs blocks (process grid matched
    to the cell grid) and each block into wpp worker blocks, so that most neighbour
-   traffic stays inside a worker, then inside a process. Non-grid decompositions are
+   traffic stays inside a worker, then inside a process: of the even cuts, the one of
+   least wall area between blocks, from the grid's walls where they are (within 5 %,
+   then the fewest cell faces; the count of faces alone cut 2x2x2 cells of a flat world
+   at its broad horizontal wall). Non-grid decompositions are
    mapped in kd-tree leaf order (cells close in the tree are close in space). No worker
    gets more than ceil(cells / workers) cells, no process more than ceil(cells /
    nprocs), and every worker gets one when there are as many cells as workers: where
@@ -52,7 +60,10 @@ VW_API vw_status vw_map_block(const vw_decomp *d, int nprocs, int wpp, int *cell
    best, one already hosting a face neighbour is preferred. speeds NULL = all equal;
    VW_E_INVAL for a speed that is not positive and finite, or a negative slack. A load
    that is not a positive number (0, negative, NaN) counts as none; cell_load NULL, or
-   no cell with a load, counts every cell alike (1 each). */
+   no cell with a load, counts every cell alike (1 each). A load of +infinity ranks
+   above every finite one: such cells go one to a worker before any gets a second (in
+   order of cell id, each among the workers with fewest of them as above: neighbours,
+   then the lowest worker id), and the finite cells only to the workers with fewest. */
 VW_API vw_status vw_map_greedy(const vw_decomp *d, const double *cell_load, int gworkers,
                                const double *speeds, double slack, int *cell_worker);
 

@@ -1,8 +1,9 @@
 /* map_test.c - the mappers' invariants over many grids and worker counts (src/map/map.c):
  * block gives every worker a cell when the grid has enough, and no worker or process
  * more than runs of cells would; greedy places by the loads it sorts, whatever they
- * are (NaN, none at all). Deterministic counts only; no timings.
- * usage: vw_test_map block|greedy_nan|greedy_zero
+ * are (NaN, none at all); block cuts the least wall area, vw_map_dims refuses n < 1,
+ * greedy spreads cells of infinite load. Deterministic counts only; no timings.
+ * usage: vw_test_map block|greedy_nan|greedy_zero|block_area|dims|greedy_inf
  */
 #include "vw_test.h"
 #include "vwalls/map.h"
@@ -131,12 +132,138 @@ static int t_greedy_zero(void)
     TEST_DONE();
 }
 
+/* The wall area between cells on different workers: each pair of grid neighbours
+   (i, j, k) and the next cell along an axis whose workers differ adds their common
+   face. */
+static double cut_area(const vw_decomp *d, const int *cw)
+{
+    int n[3];
+    vw_decomp_dims(d, n);
+    double area = 0;
+    for (int c = 0; c < n[0] * n[1] * n[2]; c++) {
+        int ix[3] = {c % n[0], (c / n[0]) % n[1], c / (n[0] * n[1])};
+        vw_box b = vw_decomp_cell_box(d, c);
+        for (int a = 0; a < 3; a++) {
+            if (ix[a] + 1 >= n[a]) continue;
+            int step = a == 0 ? 1 : a == 1 ? n[0] : n[0] * n[1];
+            if (cw[c] == cw[c + step]) continue;
+            int y = (a + 1) % 3, z = (a + 2) % 3;
+            area += (b.hi[y] - b.lo[y]) * (b.hi[z] - b.lo[z]);
+        }
+    }
+    return area;
+}
+
+/* Block cuts the least wall area, not the fewest cell faces. 2x2x2 cells of the
+   sphereflake's world (24 x 24 x 1.33) went to 2 and 4 workers cut at the horizontal
+   wall (576) where a vertical one is 32: twice the messages between workers (30048
+   against 10427 at 96x96). And the walls where they are: 4x2x1 cells of a 10 x 1 x 1
+   world with walls at x = 1, 5, 9 on 2 processes of 2 workers, the process blocks
+   [0, 5] and [5, 10] were cut along y (area 5 each, the first of two cuts of 2 faces)
+   where the walls at 1 and 9 are 1. */
+static int t_block_area(void)
+{
+    vw_box flat = {{-12, -12, -0.5}, {12, 12, 0.83}};
+    int dims[3] = {2, 2, 2}, cw[8];
+    vw_decomp *d;
+    CHECK(vw_decomp_create_grid(&flat, dims, &d) == VW_OK);
+    double wall = 24 * 1.33;
+    for (int w = 2; w <= 4; w += 2) {
+        CHECK(vw_map_block(d, 1, w, cw) == VW_OK);
+        double a = cut_area(d, cw);
+        printf("2x2x2 of 24 x 24 x 1.33 on %d workers: cut area %g (%g the least)\n", w, a,
+               (w / 2) * wall);
+        EXPECT(fabs(a - (w / 2) * wall) < 1e-9, "%d workers: cut area %g, not %g", w, a,
+               (w / 2) * wall);
+    }
+    vw_decomp_free(d);
+
+    vw_box box = {{0, 0, 0}, {10, 1, 1}};
+    int dims2[3] = {4, 2, 1}, cw2[8];
+    static const double wx[] = {1, 5, 9}, wy[] = {0.5};
+    const double *walls[3] = {wx, wy, NULL};
+    CHECK(vw_decomp_create_grid_walls(&box, dims2, walls, NULL, &d) == VW_OK);
+    CHECK(vw_map_block(d, 2, 2, cw2) == VW_OK);
+    double a = cut_area(d, cw2);
+    printf("4x2x1 walls at x = 1, 5, 9 on 2 x 2 workers: cut area %g (3 the least)\n", a);
+    EXPECT(fabs(a - 3) < 1e-9, "cut area %g, not 3", a);
+    vw_decomp_free(d);
+    TEST_DONE();
+}
+
+/* vw_map_dims with n < 1 (or no arrays) is refused, and dims are 1x1x1: it gave
+   {0, 1, 1}, a grid of no parts. */
+static int t_dims(void)
+{
+    const int cells[3] = {4, 2, 1};
+    for (int n = -2; n <= 0; n++) {
+        int dims[3] = {7, 7, 7};
+        vw_status st = vw_map_dims(n, cells, dims);
+        printf("vw_map_dims(%d): status %d, %d %d %d\n", n, (int)st, dims[0], dims[1], dims[2]);
+        EXPECT(st == VW_E_INVAL, "n %d: status %d", n, (int)st);
+        EXPECT(dims[0] == 1 && dims[1] == 1 && dims[2] == 1, "n %d: %dx%dx%d", n, dims[0],
+               dims[1], dims[2]);
+    }
+    int dims[3];
+    EXPECT(vw_map_dims(2, NULL, dims) == VW_E_INVAL, "no cells");
+    EXPECT(vw_map_dims(2, cells, NULL) == VW_E_INVAL, "no dims");
+    /* Without sizes cells are cubes: the cut of fewest faces, across the longest side. */
+    EXPECT(vw_map_dims(2, cells, dims) == VW_OK && dims[0] == 2 && dims[1] == 1 &&
+               dims[2] == 1, "4x2x1 on 2: %dx%dx%d", dims[0], dims[1], dims[2]);
+    TEST_DONE();
+}
+
+/* Cells of infinite load go one to a worker before any gets a second, and the finite
+   ones to the workers with fewest infinite cells. A row of 4 infinite cells of 4x4 went
+   all to worker 0 of 4 (every worker's time was infinite once it had one, and the
+   neighbours chose). */
+static int t_greedy_inf(void)
+{
+    vw_box world = {{0, 0, 0}, {1, 1, 1}};
+    int dims[3] = {4, 4, 1}, cw[16];
+    vw_decomp *d;
+    CHECK(vw_decomp_create_grid(&world, dims, &d) == VW_OK);
+    static const double speeds[4] = {1, 1, 2, 4};
+    for (int ninf = 4; ninf <= 6; ninf += 2)
+        for (int s = 0; s < 3; s++) {
+            double load[16];
+            for (int c = 0; c < 16; c++) load[c] = c < ninf ? INFINITY : 1 + c % 3;
+            double slack = s == 1 ? 0.0 : 0.05;
+            const double *sp = s == 2 ? speeds : NULL;
+            CHECK(vw_map_greedy(d, load, 4, sp, slack, cw) == VW_OK);
+            int inf[4] = {0}, fin[4] = {0};
+            for (int c = 0; c < 16; c++) (c < ninf ? inf : fin)[cw[c]]++;
+            printf("%d infinite cells, slack %g%s: infinite %d %d %d %d, finite %d %d %d %d\n",
+                   ninf, slack, sp ? ", speeds 1,1,2,4" : "", inf[0], inf[1], inf[2], inf[3],
+                   fin[0], fin[1], fin[2], fin[3]);
+            int lo = 16, hi = 0;
+            for (int g = 0; g < 4; g++) {
+                if (inf[g] < lo) lo = inf[g];
+                if (inf[g] > hi) hi = inf[g];
+            }
+            EXPECT(hi - lo <= 1, "%d infinite cells spread %d to %d a worker", ninf, lo, hi);
+            for (int g = 0; g < 4; g++)
+                EXPECT(!fin[g] || inf[g] == lo, "worker %d with %d infinite cells got %d finite "
+                       "ones (fewest infinite: %d)", g, inf[g], fin[g], lo);
+            /* the same mapping again: deterministic */
+            int again[16];
+            CHECK(vw_map_greedy(d, load, 4, sp, slack, again) == VW_OK);
+            EXPECT(!memcmp(cw, again, sizeof cw), "a second mapping differs");
+        }
+    vw_decomp_free(d);
+    TEST_DONE();
+}
+
 int main(int argc, char **argv)
 {
     const char *t = argc > 1 ? argv[1] : "";
     if (!strcmp(t, "block")) return t_block();
     if (!strcmp(t, "greedy_nan")) return t_greedy_nan();
     if (!strcmp(t, "greedy_zero")) return t_greedy_zero();
-    fprintf(stderr, "usage: vw_test_map block|greedy_nan|greedy_zero\n");
+    if (!strcmp(t, "block_area")) return t_block_area();
+    if (!strcmp(t, "dims")) return t_dims();
+    if (!strcmp(t, "greedy_inf")) return t_greedy_inf();
+    fprintf(stderr, "usage: vw_test_map block|greedy_nan|greedy_zero|block_area|dims|"
+                    "greedy_inf\n");
     return 2;
 }

@@ -61,3 +61,11 @@ add_test(NAME dynamic_anim_inputs
          COMMAND sh ${PROJECT_SOURCE_DIR}/tests/dynamic/anim_inputs.sh $<TARGET_FILE:vwalls_tool>
                  ${CMAKE_CURRENT_BINARY_DIR}/dynamic_anim_inputs)
 set_tests_properties(dynamic_anim_inputs PROPERTIES TIMEOUT 120)
+
+# What animate / edit count and say: live objects in the stats (a remove drops them),
+# edits apart from invalid lines, the log naming the command of a line that does not
+# parse, 'balance' under --farm all.
+add_test(NAME dynamic_anim_counts
+         COMMAND sh ${PROJECT_SOURCE_DIR}/tests/dynamic/anim_counts.sh $<TARGET_FILE:vwalls_tool>
+                 ${CMAKE_CURRENT_BINARY_DIR}/dynamic_anim_counts)
+set_tests_properties(dynamic_anim_counts PROPERTIES TIMEOUT 120)

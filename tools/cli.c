@@ -573,13 +573,13 @@ int vw_cli_frame_file(const char *pattern, const char *path, long nframes, int *
 }
 
 int vw_cli_check_frames(const char *cmd, const char *pattern, const char *const *opts,
-                        const char *const *paths, int n)
+                        const char *const *paths, int n, long nframes)
 {
     char err[1024] = "";
     vw_status st = VW_OK;
     for (int k = 0; pattern && k < n && st == VW_OK && vw_cli_is_output(); k++) {
         int frame;
-        if (paths[k] && vw_cli_frame_file(pattern, paths[k], 0, &frame)) {
+        if (paths[k] && vw_cli_frame_file(pattern, paths[k], nframes, &frame)) {
             snprintf(err, sizeof err, "%s %s: frame %d of -o %s: one would overwrite the other",
                      opts[k], paths[k], frame, pattern);
             st = VW_E_INPUT;

@@ -117,11 +117,13 @@ int vw_cli_check_scene_files(const char *cmd, const vw_scene *scene, const char 
    not known)? 1 and the number in *frame, else 0. Devices are nobody's frames (0). */
 int vw_cli_frame_file(const char *pattern, const char *path, long nframes, int *frame);
 /* The outputs other than the frames (--log, --stats) against the frame files of
-   pattern (NULL: none): VW_EXIT_OK, or VW_EXIT_USAGE on every process with "vwalls CMD:
-   OPT PATH: frame N of -o PATTERN: one would overwrite the other" printed once.
-   Collective under MPI. */
+   pattern (NULL: none), as vw_cli_frame_file sees them: the frame number each path's
+   name holds, and every frame 0 to nframes-1 (those the run will write, so a link to
+   frame 3 named otherwise is seen; 0 when not known): VW_EXIT_OK, or VW_EXIT_USAGE on
+   every process with "vwalls CMD: OPT PATH: frame N of -o PATTERN: one would overwrite
+   the other" printed once. Collective under MPI. */
 int vw_cli_check_frames(const char *cmd, const char *pattern, const char *const *opts,
-                        const char *const *paths, int n);
+                        const char *const *paths, int n, long nframes);
 
 /* Is this process the one that prints (rank 0, or no MPI)? Valid after vw_cli_engine_init. */
 int vw_cli_is_output(void);

@@ -26,6 +26,8 @@ typedef struct vw_anim_session vw_anim_session;
 typedef struct frame_rec {
     int frame;
     size_t edits, accepted, rejected, records, cells;
+    size_t invalid;              /* lines refused (not parsed, or not applicable): not edits */
+    size_t objects;              /* live objects after the frame's edits (removed ones gone) */
     double apply_s, update_s, build_s, render_s, lambda, work_lambda, balance_s;
     int balanced;
 } frame_rec;
@@ -51,16 +53,43 @@ struct vw_anim_session {
     int frame_errors;            /* vwalls edit's frames not written: exit status 1 */
     frame_rec *frames;
     size_t nframes, capframes;
+    int farm_all_said;           /* FARM_ALL_NOTE printed for --balance */
+    vw_progress bar;             /* animate on a terminal: the script's frames done */
+    long script_frames;          /* the frames the script writes (animate) */
 };
+
+/* The progress bar shares the terminal with the frame lines and the messages: it is
+   wiped before any of them is printed, and drawn again at the next frame. */
+static void bar_hide(const vw_anim_session *s)
+{
+    if (!s->bar.enabled) return;
+    fprintf(stderr, "\r\033[K");
+    fflush(stderr);
+}
+
+/* Under --farm all every worker holds every cell, so the workers share each cell's
+   work whatever the walls, and the balancer, which sees that mapping, has nothing to
+   move (it answered "lambda 1.000 -> 1.000" right after a frame line showing 1.9): on
+   one process the 'balance' command and --balance say so instead of balancing. */
+#define FARM_ALL_NOTE "nothing to balance with --farm all (every worker holds every cell)"
+
+/* Is that so? Under MPI a process holds its own cells only, and the balancer moves
+   the walls between the processes (2x2x1 on two processes: lambda 1.244 -> 1.192). */
+static int farm_all_one_process(vw_anim_session *s)
+{
+    return s->farm == RT_FARM_ALL && vw_world_processes(rt_job_world(rt_anim_job(s->anim))) == 1;
+}
 
 static void say(const vw_anim_session *s, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
 static void say(const vw_anim_session *s, const char *fmt, ...)
 {
     if (!vw_cli_is_output() || s->quiet) return;
+    bar_hide(s);
     va_list ap;
     va_start(ap, fmt);
     vfprintf(stdout, fmt, ap);
     va_end(ap);
+    if (s->bar.enabled) fflush(stdout); /* before the bar is drawn again */
 }
 
 /* An edit's answer: always for vwalls edit (its answers are its output), unless --quiet
@@ -69,6 +98,7 @@ static void tell(const vw_anim_session *s, const char *fmt, ...) __attribute__((
 static void tell(const vw_anim_session *s, const char *fmt, ...)
 {
     if (!vw_cli_is_output() || (s->quiet && !s->interactive)) return;
+    bar_hide(s);
     va_list ap;
     va_start(ap, fmt);
     vfprintf(stdout, fmt, ap);
@@ -94,6 +124,7 @@ static int flush(vw_anim_session *s)
     vw_status rc = rt_anim_apply(s->anim, s->batch, s->nbatch, s->check, s->sweep, res, &st, err,
                                  sizeof err);
     if (rc != VW_OK) {
+        bar_hide(s);
         vw_cli_error(s->cmd, "%s", err);
         s->nbatch = 0;
         return s->failed = 1;
@@ -125,6 +156,7 @@ static int flush(vw_anim_session *s)
             break;
         }
         default:
+            bar_hide(s);
             if (out) fprintf(stderr, "%s:%d: %s\n", s->name, r->edit.line, r->msg);
             if (s->log && out) fprintf(s->log, "%s:%d: %s: invalid: %s\n", s->name, r->edit.line, op, r->msg);
             s->bad_lines++;
@@ -136,6 +168,16 @@ static int flush(vw_anim_session *s)
     return s->failed;
 }
 
+/* The objects alive now: the scene's and the added ones, the removed ones not (the
+   render world keeps a removed object's record slots, empty). */
+static size_t live_objects(vw_anim_session *s)
+{
+    const vw_dynscene *ds = rt_anim_dynscene(s->anim);
+    size_t n = 0;
+    for (int id = 0, ids = vw_dynscene_ids(ds); id < ids; id++) n += vw_dynscene_alive(ds, id) != 0;
+    return n;
+}
+
 static int do_frame(vw_anim_session *s)
 {
     char err[5120] = ""; /* room for a long path and the reason after it */
@@ -143,6 +185,7 @@ static int do_frame(vw_anim_session *s)
     memset(&st, 0, sizeof st);
     vw_status rc = rt_anim_render(s->anim, &st, err, sizeof err);
     if (rc != VW_OK) {
+        bar_hide(s);
         vw_cli_error(s->cmd, "frame %d: %s", s->frame, err);
         return s->failed = 1;
     }
@@ -188,6 +231,7 @@ static int do_frame(vw_anim_session *s)
        one has no room for the record, or the others would wait for it in the next
        edit's collective calls forever. */
     if (vw_engine_agree(wst, err, sizeof err) != VW_OK) {
+        bar_hide(s);
         vw_cli_error(s->cmd, "%s", err);
         /* vwalls edit goes on (every process knows, from the agreement): the session's
            edits are not lost for a frame its user can make room for (a directory removed
@@ -203,8 +247,13 @@ static int do_frame(vw_anim_session *s)
     memset(f, 0, sizeof *f);
     f->frame = s->frame;
     f->accepted = s->acc.accepted;
-    f->rejected = s->acc.collisions + s->acc.sweeps + s->acc.invalid;
+    /* The edits applied: accepted, or rejected by the collision or sweep test. A line
+       refused as invalid (it does not parse, or names no object) is no edit: counted
+       apart. */
+    f->rejected = s->acc.collisions + s->acc.sweeps;
     f->edits = f->accepted + f->rejected;
+    f->invalid = s->acc.invalid;
+    f->objects = live_objects(s);
     f->records = s->acc.records_updated;
     f->cells = st.cells_rebuilt;
     f->apply_s = s->acc.apply_s;
@@ -213,19 +262,27 @@ static int do_frame(vw_anim_session *s)
     f->render_s = st.render_s;
     f->lambda = rt_anim_imbalance(s->anim);
     f->work_lambda = rt_anim_work_imbalance(s->anim);
-    say(s, "frame %d: %zu edits (%zu accepted), %zu records, %zu cells rebuilt; decide %.3f s, "
+    char inv[64] = "";
+    if (f->invalid) snprintf(inv, sizeof inv, ", %zu invalid line%s", f->invalid, f->invalid == 1 ? "" : "s");
+    say(s, "frame %d: %zu edits (%zu accepted)%s, %zu records, %zu cells rebuilt; decide %.3f s, "
            "update %.3f s, build %.3f s, render %.3f s, lambda %.3f (work %.3f)\n",
-        s->frame, f->edits, f->accepted, f->records, f->cells, f->apply_s, f->update_s, f->build_s,
-        f->render_s, f->lambda, f->work_lambda);
+        s->frame, f->edits, f->accepted, inv, f->records, f->cells, f->apply_s,
+        f->update_s, f->build_s, f->render_s, f->lambda, f->work_lambda);
     memset(&s->acc, 0, sizeof s->acc);
     s->frame++;
     /* Between frames: rebalance when the frame just rendered was uneven enough. */
     double lam = s->trigger_work ? f->work_lambda : f->lambda;
-    if (s->strategy && strcmp(s->strategy, "none") && lam > 1.0 + s->threshold) {
+    if (s->strategy && strcmp(s->strategy, "none") && lam > 1.0 + s->threshold && farm_all_one_process(s)) {
+        /* Every worker holds every cell: the balancer sees a mapping it cannot improve
+           (it said "lambda 1.000 -> 1.000" after a frame line showing 1.9); said once. */
+        if (!s->farm_all_said) say(s, "  --balance %s: " FARM_ALL_NOTE ": walls unchanged\n", s->strategy);
+        s->farm_all_said = 1;
+    } else if (s->strategy && strcmp(s->strategy, "none") && lam > 1.0 + s->threshold) {
         double before = 0, pred = 0, t0 = vw_cli_now();
         rc = rt_anim_balance(s->anim, s->strategy, &before, &pred, err, sizeof err);
         f->balance_s = vw_cli_now() - t0;
         if (rc != VW_OK) {
+            bar_hide(s);
             vw_cli_error(s->cmd, "%s", err);
             return s->failed = rc == VW_E_INVAL ? 2 : 1;
         }
@@ -233,7 +290,30 @@ static int do_frame(vw_anim_session *s)
         say(s, "  rebalanced (%s): lambda %.3f -> %.3f predicted, %.3f s\n", s->strategy, before,
             pred, f->balance_s);
     }
+    if (s->script_frames > 0) {
+        char note[64];
+        snprintf(note, sizeof note, "frame %zu/%ld", s->nframes, s->script_frames);
+        vw_progress_update(&s->bar, (double)s->nframes / (double)s->script_frames, note);
+    }
     return 0;
+}
+
+/* The command a line's first word names (the language's own spelling), or NULL when it
+   names none (a blank line, an unknown word: the parser's message quotes it). For the
+   log of a line that does not parse, which names its command like that of one refused
+   when applied. */
+static const char *line_command(const char *line, size_t len)
+{
+    const char *end = line + len;
+    while (line < end && *line && strchr(" \t\v\f", *line)) line++; /* vw_edit_parse's blanks */
+    const char *w = line;
+    while (line < end && *line && !strchr(" \t\v\f\r\n#", *line)) line++;
+    size_t n = (size_t)(line - w);
+    for (int op = VW_EDIT_NONE + 1; op <= VW_EDIT_BALANCE; op++) {
+        const char *name = op_name((vw_edit_op)op);
+        if (n && strlen(name) == n && !memcmp(name, w, n)) return name;
+    }
+    return NULL;
 }
 
 /* Parses one line of the language (len bytes); a line that does not parse is reported
@@ -251,13 +331,16 @@ static vw_status parse_line(vw_anim_session *s, const char *line, size_t len, in
     }
     if (pst == VW_OK) return VW_OK;
     int out = vw_cli_is_output();
+    bar_hide(s);
     if (out) fprintf(stderr, "%s\n", err);
     if (s->log && out) {
         /* The message after its "name:line: ", in the log's own format. */
         char prefix[64];
         int k = snprintf(prefix, sizeof prefix, ":%d: ", lineno);
         const char *why = strstr(err, prefix);
-        fprintf(s->log, "%s:%d: invalid: %s\n", s->name, lineno, why ? why + k : err);
+        const char *cmd = line_command(line, len);
+        fprintf(s->log, "%s:%d: %s%sinvalid: %s\n", s->name, lineno, cmd ? cmd : "", cmd ? ": " : "",
+                why ? why + k : err);
     }
     s->acc.invalid++;
     s->total_invalid++;
@@ -297,10 +380,15 @@ static int session_line(vw_anim_session *s, const char *line, size_t len, int li
         break;
     case VW_EDIT_BALANCE: {
         if (flush(s)) break;
+        if (farm_all_one_process(s)) { /* nothing the balancer can do (FARM_ALL_NOTE) */
+            say(s, "balance: " FARM_ALL_NOTE ": walls unchanged\n");
+            break;
+        }
         double before = 0, pred = 0;
         vw_status rc = rt_anim_balance(s->anim, s->strategy && strcmp(s->strategy, "none") ? s->strategy : "tensor",
                                        &before, &pred, err, sizeof err);
         if (rc != VW_OK) {
+            bar_hide(s);
             if (vw_cli_is_output()) fprintf(stderr, "%s:%d: balance: %s\n", s->name, lineno, err);
             if (rc != VW_E_UNSUPPORTED && !s->interactive) s->failed = 1;
         } else if (before == 0) { /* the loads were reset by a rebalance: 1 -> 1 said nothing */
@@ -350,12 +438,12 @@ static void help(const char *cmd)
     if (strcmp(cmd, "edit")) /* edit answers every line and goes on */
         printf("  --keep-going     report bad lines and go on instead of stopping\n"
                "                   (the exit status is still 2)\n");
-    printf("  --log FILE       every edit's outcome, one line each\n"
+    printf("  --log FILE       every edit's and invalid line's outcome, one line each\n"
            "  --stats FILE     the stats JSON, with an \"animation\" member (per frame)\n"
            "  --full-rebuild   rebuild every cell at every frame (the benchmark's baseline)\n"
            "  --brute-force    decide with the O(n^2) reference instead of the cells\n"
            "  -q, --quiet      no banner, frame lines or summary (animate: no rejections\n"
-           "                   either; edit always answers every edit)\n"
+           "                   or progress bar either; edit always answers every edit)\n"
            "  --help           this text\n"
            "The outputs (the frames, --log, --stats) must be files other than each other and\n"
            "the inputs (devices like /dev/null excepted); \"-\" is not standard output.\n"
@@ -364,23 +452,26 @@ static void help(const char *cmd)
            "they are reached), 1 other.\n");
 }
 
-static char *frames_json(const vw_anim_session *s)
+static char *frames_json(vw_anim_session *s)
 {
     char *j = NULL;
     size_t n = 0, cap = 0;
     int ok = vw_cli_appendf(&j, &n, &cap,
                             "\"animation\": {\"frames\": %zu, \"accepted\": %zu, \"collisions\": %zu, "
-                            "\"sweeps\": %zu, \"invalid\": %zu, \"farm\": \"%s\", \"per_frame\": [",
+                            "\"sweeps\": %zu, \"invalid\": %zu, \"objects\": %zu, \"farm\": \"%s\", "
+                            "\"per_frame\": [",
                             s->nframes, s->total_acc, s->total_coll, s->total_sweep, s->total_invalid,
-                            rt_farm_name(s->farm));
+                            live_objects(s), rt_farm_name(s->farm));
     for (size_t i = 0; ok && i < s->nframes; i++) {
         const frame_rec *f = &s->frames[i];
         ok = vw_cli_appendf(&j, &n, &cap,
-                            "%s\n    {\"frame\": %d, \"edits\": %zu, \"accepted\": %zu, \"records\": %zu, "
+                            "%s\n    {\"frame\": %d, \"edits\": %zu, \"accepted\": %zu, \"invalid\": %zu, "
+                            "\"objects\": %zu, \"records\": %zu, "
                             "\"cells_rebuilt\": %zu, \"decide_s\": %.6f, \"update_s\": %.6f, "
                             "\"build_s\": %.6f, \"render_s\": %.6f, \"lambda\": %.4f, "
                             "\"work_lambda\": %.4f, \"balanced\": %d, \"balance_s\": %.6f}",
-                            i ? "," : "", f->frame, f->edits, f->accepted, f->records, f->cells,
+                            i ? "," : "", f->frame, f->edits, f->accepted, f->invalid, f->objects,
+                            f->records, f->cells,
                             f->apply_s, f->update_s, f->build_s, f->render_s, f->lambda,
                             f->work_lambda, f->balanced, f->balance_s);
     }
@@ -700,7 +791,7 @@ int vw_anim_main(const char *cmd, int argc, char **argv)
         int crc = vw_cli_check_files(cmd, inputs, opts, paths, 3);
         /* ... and neither is one of the frames: --log f00.png with -o f%02d.png
            replaced frame 0 by the log at the end. */
-        if (crc == VW_EXIT_OK) crc = vw_cli_check_frames(cmd, s->pattern, opts + 1, paths + 1, 2);
+        if (crc == VW_EXIT_OK) crc = vw_cli_check_frames(cmd, s->pattern, opts + 1, paths + 1, 2, 0);
         if (crc != VW_EXIT_OK) {
             rc = crc;
             goto done;
@@ -750,7 +841,13 @@ int vw_anim_main(const char *cmd, int argc, char **argv)
                 for (int k = 0; !seen && k < nin; k++) seen = !strcmp(in[k], lib);
                 if (!seen) in[nin++] = lib;
             }
-            crc = frames_spare_inputs(cmd, s->pattern, in, nin, script_frames(s, &ed));
+            long nframes = s->script_frames = script_frames(s, &ed);
+            crc = frames_spare_inputs(cmd, s->pattern, in, nin, nframes);
+            /* ... and neither --stats nor --log is one of the frames the script writes,
+               whatever its name says (a link to frame 3 named s.json; above, only the
+               number a name holds was known). */
+            if (crc == VW_EXIT_OK && nframes > 0)
+                crc = vw_cli_check_frames(cmd, s->pattern, opts, paths, 2, nframes);
         }
         free(in);
         if (crc != VW_EXIT_OK) {
@@ -784,6 +881,10 @@ int vw_anim_main(const char *cmd, int argc, char **argv)
             vw_dynscene_ids(rt_anim_dynscene(s->anim)));
         fflush(stdout); /* a program driving edit waits for it */
     }
+    /* animate on a terminal: a bar over the script's frames (vwalls edit's are not known,
+       and its answers are its output). */
+    vw_progress_begin(&s->bar, cmd, s->quiet || s->interactive || s->script_frames <= 0
+                                         ? VW_PROGRESS_OFF : VW_PROGRESS_AUTO);
     int read_error = 0;
     int stop = 0;
     if (ed.text && !s->keep_going && precheck(s, &ed)) stop = s->failed = 2;
@@ -800,6 +901,8 @@ int vw_anim_main(const char *cmd, int argc, char **argv)
         if (s->interactive) fflush(stdout);
     }
     if (!s->failed) flush(s);
+    vw_progress_end(&s->bar);
+    s->bar.enabled = 0;
     if (read_error && !s->failed) {
         vw_cli_error(cmd, "cannot read 'stdin': %s", strerror(read_error));
         s->failed = 1;

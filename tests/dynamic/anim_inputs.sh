@@ -42,6 +42,29 @@ printf 'frame\nframe\nframe\n' > three.txt
 "$V" animate scene.nff three.txt -o 'lk%d.png' --quiet || fail "three frames, the fourth linked: status $?"
 [ -s lk2.png ] && cmp -s scene.nff scene.orig || fail "three frames, the fourth linked: frames or scene"
 
+# --stats and --log against every frame the script writes, whatever their names say: a
+# link (symbolic or hard) to frame 3 of a run before, named otherwise, and a name that
+# holds another frame's number (they were checked at the number their name holds only).
+printf 'frame\nframe\nframe\nframe\nframe\n' > five.txt
+"$V" animate scene.nff five.txt -o 'pf%04d.png' --quiet || fail "five frames: status $?"
+cp pf0003.png pf3.orig
+ln -s pf0003.png sl.json
+ln pf0003.png hl.log
+ln -s pf0002.png sl0007.json
+for opt in "--stats sl.json" "--log hl.log" "--stats sl0007.json"; do
+  rm -f pf0000.png
+  # shellcheck disable=SC2086
+  "$V" animate scene.nff five.txt -o 'pf%04d.png' --quiet $opt 2> err.txt; rc=$?
+  [ $rc -eq 2 ] || fail "$opt, a link to a frame: status $rc, expected 2"
+  grep -q "^vwalls animate: $opt: frame [23] of -o pf%04d.png: one would overwrite the other$" err.txt ||
+    fail "$opt, a link to a frame: message: $(cat err.txt)"
+  [ -e pf0000.png ] && fail "$opt, a link to a frame: frame 0 was written"
+  cmp -s pf0003.png pf3.orig || fail "$opt: frame 3 changed"
+done
+# Four frames do not reach frame 4; a link to frame 4 is no frame of theirs.
+ln -s pf0004.png sfour.json
+"$V" animate scene.nff four.txt -o 'pf%04d.png' --quiet --stats sfour.json || fail "four frames, --stats a link to frame 4: status $?"
+
 # vwalls edit: the frame number an input's name holds (its frames are not known ahead).
 ln -s scene.nff ed0.png
 echo frame | "$V" edit scene.nff -o 'ed%d.png' --quiet > /dev/null 2> err.txt; rc=$?

@@ -45,6 +45,7 @@
 #include <unistd.h>
 #include "vw_test.h"
 #include "vwalls/vwalls.h"
+#include "core/run_child.h"
 
 typedef struct obj {
     double p[3];
@@ -466,27 +467,8 @@ int main(int argc, char **argv)
                line, from one worker (the lines of several were interleaved and cut). */
             int tries = !strcmp(mode, "count-all") ? 20 : 1;
             for (int t = 0; t < tries; t++) {
-            int fd[2];
-            CHECK(pipe(fd) == 0);
-            fflush(NULL);
-            pid_t pid = fork();
-            CHECK(pid >= 0);
-            if (pid == 0) {
-                dup2(fd[1], 2);
-                close(fd[0]);
-                vw_world_run(w); /* the mistake stops the process in here */
-                fprintf(stderr, "the mistake went unnoticed\n");
-                _exit(0);
-            }
-            close(fd[1]);
             char err[1024];
-            size_t n = 0;
-            ssize_t k;
-            while (n < sizeof err - 1 && (k = read(fd[0], err + n, sizeof err - 1 - n)) > 0) n += (size_t)k;
-            err[n] = 0;
-            close(fd[0]);
-            int status;
-            CHECK(waitpid(pid, &status, 0) == pid);
+            int status = run_in_child(w, err, sizeof err);
             printf("%s: %s", mode, err);
             CHECK(WIFSIGNALED(status) && WTERMSIG(status) == SIGABRT);
             CHECK(argc > 2 && strstr(err, argv[2]) != NULL);

@@ -300,7 +300,7 @@ vw_status ex_components_label(const ex_sphere *s, size_t n, double rmax, const v
     clock_gettime(CLOCK_MONOTONIC, &t[3]);
     const int dummy = 0;
     for (int c = 0; st == VW_OK && c < vw_decomp_cell_count(d); c++)
-        st = vw_world_post(w, c, MSG_REPORT, &dummy);
+        st = VW_WORLD_POST(w, c, MSG_REPORT, dummy);
     if (st == VW_OK) st = vw_world_run(w);       /* final labels to the output process */
     clock_gettime(CLOCK_MONOTONIC, &t[4]);
     ex__world_failed(st, w);

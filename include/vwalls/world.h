@@ -132,6 +132,13 @@ VW_API vw_status vw_world_commit(vw_world *w);
    NULL for a kind of size 0. An unknown cell or kind, a kind without handle, or a NULL
    msg for a kind of size > 0 is VW_E_INVAL with a message. */
 VW_API vw_status vw_world_post(vw_world *w, int cell, int kind, const void *msg);
+/* The same, told the size of the record msg points to (module.h, sized sends): a size
+   other than the kind's is VW_E_INVAL with a message naming both, nothing posted.
+   VW_WORLD_POST(w, cell, kind, rec) passes &(rec) and sizeof(rec); a signal (a kind of
+   size 0) is posted with msg NULL and size 0. */
+VW_API vw_status vw_world_post_sized(vw_world *w, int cell, int kind, const void *msg, size_t size);
+#define VW_WORLD_POST(w, cell, kind, rec) \
+    vw_world_post_sized((w), (cell), (kind), &(rec), sizeof(rec))
 /* Runs every cell to quiescence (no message in flight, every step() idle); commits
    first when objects or the decomposition changed since the last commit. A run that a
    callback failed (vw_ctx_fail, module.h) or that could not allocate a packet drops

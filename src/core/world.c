@@ -917,6 +917,18 @@ vw_status vw_world_commit(vw_world *w)
     return VW_OK;
 }
 
+vw_status vw_world_post_sized(vw_world *w, int cell, int kind, const void *msg, size_t size)
+{
+    if (!w) return VW_E_INVAL;
+    vw__world_begin_step(w); /* (from a callback: stops the process, naming this call) */
+    /* An unknown kind is left to vw_world_post to report. */
+    if (kind >= 0 && kind < w->m->nkinds && w->m->kinds[kind].size != size)
+        return vw__world_error(w, VW_E_INVAL, "posted a record of %zu bytes for message kind %d "
+                               "('%s'), whose size is %zu bytes", size, kind,
+                               w->m->kinds[kind].name, w->m->kinds[kind].size);
+    return vw_world_post(w, cell, kind, msg);
+}
+
 vw_status vw_world_post(vw_world *w, int cell, int kind, const void *msg)
 {
     if (!w) return VW_E_INVAL;

@@ -4,7 +4,9 @@
  *            each of the five macros, a record through a pointer (*p), and a signal
  *            (size 0, no buffer); every message arrives whole, as many as the plain
  *            sends deliver, and a point outside the world is dropped as by
- *            vw_send_point
+ *            vw_send_point; before the run, VW_WORLD_POST posts a record of the kind's
+ *            size and vw_world_post_sized a signal, and refuses (VW_E_INVAL, a message
+ *            naming both sizes, nothing posted) a record short or long
  *   cell-small | cell-large | pointer | point | point-outside | face | face-wall |
  *   neighbours | output | signal
  *            a record whose size is not the kind's (smaller: every message was cut
@@ -43,7 +45,7 @@ typedef struct rec_long { /* 40 bytes: the record one field long */
     double extra;
 } rec_long;
 
-enum { TAG_CELL, TAG_POINT, TAG_FACE, TAG_NEIGHBOURS, TAG_POINTER, NTAGS };
+enum { TAG_CELL, TAG_POINT, TAG_FACE, TAG_NEIGHBOURS, TAG_POINTER, TAG_POST, NTAGS };
 
 static const char *mode;
 static int got[NTAGS], got_bad, got_signals, got_out, out_bad;
@@ -178,7 +180,22 @@ int main(int argc, char **argv)
     obj o = {{0.5, 0.5, 0.5}};
     CHECK(vw_world_add_objects(w, &o, 1) == VW_OK);
     if (!strcmp(mode, "ok")) {
+        /* Posts: the record of the kind's size and a signal go; one short or long is
+           refused with a message, nothing posted. */
+        rec r = make(9, TAG_POST);
+        rec_short rs = {{1, 2, 3}};
+        rec_long rl = {make(9, TAG_POST), 4};
+        CHECK_EQ_INT(VW_WORLD_POST(w, 3, MSG_REC, r), VW_OK);
+        CHECK_EQ_INT(VW_WORLD_POST(w, 3, MSG_REC, rs), VW_E_INVAL);
+        printf("post: %s\n", vw_world_errmsg(w));
+        CHECK(strstr(vw_world_errmsg(w), "posted a record of 24 bytes for message kind 0 ('rec'), "
+                                         "whose size is 32 bytes") != NULL);
+        CHECK_EQ_INT(VW_WORLD_POST(w, 2, MSG_REC, rl), VW_E_INVAL);
+        CHECK(strstr(vw_world_errmsg(w), "posted a record of 40 bytes") != NULL);
+        CHECK_EQ_INT(vw_world_post_sized(w, 1, MSG_SIGNAL, NULL, 0), VW_OK);
+        CHECK_EQ_INT(vw_world_post_sized(w, 1, MSG_SIGNAL, &r, sizeof r), VW_E_INVAL);
         CHECK_EQ_INT(vw_world_run(w), VW_OK);
+        CHECK_EQ_INT(got[TAG_POST], 1);
         for (int c = 0; c < 4; c++) {
             CHECK_EQ_INT(point_in[c], 0);
             CHECK_EQ_INT(point_out[c], -1);
@@ -191,7 +208,7 @@ int main(int argc, char **argv)
         CHECK_EQ_INT(got[TAG_FACE], 2);
         CHECK_EQ_INT(got[TAG_NEIGHBOURS], 8);
         CHECK_EQ_INT(got[TAG_POINTER], 4);
-        CHECK_EQ_INT(got_signals, 4);
+        CHECK_EQ_INT(got_signals, 5); /* four sent, one posted */
         CHECK_EQ_INT(got_out, 4);
         CHECK_EQ_INT(out_bad, 0);
     } else {

@@ -528,6 +528,19 @@ int vw_cli_check_scene_files(const char *cmd, const vw_scene *scene, const char 
     return rc;
 }
 
+/* Is frame n of pattern the file out? */
+static int frame_is(const char *pattern, long n, const file_id *out)
+{
+    char name[4096];
+    file_id id;
+    /* The pattern has exactly one integer conversion (vw_cli_frame_pattern). */
+    int w = snprintf(name, sizeof name, pattern, (int)n);
+    if (w < 0 || (size_t)w >= sizeof name || !file_identify(name, &id)) return 0;
+    int same = file_same(out, &id);
+    free(id.path);
+    return same;
+}
+
 int vw_cli_frame_file(const char *pattern, const char *path, long nframes, int *frame)
 {
     file_id out;
@@ -544,30 +557,12 @@ int vw_cli_frame_file(const char *pattern, const char *path, long nframes, int *
             long n = 0;
             for (size_t k = i; k < j; k++) n = 10 * n + (path[k] - '0');
             if (n > INT_MAX) break;
-            char name[4096];
-            file_id id;
-            /* The pattern has exactly one integer conversion (vw_cli_frame_pattern). */
-            int w = snprintf(name, sizeof name, pattern, (int)n);
-            if (w < 0 || (size_t)w >= sizeof name || !file_identify(name, &id)) continue;
-            if (file_same(&out, &id)) {
-                found = 1;
-                if (frame) *frame = (int)n;
-            }
-            free(id.path);
+            if ((found = frame_is(pattern, n, &out)) && frame) *frame = (int)n;
         }
     }
     /* And the frames a run will write, whatever the name says (a link named otherwise). */
-    for (long f = 0; !found && f < nframes && f <= INT_MAX; f++) {
-        char name[4096];
-        file_id id;
-        int w = snprintf(name, sizeof name, pattern, (int)f);
-        if (w < 0 || (size_t)w >= sizeof name || !file_identify(name, &id)) continue;
-        if (file_same(&out, &id)) {
-            found = 1;
-            if (frame) *frame = (int)f;
-        }
-        free(id.path);
-    }
+    for (long f = 0; !found && f < nframes && f <= INT_MAX; f++)
+        if ((found = frame_is(pattern, f, &out)) && frame) *frame = (int)f;
     free(out.path);
     return found;
 }

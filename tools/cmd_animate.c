@@ -272,12 +272,13 @@ static int do_frame(vw_anim_session *s)
     s->frame++;
     /* Between frames: rebalance when the frame just rendered was uneven enough. */
     double lam = s->trigger_work ? f->work_lambda : f->lambda;
-    if (s->strategy && strcmp(s->strategy, "none") && lam > 1.0 + s->threshold && farm_all_one_process(s)) {
+    int rebalance = s->strategy && strcmp(s->strategy, "none") && lam > 1.0 + s->threshold;
+    if (rebalance && farm_all_one_process(s)) {
         /* Every worker holds every cell: the balancer sees a mapping it cannot improve
            (it said "lambda 1.000 -> 1.000" after a frame line showing 1.9); said once. */
         if (!s->farm_all_said) say(s, "  --balance %s: " FARM_ALL_NOTE ": walls unchanged\n", s->strategy);
         s->farm_all_said = 1;
-    } else if (s->strategy && strcmp(s->strategy, "none") && lam > 1.0 + s->threshold) {
+    } else if (rebalance) {
         double before = 0, pred = 0, t0 = vw_cli_now();
         rc = rt_anim_balance(s->anim, s->strategy, &before, &pred, err, sizeof err);
         f->balance_s = vw_cli_now() - t0;

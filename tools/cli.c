@@ -643,12 +643,14 @@ void vw_progress_update(vw_progress *p, double fraction, const char *note)
     fflush(stderr);
 }
 
-void vw_progress_end(vw_progress *p)
+void vw_progress_hide(const vw_progress *p)
 {
     if (!p->enabled) return;
     fprintf(stderr, "\r\033[K");
     fflush(stderr);
 }
+
+void vw_progress_end(vw_progress *p) { vw_progress_hide(p); }
 
 int vw_cli_appendf(char **buf, size_t *len, size_t *cap, const char *fmt, ...)
 {

@@ -203,6 +203,8 @@ enum { VW_PROGRESS_OFF = -1, VW_PROGRESS_AUTO = 0, VW_PROGRESS_ON = 1 };
 void vw_progress_begin(vw_progress *p, const char *label, int show);
 void vw_progress_update(vw_progress *p, double fraction, const char *note);
 void vw_progress_end(vw_progress *p);
+/* Wipes the bar for a line of text; the next update draws it again. */
+void vw_progress_hide(const vw_progress *p);
 
 double vw_cli_now(void);
 /* How many processes of the job run on this host (the launcher's environment; 1 when

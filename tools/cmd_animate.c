@@ -59,13 +59,8 @@ struct vw_anim_session {
 };
 
 /* The progress bar shares the terminal with the frame lines and the messages: it is
-   wiped before any of them is printed, and drawn again at the next frame. */
-static void bar_hide(const vw_anim_session *s)
-{
-    if (!s->bar.enabled) return;
-    fprintf(stderr, "\r\033[K");
-    fflush(stderr);
-}
+   wiped (vw_progress_hide) before any of them is printed, and drawn again at the next
+   frame. */
 
 /* Under --farm all every worker holds every cell, so the workers share each cell's
    work whatever the walls, and the balancer, which sees that mapping, has nothing to
@@ -84,7 +79,7 @@ static void say(const vw_anim_session *s, const char *fmt, ...) __attribute__((f
 static void say(const vw_anim_session *s, const char *fmt, ...)
 {
     if (!vw_cli_is_output() || s->quiet) return;
-    bar_hide(s);
+    vw_progress_hide(&s->bar);
     va_list ap;
     va_start(ap, fmt);
     vfprintf(stdout, fmt, ap);
@@ -98,7 +93,7 @@ static void tell(const vw_anim_session *s, const char *fmt, ...) __attribute__((
 static void tell(const vw_anim_session *s, const char *fmt, ...)
 {
     if (!vw_cli_is_output() || (s->quiet && !s->interactive)) return;
-    bar_hide(s);
+    vw_progress_hide(&s->bar);
     va_list ap;
     va_start(ap, fmt);
     vfprintf(stdout, fmt, ap);
@@ -124,7 +119,7 @@ static int flush(vw_anim_session *s)
     vw_status rc = rt_anim_apply(s->anim, s->batch, s->nbatch, s->check, s->sweep, res, &st, err,
                                  sizeof err);
     if (rc != VW_OK) {
-        bar_hide(s);
+        vw_progress_hide(&s->bar);
         vw_cli_error(s->cmd, "%s", err);
         s->nbatch = 0;
         return s->failed = 1;
@@ -156,7 +151,7 @@ static int flush(vw_anim_session *s)
             break;
         }
         default:
-            bar_hide(s);
+            vw_progress_hide(&s->bar);
             if (out) fprintf(stderr, "%s:%d: %s\n", s->name, r->edit.line, r->msg);
             if (s->log && out) fprintf(s->log, "%s:%d: %s: invalid: %s\n", s->name, r->edit.line, op, r->msg);
             s->bad_lines++;
@@ -185,7 +180,7 @@ static int do_frame(vw_anim_session *s)
     memset(&st, 0, sizeof st);
     vw_status rc = rt_anim_render(s->anim, &st, err, sizeof err);
     if (rc != VW_OK) {
-        bar_hide(s);
+        vw_progress_hide(&s->bar);
         vw_cli_error(s->cmd, "frame %d: %s", s->frame, err);
         return s->failed = 1;
     }
@@ -231,7 +226,7 @@ static int do_frame(vw_anim_session *s)
        one has no room for the record, or the others would wait for it in the next
        edit's collective calls forever. */
     if (vw_engine_agree(wst, err, sizeof err) != VW_OK) {
-        bar_hide(s);
+        vw_progress_hide(&s->bar);
         vw_cli_error(s->cmd, "%s", err);
         /* vwalls edit goes on (every process knows, from the agreement): the session's
            edits are not lost for a frame its user can make room for (a directory removed
@@ -283,7 +278,7 @@ static int do_frame(vw_anim_session *s)
         rc = rt_anim_balance(s->anim, s->strategy, &before, &pred, err, sizeof err);
         f->balance_s = vw_cli_now() - t0;
         if (rc != VW_OK) {
-            bar_hide(s);
+            vw_progress_hide(&s->bar);
             vw_cli_error(s->cmd, "%s", err);
             return s->failed = rc == VW_E_INVAL ? 2 : 1;
         }
@@ -332,7 +327,7 @@ static vw_status parse_line(vw_anim_session *s, const char *line, size_t len, in
     }
     if (pst == VW_OK) return VW_OK;
     int out = vw_cli_is_output();
-    bar_hide(s);
+    vw_progress_hide(&s->bar);
     if (out) fprintf(stderr, "%s\n", err);
     if (s->log && out) {
         /* The message after its "name:line: ", in the log's own format. */
@@ -389,7 +384,7 @@ static int session_line(vw_anim_session *s, const char *line, size_t len, int li
         vw_status rc = rt_anim_balance(s->anim, s->strategy && strcmp(s->strategy, "none") ? s->strategy : "tensor",
                                        &before, &pred, err, sizeof err);
         if (rc != VW_OK) {
-            bar_hide(s);
+            vw_progress_hide(&s->bar);
             if (vw_cli_is_output()) fprintf(stderr, "%s:%d: balance: %s\n", s->name, lineno, err);
             if (rc != VW_E_UNSUPPORTED && !s->interactive) s->failed = 1;
         } else if (before == 0) { /* the loads were reset by a rebalance: 1 -> 1 said nothing */

@@ -50,6 +50,14 @@ add_test(NAME install_man_options
                  ${PROJECT_SOURCE_DIR}/docs/man/vwalls.1)
 set_tests_properties(install_man_options PROPERTIES LABELS "install;docs")
 
+# The other way: every vwalls command the docs show (README.md, BENCHMARKS.md, docs/*.md
+# and the man page) is one the program takes: its subcommand, its options as --help
+# shows them, and its arguments as the command reads them; `./run X` and bench/NAME.sh too.
+add_test(NAME docs_commands
+         COMMAND sh ${PROJECT_SOURCE_DIR}/tests/install/doc_commands.sh $<TARGET_FILE:vwalls_tool>
+                 ${PROJECT_SOURCE_DIR})
+set_tests_properties(docs_commands PROPERTIES LABELS "install;docs")
+
 # The C shown in docs/tutorial.md is the C that tests/examples.cmake builds and runs.
 file(GLOB _vw_tutorial_sources ${PROJECT_SOURCE_DIR}/docs/tutorial/*.c ${PROJECT_SOURCE_DIR}/docs/tutorial/*.h)
 add_test(NAME docs_tutorial_snippets

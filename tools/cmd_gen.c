@@ -33,8 +33,8 @@ static void gen_usage(FILE *f)
             "  --cluster F       fraction of spheres in the cluster region, 0..1 (default 0)\n"
             "                    (an option the scene has no use for is an error)\n"
             "  --resolution WxH  camera resolution (default 512x512)\n"
-            "  -o FILE.nff       write to FILE.nff (atomically) instead of stdout; under mpirun\n"
-            "                    the first process alone writes it\n"
+            "  -o, --output FILE write to FILE, a .nff name (atomically), instead of stdout;\n"
+            "                    under mpirun the first process alone writes it\n"
             "  --stats FILE      the stats JSON: the generator, its parameters, the scene's\n"
             "                    counts and bounds, the time taken\n"
             "  --help            this text\n"
@@ -110,7 +110,7 @@ int vw_cmd_gen(int argc, char **argv)
             if (!(v = vw_cli_value(cmd, argc, argv, &i)) ||
                 vw_cli_size(cmd, a, v, &p.width, &p.height))
                 return VW_EXIT_USAGE;
-        } else if (!strcmp(a, "-o")) {
+        } else if (!strcmp(a, "-o") || !strcmp(a, "--output")) {
             if (!(out = vw_cli_output(cmd, argc, argv, &i)))
                 return VW_EXIT_USAGE;
         } else if (!strcmp(a, "--stats")) {

@@ -29,7 +29,7 @@ static void help(void)
            "convert it to OBJ+MTL or NFF and give it one. Spheres and cones are meshed as\n"
            "fixed facets (a sphere 16 x 8, a cone 16 around). At least one output: -o,\n"
            "--csv, --image, --stats, --trace or --checkpoint.\n"
-           "  -o FILE.ply          vertex-coloured mesh of the solution\n"
+           "  -o, --output FILE    vertex-coloured mesh of the solution (.ply)\n"
            "  --cells L            layout of cells, like 2x2x2 (default: 1 on one worker, else\n"
            "                       at least 4 cells a worker: 2x2x2 for 2 workers)\n"
            "  --workers W          worker threads per process (default: the cores it may run\n"
@@ -78,7 +78,7 @@ static void help(void)
            "  --max-rounds N       stop after N rounds as if killed: only --checkpoint is\n"
            "                       written (tests)\n"
            "  --progress           the progress bar even when stderr is no terminal (mpirun)\n"
-           "  --quiet              no progress bar and no summary\n"
+           "  -q, --quiet          no progress bar and no summary\n"
            "  --help               this text\n"
            "\nexit status: 0 success, 2 bad input or usage, 1 any other failure\n",
            RAD_MAX_RES, RAD_STALL_SHOTS);
@@ -248,11 +248,11 @@ int vw_cmd_radiosity(int argc, char **argv)
         if (!strcmp(a, "--help") || !strcmp(a, "-h")) {
             help();
             return VW_EXIT_OK;
-        } else if (!strcmp(a, "--quiet")) {
+        } else if (!strcmp(a, "--quiet") || !strcmp(a, "-q")) {
             o.quiet = 1;
         } else if (!strcmp(a, "--progress")) {
             progress = 1;
-        } else if (!strcmp(a, "-o")) {
+        } else if (!strcmp(a, "-o") || !strcmp(a, "--output")) {
             OUTPUT();
             r.out = v;
         } else if (!strcmp(a, "--cells")) {

@@ -54,6 +54,13 @@ done
 "$V" radiosity "$T/cornell.nff" --image "$T/v.png" --view 278,273,-800,278,273,0,179.5 --size 8x8 \
   --max-shots 4 --quiet 2>"$T/err" && [ -s "$T/v.png" ] || fail "--view FOV 179.5: $(cat "$T/err")"
 rm -f "$T/v.png"
+# The short and long spellings every other command takes: -q and --output (radiosity
+# took only --quiet and -o), and gen's --output.
+"$V" radiosity "$T/cornell.nff" --output "$T/q.ply" -q --max-shots 4 >"$T/out" 2>"$T/err" \
+  && [ -s "$T/q.ply" ] && [ ! -s "$T/out" ] || fail "--output/-q: $(cat "$T/err" "$T/out")"
+"$V" gen cornell --output "$T/g.nff" 2>"$T/err" && "$V" gen cornell >"$T/g2.nff" \
+  && cmp -s "$T/g.nff" "$T/g2.nff" \
+  || fail "gen --output: $(cat "$T/err")"
 # A patch size far below the scene's: refused before meshing (it used to overflow the
 # patch indices and report "no polygon to mesh").
 "$V" radiosity "$T/cornell.nff" -o "$T/p.ply" --patch-size 1e-9 --quiet 2>"$T/err"; rc=$?

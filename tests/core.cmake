@@ -76,7 +76,9 @@ foreach(case "send;sent message kind 1 ('to_output') to cell 0, but the kind has
              "bad-kind;sent unknown message kind 7 (it has 2 kinds)"
              "bad-cell;sent to cell 99, which does not exist (2 cells)"
              "norestore-step;returned from step() of cell 0 in cell 1"
-             "norestore-handle;returned from its handler of a kind 0 message to cell 0 in another cell")
+             "norestore-handle;returned from its handler of a kind 0 message to cell 0 in another cell"
+             "enter-output;entered cell 1 with message kind 1 ('to_output'), but the kind has no handle (an output kind: sent with vw_send_output)"
+             "build-enter;entered cell 0 with message kind 1 ('to_output'), but the kind has no handle")
   list(GET case 0 m)
   list(GET case 1 want)
   add_test(NAME core_misuse_${m} COMMAND test_misuse ${m} ${want})

@@ -203,7 +203,10 @@ VW_API void vw_send_output_sized(vw_ctx *ctx, int kind, const void *msg, size_t 
    using the values vw_ctx_cell() and vw_ctx_replica() had before, before it returns or
    uses the first cell's state again. Messages are the model; this only skips the packet
    for the common case of a neighbour on the same worker (a ray crossing a wall). Only
-   in handlers and step(): cell_build and load get NULL (there is no run to hand off in). */
+   in handlers and step(): cell_build and load get NULL (there is no run to hand off in).
+   An unknown cell or kind, or a kind without handle, stops the process as vw_send_cell
+   does. The common case (a cell of this worker without copies) is a few compares and
+   the meter's note. */
 VW_API void *vw_ctx_enter(vw_ctx *ctx, int cell, int kind);
 VW_API void vw_ctx_restore(vw_ctx *ctx, int cell, int replica);
 

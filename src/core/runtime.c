@@ -43,7 +43,25 @@ struct vw_ctx {
        note across runs (and a new decomposition freeing the cell), and charge it the
        time since its last clock read. */
     int in_run;
+    /* The hand-off's fast path (vw_ctx_enter, vw_ctx_restore), one compare per rare case
+       it leaves to the slow path: enter_cells is the number of cells in a run without
+       the stress switch, 0 otherwise (so every hand-off takes the slow path, which
+       checks all); `handled` has bit k set when kind k has a handle (bits past the
+       module's kinds clear); cells and global are w->cells and wk->global. */
+    unsigned enter_cells;
+    int global;
+    vw__cell *cells;
+    uint64_t handled;
 };
+
+/* The kinds of the module that have a handle, one bit each (VW_MAX_KINDS is 64). */
+static uint64_t handled_kinds(const vw_module *m)
+{
+    uint64_t b = 0;
+    for (int k = 0; k < m->nkinds && k < 64; k++)
+        if (m->kinds[k].handle) b |= (uint64_t)1 << k;
+    return b;
+}
 
 /* The module's callbacks may run from now until callbacks_end (w->in_callbacks): a
    world-changing call meanwhile is refused (vw__world_guard). Returns what was running
@@ -586,18 +604,24 @@ uint64_t vw_ctx_next_batch(vw_ctx *ctx, uint64_t nbatches)
    or -1. When every worker of this process holds one (farming), this worker's own copy
    takes it, and a ray stays on the worker it started on; otherwise the copies share
    what is sent to the cell in turns, the shares the balancer planned. */
-static int __attribute__((noinline)) enter_copy(const vw_ctx *ctx, int cell, int kind)
+static int enter_copy(const vw_ctx *ctx, int cell, int kind)
 {
     const vw_world *w = ctx->w;
     if (!w->cells[cell].farmed || !(w->m->kinds[kind].flags & VW_MSG_INDEPENDENT)) return -1;
     return vw__cell_rep_of(w, cell, ctx->wk->global);
 }
 
-void *vw_ctx_enter(vw_ctx *ctx, int cell, int kind)
+/* vw_ctx_enter's every case: what the fast path leaves (a cell or kind that does not
+   exist or has no handle, a duplicated cell, a cell of another worker, outside a run,
+   the stress switch). */
+static void *__attribute__((noinline)) enter_slow(vw_ctx *ctx, int cell, int kind)
 {
     vw_world *w = ctx->w;
     if ((unsigned)cell >= (unsigned)w->ncells || (unsigned)kind >= (unsigned)w->m->nkinds)
         misuse(ctx, "entered cell %d with message kind %d: no such cell or kind", cell, kind);
+    if (!w->m->kinds[kind].handle)
+        misuse(ctx, "entered cell %d with message kind %d ('%s'), but the kind has no handle "
+               "(an output kind: sent with vw_send_output)", cell, kind, w->m->kinds[kind].name);
     if (!ctx->in_run) return NULL;
     vw__cell *c = &w->cells[cell];
     int rep = 0;
@@ -626,9 +650,31 @@ void *vw_ctx_enter(vw_ctx *ctx, int cell, int kind)
     return state;
 }
 
-void vw_ctx_restore(vw_ctx *ctx, int cell, int replica)
+/* The common case, small enough to be inlined into the module's walk (LTO): a cell of
+   this worker without copies, in a run without the stress switch, for a kind with a
+   handle. Each of the other cases fails one of the first two tests (enter_cells is 0
+   outside a run and under the stress switch) or the third, and the slow path decides
+   it as it always did. The master of a cell without copies is the only unit of it this
+   worker can be in, so the cell alone says whether the meter notes it. */
+void *vw_ctx_enter(vw_ctx *ctx, int cell, int kind)
 {
-    if (cell == ctx->cell && replica == ctx->rep) return;
+    if ((unsigned)cell < ctx->enter_cells && (unsigned)kind < 64 && (ctx->handled >> kind & 1)) {
+        vw__cell *c = &ctx->cells[cell];
+        if (c->solo == ctx->global) {
+            if (cell != ctx->cell) meter_note(ctx->wk, &c->busy);
+            c->messages_in++;
+            ctx->cell = cell;
+            ctx->rep = 0;
+            return c->state;
+        }
+    }
+    return enter_slow(ctx, cell, kind);
+}
+
+/* vw_ctx_restore's every case: what the fast path leaves (a copy, a cell of another
+   worker or none, outside a run, the stress switch). */
+static void __attribute__((noinline)) restore_slow(vw_ctx *ctx, int cell, int replica)
+{
     if (cell != ctx->home_cell || replica != ctx->home_rep) {
         vw_world *w = ctx->w;
         int hosted = cell >= 0 && cell < w->ncells &&
@@ -637,6 +683,17 @@ void vw_ctx_restore(vw_ctx *ctx, int cell, int replica)
         if (!hosted) misuse(ctx, "restored cell %d copy %d, which it does not host", cell, replica);
     }
     if (ctx->in_run) meter_note(ctx->wk, unit_busy(ctx->wk, cell, replica));
+}
+
+void vw_ctx_restore(vw_ctx *ctx, int cell, int replica)
+{
+    if (cell == ctx->cell && replica == ctx->rep) return;
+    /* Back to a master this worker hosts, in a run without the stress switch (the home
+       unit, or a cell a hand-off entered, which the walk left for a secondary ray). */
+    if (!replica && (unsigned)cell < ctx->enter_cells && ctx->cells[cell].worker == ctx->global)
+        meter_note(ctx->wk, &ctx->cells[cell].busy);
+    else
+        restore_slow(ctx, cell, replica);
     ctx->cell = cell;
     ctx->rep = replica;
 }
@@ -871,7 +928,9 @@ static void stress_pause(vw__worker *wk)
 static void worker_run(vw__worker *wk)
 {
     vw_world *w = wk->w;
-    vw_ctx ctx = {w, wk, -1, 0, -1, 0, 1};
+    vw_ctx ctx = {.w = w, .wk = wk, .cell = -1, .home_cell = -1, .in_run = 1,
+                  .enter_cells = w->cfg.stress_seed ? 0 : (unsigned)w->ncells,
+                  .global = wk->global, .cells = w->cells, .handled = handled_kinds(w->m)};
     for (;;) {
         if (w->share_core) share_core(wk);
         pthread_mutex_lock(&wk->mu);
@@ -1032,7 +1091,8 @@ static vw_status runtime_run(vw_world *w)
     atomic_store(&w->active, w->nworkers + (w->transport ? 1 : 0));
     for (int i = 0; i < w->nworkers; i++) w->workers[i].busy = 1;
     /* Every run numbers the cells' batches afresh (vw_ctx_next_batch), and notes the
-       cells every worker of this process holds a copy of (vw_ctx_enter). */
+       cells every worker of this process holds a copy of, and those without copies
+       (vw_ctx_enter). */
     for (int cl = 0; cl < w->ncells; cl++) {
         vw__cell *c = &w->cells[cl];
         atomic_store_explicit(&c->batches, 0, memory_order_relaxed);
@@ -1046,6 +1106,7 @@ static vw_status runtime_run(vw_world *w)
             local += vw__worker_process(w, c->reps[r].worker) == w->rank;
         }
         c->farmed = c->nreps > 0 && local == w->nworkers;
+        c->solo = c->nreps ? -1 : c->worker;
     }
     /* Posted messages (every process holds them all): to the worker that hosts the
        cell now, if it is one of this process's; counted like any packet. */
@@ -1136,7 +1197,7 @@ static vw_status build_unit(vw_world *w, int cell, int rep, vw__worker *wk)
 {
     vw__cell *c = &w->cells[cell];
     vw__replica *rp = rep ? &c->reps[rep - 1] : NULL;
-    vw_ctx ctx = {w, wk, cell, rep, cell, rep};
+    vw_ctx ctx = {.w = w, .wk = wk, .cell = cell, .rep = rep, .home_cell = cell, .home_rep = rep};
     size_t osz = w->m->object_size;
     const unsigned char *objs = NULL;
     unsigned char *gathered = NULL;
@@ -1202,7 +1263,8 @@ vw_status vw__world_build_replica(vw_world *w, int cell, int rep, vw__worker *wk
 static vw_ctx between_runs(vw_world *w, int cell, int rep)
 {
     int g = rep ? w->cells[cell].reps[rep - 1].worker : w->cells[cell].worker;
-    return (vw_ctx){w, &w->workers[g - w->rank * w->nworkers], cell, rep, cell, rep};
+    return (vw_ctx){.w = w, .wk = &w->workers[g - w->rank * w->nworkers], .cell = cell,
+                    .rep = rep, .home_cell = cell, .home_rep = rep};
 }
 
 /* The module's load estimate of unit (cell, rep), called between runs. */

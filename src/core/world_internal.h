@@ -103,6 +103,8 @@ typedef struct vw__cell {
     int nreps;
     vw__replica *reps;       /* copies besides the master, nreps of them */
     int farmed;              /* every worker of this process holds a copy (set per run) */
+    int solo;                /* the worker vw_ctx_enter's fast path enters it on: `worker`
+                                without copies, -1 with them (set per run) */
     unsigned *rr;            /* duplicated cells: per local worker, the next copy to send to
                                 (one counter per sender and cell, so each cell's copies get
                                 their shares whatever else the sender sends), at

@@ -36,6 +36,9 @@
  *   norestore-step | norestore-handle   a step() or a handler that hands off inline
  *            (vw_ctx_enter) and returns without vw_ctx_restore stops the process, as
  *            module.h requires the restore (it went unnoticed)
+ *   enter-output | build-enter   a hand-off (vw_ctx_enter) with a kind that has no handle
+ *            stops the process as vw_send_cell does, from step() to a cell of its own
+ *            worker and from cell_build alike (it returned the cell's state, or NULL)
  * Usage: test_misuse MODE [EXPECTED-MESSAGE]
  */
 #include <signal.h>
@@ -101,6 +104,8 @@ static int step(vw_ctx *ctx, void *state)
     /* Both cells on one worker (see main): the hand-off succeeds, no restore follows. */
     if (!strcmp(mode, "norestore-step")) vw_ctx_enter(ctx, 1, 0);
     if (!strcmp(mode, "norestore-handle")) vw_send_cell(ctx, 0, 0, &x);
+    /* Both cells on one worker: a kind with a handle would be entered. */
+    if (!strcmp(mode, "enter-output") && vw_ctx_enter(ctx, 1, 1)) vw_ctx_restore(ctx, 0, 0);
     return 1;
 }
 
@@ -111,6 +116,7 @@ static vw_status build(vw_ctx *ctx, const void *objects, size_t n, void **state)
     *state = &done[vw_ctx_cell(ctx)];
     int x = 0;
     if (!strcmp(mode, "build-send") && vw_ctx_cell(ctx) == 0) vw_send_cell(ctx, 0, 0, &x);
+    if (!strcmp(mode, "build-enter") && vw_ctx_cell(ctx) == 0) vw_ctx_enter(ctx, 0, 1);
     if (!strcmp(mode, "reenter-commit") && vw_ctx_cell(ctx) == 0) vw_world_commit(the_world);
     if (!strcmp(mode, "build-agree") && vw_ctx_cell(ctx) == 0) vw_world_agree(the_world, VW_OK, NULL, 0);
     return VW_OK;
@@ -265,7 +271,8 @@ int main(int argc, char **argv)
         CHECK_EQ_INT(vw_engine_workers(3), 3);
         CHECK_EQ_INT(vw_engine_workers(0), vw_host_cores());
     } else {
-        if (!strncmp(mode, "norestore", 9)) cfg.workers = 1; /* a hand-off needs both cells */
+        if (!strncmp(mode, "norestore", 9) || !strcmp(mode, "enter-output"))
+            cfg.workers = 1; /* a hand-off needs both cells */
         CHECK(vw_world_create(&m, NULL, d, &cfg, &w) == VW_OK);
         the_world = w;
         obj o[2] = {{{0.25, 0.5, 0.5}}, {{0.75, 0.5, 0.5}}};

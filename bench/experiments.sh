@@ -22,7 +22,16 @@
 #              this repository)
 #   --publish  also copy the plots to docs/bench/ and rewrite BENCHMARKS.md
 # Environment: REPEAT (render runs per row, best kept), SIZE (image side), RSF (radiosity
-# stopping ratio), BALANCE (strategies for the balanced rows, default "tensor").
+# stopping ratio), BALANCE (strategies for the balanced rows, default "tensor"),
+# BALANCE_LOAD (the balancer's load, `--balance-load`: busy or segments; default: busy
+# where a row has no more workers than cores, segments where it has more).
+#
+# Why segments on an oversubscribed row: the balancer's pre-pass lasts milliseconds, and
+# a worker's busy time on 8 workers sharing 2 cores is mostly the time it waited for a
+# core. Balancing on it moved walls by the scheduler's noise: 1000 spheres 100% clustered,
+# 2x4, tensor, work lambda 1.20 to 2.24 over five runs (none: 1.51), where the counted
+# segments give 1.15 every run. The table's deterministic columns are counted segments,
+# so the balancer is given the same figure.
 # Needs bash, awk; optional: mpirun, gnuplot, povray + python3 (nff2pov.py).
 set -uo pipefail
 HERE=$(cd "$(dirname "$0")" && pwd)
@@ -72,6 +81,9 @@ else
   RSCENE=room; RSF=${RSF:-2.5e-4}; RPATCH="--patch-size 0.21"; RSEQ_LAYOUTS="1x2 2x4"
 fi
 BALANCE=${BALANCE:-tensor}
+BALANCE_LOAD=${BALANCE_LOAD:-}
+# bload WORKERS: the --balance-load a balanced row of WORKERS workers (threads) gets
+bload() { if [ -n "$BALANCE_LOAD" ]; then echo "$BALANCE_LOAD"; elif [ "$1" -gt "$NPROC" ]; then echo segments; else echo busy; fi; }
 
 note() { echo "$*" | tee -a "$LOG" >&2; }
 cells_of() { awk -v l="$1" 'BEGIN { n = split(l, a, "x"); c = 1; for (i = 1; i <= n; i++) c *= a[i]; print c }'; }
@@ -177,7 +189,8 @@ for s in "${SCENES[@]}"; do
     row raytrace "$s" "$l" threads 1 "$n" none "$REPEAT" -- render threads 1 "$s" "$l" "$n"
     if [ $HAVE_BALANCE = 1 ] && [ "$n" -gt 1 ]; then
       for b in $BALANCE; do
-        row raytrace "$s" "$l" threads 1 "$n" "$b" "$REPEAT" -- render threads 1 "$s" "$l" "$n" --balance "$b"
+        row raytrace "$s" "$l" threads 1 "$n" "$b" "$REPEAT" -- render threads 1 "$s" "$l" "$n" --balance "$b" \
+          --balance-load "$(bload "$n")"
       done
     fi
   done
@@ -205,7 +218,8 @@ if [ $HAVE_BALANCE = 1 ] && [ ${#SCENES[@]} -gt 0 ]; then
   strats=$("$VW" render --help 2>&1 | sed -n 's/.*--balance S *\([a-z|]*\).*/\1/p' | tr '|' ' ')
   for b in ${strats:-tensor rotate staggered divide duplicate}; do
     [ "$b" = none ] || [[ " $BALANCE " == *" $b "* ]] && continue
-    row raytrace "$hard" "$last" threads 1 "$n" "$b" "$REPEAT" -- render threads 1 "$hard" "$last" "$n" --balance "$b"
+    row raytrace "$hard" "$last" threads 1 "$n" "$b" "$REPEAT" -- render threads 1 "$hard" "$last" "$n" --balance "$b" \
+      --balance-load "$(bload "$n")"
   done
 fi
 
@@ -261,7 +275,7 @@ ELAPSED=$(( $(date +%s) - START ))
   echo "seconds=$ELAPSED"; echo "nproc=$NPROC"; echo "size=$SIZE"; echo "repeat=$REPEAT"
   echo "rsf=$RSF"; echo "have_balance=$HAVE_BALANCE"; echo "have_rbalance=$HAVE_RBALANCE"
   echo "load_start=$LOAD_START"; echo "load_end=$(cut -d" " -f1-3 /proc/loadavg 2>/dev/null)"
-  echo "have_mpi=$HAVE_MPI"; echo "balance=$BALANCE"; echo "failed=$FAILED"
+  echo "have_mpi=$HAVE_MPI"; echo "balance=$BALANCE"; echo "balance_load=${BALANCE_LOAD:-auto}"; echo "failed=$FAILED"
   echo "date=$(date -u +%Y-%m-%dT%H:%MZ)"; echo "commit=$(git -C "$ROOT" rev-parse --short HEAD 2>/dev/null)"
 } > "$OUT/run.env"
 if [ $PUBLISH = 1 ]; then

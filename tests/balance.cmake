@@ -73,3 +73,12 @@ set_tests_properties(balance_slowest PROPERTIES LABELS "balance" TIMEOUT 120)
 add_test(NAME balance_shares COMMAND vw_test_balance shares)
 set_tests_properties(balance_shares PROPERTIES LABELS "balance;threads" ENVIRONMENT "${VW_BAL_TSAN}")
 
+
+# What the rounds keep and what the experiments' table reads of it (counted work): rotate
+# ended on the grid, unbalanced, when its rotated frame was refuted and could not be
+# re-cut; a kept starting layout reports predicted = before; bench/experiments/stats.awk's
+# work lambda counts a duplicated or farmed cell's work where its copies ran.
+add_test(NAME balance_kept
+         COMMAND sh ${PROJECT_SOURCE_DIR}/tests/balance/kept.sh $<TARGET_FILE:vwalls_tool>
+                 ${CMAKE_CURRENT_BINARY_DIR}/balance_kept)
+set_tests_properties(balance_kept PROPERTIES LABELS "balance" TIMEOUT 120)

@@ -567,6 +567,13 @@ int vw_cmd_render(int argc, char **argv)
                         "other than none, or --map greedy or weighted)\n", tuning);
     if (by_given && !overlay && vw_cli_is_output())
         fprintf(stderr, "vwalls render: warning: --overlay-by has no effect without --overlay\n");
+    /* Busy time on more workers than cores is mostly time spent waiting for a core: the
+       balancer then moves walls by the scheduler's noise (docs/known-issues.md). */
+    if (balancing && lspec.model == VW_LOAD_BUSY && vw_world_workers(w) > vw_host_cores() &&
+        vw_cli_is_output())
+        fprintf(stderr, "vwalls render: warning: %d workers on %d cores: their busy time is "
+                        "mostly waiting for a core, a poor load to balance by (--balance-load "
+                        "segments counts the work)\n", vw_world_workers(w), vw_host_cores());
     rt_balance_result bi;
     memset(&bi, 0, sizeof bi);
     if ((map_given || speeds) && rt_job_map(job, map, NULL, speeds, err, sizeof err) != VW_OK) {
@@ -744,6 +751,9 @@ int vw_cmd_render(int argc, char **argv)
                        bi.rep.imbalance_before, bi.rep.imbalance_predicted, vw_world_imbalance(w),
                        rt_job_work_imbalance(job, speeds), (unsigned long long)bi.migrated,
                        vw_world_time(w, "balance"));
+            if (balancing && bi.reverted && !bi.rep.applied)
+                printf("balance: every layout the balancer made measured worse than the first "
+                       "in its pre-pass: the first kept\n");
             printf("time: load %.3f s, balance %.3f s, build %.3f s, compute %.3f s, write %.3f s, "
                    "total %.3f s\n", t_loaded - t_load0, t_build0 - t_loaded, t_run0 - t_build0, comp,
                    t_end - t_run1, t_end - t_load0);

@@ -282,6 +282,14 @@ vw_status rt_job_balance(rt_job *j, const rt_balance *b, rt_balance_result *bi, 
        So with R rounds there are R + 1 pre-passes. */
     layout best = {0};
     double best_cost = 0;
+    /* The prediction made for the layout applied last, and for the best layout measured
+       (the original's is what its pre-pass measured): where the rounds end on the best
+       layout restored, the result reports its prediction, not the prediction of the
+       layout just undone, so a run that kept its original layout says "predicted" =
+       "before" instead of a gain it never got. */
+    double pred_applied = 0, best_pred = 0;
+    int best_round = 0;
+    vw_balance_strategy strategy = b->strategy; /* rotate may fall back to tensor, below */
     for (int r = 0; st == VW_OK && r <= rounds; r++) {
         double t0 = now();
         if (b->stride <= 0 && r > 0) {
@@ -328,6 +336,8 @@ vw_status rt_job_balance(rt_job *j, const rt_balance *b, rt_balance_result *bi, 
         if (st == VW_OK && !refuted && b->strategy != VW_BALANCE_NONE) {
             best_cost = cost;
             bi->measured = lam;
+            best_pred = r == 0 ? lam : pred_applied;
+            best_round = r;
             if ((st = layout_save(w, &best)) != VW_OK)
                 snprintf(err, errlen, "saving the layout: %s", vw_status_message(st));
         }
@@ -341,7 +351,7 @@ vw_status rt_job_balance(rt_job *j, const rt_balance *b, rt_balance_result *bi, 
             /* Back to the best layout measured (its cells are built for the pre-pass as
                the others, so stale stays). */
             st = layout_restore(w, &best);
-            bi->reverted++;
+            bi->reverted = 1;
             break;
         }
         if (last) break;
@@ -371,7 +381,7 @@ vw_status rt_job_balance(rt_job *j, const rt_balance *b, rt_balance_result *bi, 
         }
         vw_balance_params bp;
         vw_balance_params_init(&bp);
-        bp.strategy = b->strategy;
+        bp.strategy = strategy;
         bp.speeds = b->speeds;
         vw_balance_apply ap = {(int)b->map, b->speeds, 0, 0};
         vw_balance_report rep;
@@ -386,13 +396,53 @@ vw_status rt_job_balance(rt_job *j, const rt_balance *b, rt_balance_result *bi, 
         bi->migrated += rep.migrated_objects;
         bi->bytes += rep.bytes_moved;
         bi->rounds++;
-        if (!rep.applied) { /* nothing changed: measuring again would tell nothing */
+        if (!rep.applied && refuted && r + 1 < rounds) {
+            /* The layout measured worse than the best, and no balance on from it predicts a
+               gain: go back to the best layout and balance again from there, on the field
+               as this measurement re-calibrated it. Stopping here kept the best layout
+               unbalanced: rotate's first frame on the fully clustered 1000 spheres (512x512,
+               2x4 cells, 8 workers, --balance-load segments) was predicted at lambda 1.000
+               from the field of the grid's uniform cells, measured 1.361 with more work,
+               could not be re-cut in its frame, and the grid came back with its work lambda
+               1.514, where the unrotated frame's walls give 1.15.
+               A rotated frame refuted against an unrotated best layout is not tried again:
+               every rotated candidate is predicted from a field that cannot see the work a
+               turned world box adds (more eye rays enter it), so rotate would pick one
+               again (at 256x256 the same scene went through four refuted rotated layouts
+               back to the grid). Balancing on goes on with rotate's unrotated candidate,
+               tensor's walls. */
+            int turned = vw_decomp_frame(vw_world_decomp(w)) != NULL;
+            st = layout_restore(w, &best);
+            if (st == VW_OK && strategy == VW_BALANCE_ROTATE && turned &&
+                !vw_decomp_frame(vw_world_decomp(w)))
+                bp.strategy = strategy = VW_BALANCE_TENSOR;
+            if (st == VW_OK) st = vw_balance_world(w, f, &bp, &ap, &rep);
+            if (st != VW_OK) {
+                snprintf(err, errlen, "balancing: %s", vw_world_errmsg(w));
+                break;
+            }
+            bi->rep = rep;
+            bi->rep.imbalance_before = before;
+            bi->migrated += rep.migrated_objects;
+            bi->bytes += rep.bytes_moved;
+            if (!rep.applied) { /* the best layout stays, balanced no further */
+                bi->reverted = 1;
+                break;
+            }
+        } else if (!rep.applied) { /* nothing changed: measuring again would tell nothing */
             if (refuted) {
                 st = layout_restore(w, &best);
-                bi->reverted++;
+                bi->reverted = 1;
             }
             break;
         }
+        pred_applied = rep.imbalance_predicted;
+    }
+    if (bi->reverted) {
+        /* The layout in use is the best one measured: its prediction, and whether it is
+           a balanced one at all (best_round 0: the layout the rounds started from). */
+        bi->rep.imbalance_predicted = best_pred;
+        bi->rep.applied = best_round > 0;
     }
     layout_free(&best);
     rt_job_set_sample(j, 1);

@@ -2,7 +2,9 @@
 # plots.sh - the experiment's pictures, from results.csv and the radiosity traces in OUT:
 #   efficiency.png  against the number of cells (threads engine, one cell per worker):
 #                   measured efficiency (bounded by cores / workers on this machine), the
-#                   load-balance efficiency 1/lambda, and the model efficiency from
+#                   load-balance efficiency 1/lambda of the counted work (busy time on
+#                   more workers than cores is mostly waiting for a core), and the model
+#                   efficiency from
 #                   counted work, without and (dashed) with balancing where available
 #   unshot.png      radiosity: max unshot power / emitted against seconds, per layout
 #   speedup.png     compute-phase speedup against cells, with the machine's core count
@@ -14,13 +16,13 @@ mkdir -p "$D"
 rm -f "$D"/*.dat
 # one data file per (app, clustering, balance) of threads rows with one cell per worker,
 # the mean over the sphere counts (100, 500, 1000) so the plot keeps a readable handful of
-# lines; per scene figures are in the table: cells efficiency lb_eff speedup eff_model
+# lines; per scene figures are in the table: cells efficiency 1/lambda_work speedup eff_model
 awk -F, -v d="$D" 'NR == 1 { for (i = 1; i <= NF; i++) c[$i] = i; next }
   $(c["engine"]) == "threads" && $(c["workers"]) == $(c["cells"]) {
     sc = $(c["scene"]); sub(/^s[0-9]+-c/, "", sc)
     if ($(c["app"]) == "raytrace") sc = "spheres " (sc * 100) "% clustered"
     k = $(c["app"]) "_" sc "_" $(c["balance"]) SUBSEP $(c["cells"])
-    e[k] += $(c["efficiency"]); l[k] += $(c["lb_eff"]); s[k] += $(c["speedup"]); m[k] += $(c["eff_model"]); n[k]++
+    e[k] += $(c["efficiency"]); l[k] += ($(c["lambda_work"]) > 0 ? 1 / $(c["lambda_work"]) : 0); s[k] += $(c["speedup"]); m[k] += $(c["eff_model"]); n[k]++
   }
   END { for (k in n) { split(k, a, SUBSEP); f = d "/" a[1] ".dat"; gsub(/ /, "-", f)
           printf "%d %.4f %.4f %.4f %.4f\n", a[2], e[k] / n[k], l[k] / n[k], s[k] / n[k], m[k] / n[k] >> f } }' "$OUT/results.csv"
@@ -54,7 +56,7 @@ set title "measured efficiency = speedup / workers"
 set key top right font ",8"
 plot $(plotlist 2), $NPROC / x with lines lc rgb "black" dt 2 title "cores / workers"
 set key bottom left font ",8"
-set title "load-balance efficiency 1/lambda, busy time (dashed: balanced)"
+set title "load-balance efficiency 1/lambda of counted work (dashed: balanced)"
 plot $(plotlist 3)
 set title "model: (seq. work / work) / lambda of counted work"
 plot $(plotlist 5)

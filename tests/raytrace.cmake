@@ -90,6 +90,14 @@ add_test(NAME raytrace_inline_spawn
 set_tests_properties(raytrace_inline_spawn PROPERTIES LABELS "threads" TIMEOUT 60
                      ENVIRONMENT "${VW_RT_TSAN}")
 
+# --world: the walls divide the box given, not only the objects' bounds (the paper's
+# clustered load cases); the same image; a bad box refused.
+add_test(NAME raytrace_world_box
+         COMMAND sh ${PROJECT_SOURCE_DIR}/tests/raytrace/world_box.sh $<TARGET_FILE:vwalls_tool>
+                 ${CMAKE_CURRENT_BINARY_DIR}/raytrace_world_box)
+set_tests_properties(raytrace_world_box PROPERTIES LABELS "threads" TIMEOUT 60
+                     ENVIRONMENT "${VW_RT_TSAN}")
+
 # vwalls bench: a row per configuration in order, the images checked identical (a
 # difference fails it), bad options refused with nothing written (tests/raytrace/cli_bench.sh).
 add_test(NAME raytrace_cli_bench

@@ -44,6 +44,10 @@ static void help(void)
            "                   light (up to 64); without a colour, 1/sqrt(lights) each,\n"
            "                   as NFF gives a light without one; a colour is taken as an\n"
            "                   NFF 'l' takes it (negative darkens)\n"
+           "  --world X0,Y0,Z0,X1,Y1,Z1  the world box covers at least this box (default:\n"
+           "                   the scene's bounds, padded, which it always covers): the\n"
+           "                   walls then divide the space the scene is meant to fill, as\n"
+           "                   the paper's grids do, not only where its objects lie\n"
            "  --stats FILE     write the stats JSON\n"
            "  --overlay FILE   write a PNG of the image with the walls drawn and each pixel\n"
            "                   tinted by the measured load of the cell where its eye ray\n"
@@ -220,7 +224,8 @@ int vw_cmd_render(int argc, char **argv)
     int dims[3] = {1, 1, 1}, width = 0, height = 0, quiet = 0, progress = 0;
     long workers = 0, depth = 5;
     double from[3], at[3], up[3], angle = 0;
-    int has_from = 0, has_at = 0, has_up = 0, has_angle = 0;
+    int has_from = 0, has_at = 0, has_up = 0, has_angle = 0, has_world = 0;
+    vw_box world_min;
     vw_light lights[MAX_LIGHTS];
     int light_color[MAX_LIGHTS]; /* was the colour given? */
     int nlights = 0;
@@ -324,6 +329,21 @@ int vw_cmd_render(int argc, char **argv)
             by_worker = !strcmp(v, "worker");
             by_entry = !strcmp(v, "entry");
             by_given = 1;
+        } else if (!strcmp(a, "--world")) {
+            double b[6];
+            if (vw_cli_numbers(CMD, a, vw_cli_value(CMD, argc, argv, &i), "X0,Y0,Z0,X1,Y1,Z1", b,
+                               6, 6, NULL))
+                return VW_EXIT_USAGE;
+            for (int k = 0; k < 3; k++) {
+                if (!(b[k] < b[k + 3])) {
+                    vw_cli_error(CMD, "--world: bad value '%s' (the box's low corner must lie "
+                                      "below its high corner on every axis)", argv[i]);
+                    return VW_EXIT_USAGE;
+                }
+                world_min.lo[k] = b[k];
+                world_min.hi[k] = b[k + 3];
+            }
+            has_world = 1;
         } else if (!strcmp(a, "--from")) {
             if (vw_cli_numbers(CMD, a, vw_cli_value(CMD, argc, argv, &i), "X,Y,Z", from, 3, 3,
                                NULL))
@@ -537,6 +557,7 @@ int vw_cmd_render(int argc, char **argv)
     memcpy(p.dims, dims, sizeof dims);
     p.workers = (int)workers;
     p.camera = &cam;
+    p.world_min = has_world ? &world_min : NULL;
     vw_config cfg;
     vw_config_init(&cfg);
     cfg.worker_slowdown = slowdown;

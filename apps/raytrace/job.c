@@ -270,6 +270,11 @@ static vw_status job_prepare(rt_job *j, const vw_scene *s, const rt_params *p, i
         world.lo[a] = lo[a] - pad;
         world.hi[a] = hi[a] + pad;
     }
+    if (p->world_min)
+        for (int a = 0; a < 3; a++) {
+            world.lo[a] = fmin(world.lo[a], p->world_min->lo[a]);
+            world.hi[a] = fmax(world.hi[a], p->world_min->hi[a]);
+        }
     if (p->world) world = *p->world;
     sh->ff = rt_float_frame_of(cam.from, &world);
     /* A cell's search runs past its far wall by `overlap` (walk_ray), so that a hit on

@@ -201,6 +201,10 @@ typedef struct rt_params {
     /* Dynamic scenes (vwalls animate) fix these for a whole animation, so that a frame
        depends only on where the objects are, not on where they were at the start: */
     const vw_box *world;       /* NULL: the scene bounds, padded */
+    /* NULL, or a box the world box is grown to cover (vwalls render --world): the space
+       the scene is meant to fill, which its objects may not reach (the paper's clustered
+       load cases cut the whole scene space, not the cluster's bounds). Not with world. */
+    const vw_box *world_min;
     double scale;              /* 0: the scene's diagonal; sets the epsilons */
     const rt_object *objects;  /* NULL: rt_objects_from_scene(); else these records, */
     size_t nobjects;           /* in this order (world object ids = their index) */

@@ -159,11 +159,17 @@ launch() { # launch ENGINE PROCS COMMAND...: the command itself or under mpirun
 }
 # The paper's setting: cells mapped onto the workers, rays crossing between workers as
 # messages (--farm none; the default would farm the cells among a process's workers).
+# The sphere scenes' space: `vwalls gen spheres` places them in the cube [0,10]^3, its
+# cluster region in one octant of it. The walls divide that cube, as the paper's grids
+# divided the scene space: without --world the world box is the objects' bounds, which at
+# 100% clustering is the cluster's own box, evenly cut, and the clustered load case the
+# paper made to unbalance the cells would be no harder than the uniform one.
+WORLD=0,0,0,10,10,10
 render() { # render ENGINE PROCS SCENE LAYOUT WORKERS [options...]
   local engine=$1 procs=$2 scene=$3 layout=$4 workers=$5; shift 5
   launch "$engine" "$procs" "$VW" render "$OUT/scenes/$scene.nff" -o "$T/$scene.png" \
     --size "${SIZE}x${SIZE}" --depth 5 --cells "$layout" --workers "$workers" --farm none \
-    --quiet --stats "$J" "$@"
+    --world "$WORLD" --quiet --stats "$J" "$@"
 }
 radiosity() { # radiosity ENGINE PROCS LAYOUT WORKERS [options...]
   local engine=$1 procs=$2 layout=$3 workers=$4; shift 4

@@ -88,14 +88,16 @@ fi
 
 # Load maps: each cell's pixels tinted by its measured load, the hardest scene on 2x4
 rm -f "$OUT"/overlay-*.png
+# (the walls divide the sphere scenes' space, as in the table: experiments.sh, WORLD; the
+# balancer counts segments, as the table's rows of more workers than cores do)
 hard=$OUT/scenes/s1000-c1.nff
 if [ -f "$hard" ]; then
   "$VW" render "$hard" -o "$T/o.png" --size "${SIZE}x${SIZE}" --cells 2x4 --workers 8 --farm none --quiet \
-    --overlay "$OUT/overlay-none.png" --stats "$T/o.json" >/dev/null 2>&1
+    --world 0,0,0,10,10,10 --overlay "$OUT/overlay-none.png" --stats "$T/o.json" >/dev/null 2>&1
   if [ "$HAVE_BALANCE" = 1 ]; then
     for b in $BALANCE; do
       "$VW" render "$hard" -o "$T/o.png" --size "${SIZE}x${SIZE}" --cells 2x4 --workers 8 --quiet \
-        --balance "$b" --overlay "$OUT/overlay-$b.png" >/dev/null 2>&1 || echo "peers: overlay $b failed" >&2
+        --world 0,0,0,10,10,10 --balance-load segments --balance "$b" --overlay "$OUT/overlay-$b.png" >/dev/null 2>&1 || echo "peers: overlay $b failed" >&2
     done
   fi
 fi

@@ -110,7 +110,10 @@ bench/experiments.sh --smoke             # the ctest version (label bench): seco
 - run $(env_ date), commit $(env_ commit), $(env_ seconds) s; images $(env_ size)x$(env_ size),
   depth 5, the cells mapped onto the workers as the paper does (\`--farm none\`: rays cross
   between workers as messages; \`vwalls render\` by default farms a process's cells among
-  its workers, see docs/balancing.md); radiosity of \`vwalls gen room\` with patch size 0.21 (3614 pieces on 1 cell) stops at
+  its workers, see docs/balancing.md); the walls divide the sphere scenes' space, the cube
+  [0,10]^3 \`vwalls gen spheres\` fills (\`--world 0,0,0,10,10,10\`), so a clustered scene
+  loads the cells of its cluster, as in the paper (the objects' own bounds, the default
+  world box, would be the cluster's at 100%); radiosity of \`vwalls gen room\` with patch size 0.21 (3614 pieces on 1 cell) stops at
   unshot/emitted < $(env_ rsf)
 
 ## How to read the table

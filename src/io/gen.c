@@ -469,8 +469,9 @@ static vw_status gen_spheres(vw__sb *b, const vw_gen_params *p, char *err, size_
     int n = p->count ? p->count : 1000;
     vw_scene *s = b->s;
     /* World: the cube [0,L]^3. The cluster region is the cube of side L/4 at
-       [L/8, 3L/8]^3, inside one octant, so a 2x2x2 decomposition sees the whole
-       cluster in one cell. The radius is set by N alone, so the uniform and the
+       [L/8, 3L/8]^3, inside one octant, so a 2x2x2 decomposition of this cube (vwalls
+       render --world 0,0,0,10,10,10; the default world box is the spheres' bounds) sees
+       the whole cluster in one cell. The radius is set by N alone, so the uniform and the
        clustered cases of one N differ only in placement; at full clustering the
        spheres fill 6.5% of the region, far below random packing's jamming limit. */
     const double L = 10.0, cl = L / 8, ch = 3 * L / 8;

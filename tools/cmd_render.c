@@ -590,11 +590,12 @@ int vw_cmd_render(int argc, char **argv)
         fprintf(stderr, "vwalls render: warning: --overlay-by has no effect without --overlay\n");
     /* Busy time on more workers than cores is mostly time spent waiting for a core: the
        balancer then moves walls by the scheduler's noise (docs/known-issues.md). */
-    if (balancing && lspec.model == VW_LOAD_BUSY && vw_world_workers(w) > vw_host_cores() &&
+    int cores = vw_host_cores();
+    if (balancing && lspec.model == VW_LOAD_BUSY && vw_world_workers(w) > cores &&
         vw_cli_is_output())
         fprintf(stderr, "vwalls render: warning: %d workers on %d cores: their busy time is "
                         "mostly waiting for a core, a poor load to balance by (--balance-load "
-                        "segments counts the work)\n", vw_world_workers(w), vw_host_cores());
+                        "segments counts the work)\n", vw_world_workers(w), cores);
     rt_balance_result bi;
     memset(&bi, 0, sizeof bi);
     if ((map_given || speeds) && rt_job_map(job, map, NULL, speeds, err, sizeof err) != VW_OK) {

@@ -249,6 +249,25 @@ int rt_prepass_stride(int width, int height, int cells)
     return s < 1 ? 1 : s > 8 ? 8 : s;
 }
 
+/* One balance of the rounds: its report becomes the result's, but for the imbalance
+   the rounds started from (the first balance's own), and its migrations add up. */
+static vw_status balance_once(vw_world *w, vw_load_field *f, const vw_balance_params *bp,
+                              vw_balance_apply *ap, vw_balance_report *rep, int first,
+                              rt_balance_result *bi, char *err, size_t errlen)
+{
+    vw_status st = vw_balance_world(w, f, bp, ap, rep);
+    if (st != VW_OK) {
+        snprintf(err, errlen, "balancing: %s", vw_world_errmsg(w));
+        return st;
+    }
+    double before = first ? rep->imbalance_before : bi->rep.imbalance_before;
+    bi->rep = *rep;
+    bi->rep.imbalance_before = before;
+    bi->migrated += rep->migrated_objects;
+    bi->bytes += rep->bytes_moved;
+    return VW_OK;
+}
+
 vw_status rt_job_balance(rt_job *j, const rt_balance *b, rt_balance_result *bi, char *err,
                          size_t errlen)
 {
@@ -385,16 +404,7 @@ vw_status rt_job_balance(rt_job *j, const rt_balance *b, rt_balance_result *bi, 
         bp.speeds = b->speeds;
         vw_balance_apply ap = {(int)b->map, b->speeds, 0, 0};
         vw_balance_report rep;
-        st = vw_balance_world(w, f, &bp, &ap, &rep);
-        if (st != VW_OK) {
-            snprintf(err, errlen, "balancing: %s", vw_world_errmsg(w));
-            break;
-        }
-        double before = r == 0 ? rep.imbalance_before : bi->rep.imbalance_before;
-        bi->rep = rep;
-        bi->rep.imbalance_before = before;
-        bi->migrated += rep.migrated_objects;
-        bi->bytes += rep.bytes_moved;
+        if ((st = balance_once(w, f, &bp, &ap, &rep, r == 0, bi, err, errlen)) != VW_OK) break;
         bi->rounds++;
         if (!rep.applied && refuted && r + 1 < rounds) {
             /* The layout measured worse than the best, and no balance on from it predicts a
@@ -416,15 +426,11 @@ vw_status rt_job_balance(rt_job *j, const rt_balance *b, rt_balance_result *bi, 
             if (st == VW_OK && strategy == VW_BALANCE_ROTATE && turned &&
                 !vw_decomp_frame(vw_world_decomp(w)))
                 bp.strategy = strategy = VW_BALANCE_TENSOR;
-            if (st == VW_OK) st = vw_balance_world(w, f, &bp, &ap, &rep);
             if (st != VW_OK) {
-                snprintf(err, errlen, "balancing: %s", vw_world_errmsg(w));
+                snprintf(err, errlen, "restoring the best layout: %s", vw_status_message(st));
                 break;
             }
-            bi->rep = rep;
-            bi->rep.imbalance_before = before;
-            bi->migrated += rep.migrated_objects;
-            bi->bytes += rep.bytes_moved;
+            if ((st = balance_once(w, f, &bp, &ap, &rep, 0, bi, err, errlen)) != VW_OK) break;
             if (!rep.applied) { /* the best layout stays, balanced no further */
                 bi->reverted = 1;
                 break;

@@ -121,6 +121,22 @@ int vw_cli_numbers(const char *cmd, const char *opt, const char *s, const char *
     return -1;
 }
 
+int vw_cli_box(const char *cmd, const char *opt, const char *s, vw_box *out)
+{
+    double b[6];
+    if (vw_cli_numbers(cmd, opt, s, "X0,Y0,Z0,X1,Y1,Z1", b, 6, 6, NULL)) return -1;
+    for (int k = 0; k < 3; k++) {
+        if (!(b[k] < b[k + 3])) {
+            vw_cli_error(cmd, "%s: bad value '%s' (the box's low corner must lie below its "
+                              "high corner on every axis)", opt, s);
+            return -1;
+        }
+        out->lo[k] = b[k];
+        out->hi[k] = b[k + 3];
+    }
+    return 0;
+}
+
 int vw_cli_size(const char *cmd, const char *opt, const char *s, int *w, int *h)
 {
     long a, b;

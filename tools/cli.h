@@ -36,6 +36,9 @@ int vw_cli_angle(const char *cmd, const char *opt, const char *s, double *out);
    not NULL) gets their count. */
 int vw_cli_numbers(const char *cmd, const char *opt, const char *s, const char *shape,
                    double *out, int min, int max, int *n);
+/* A box given as X0,Y0,Z0,X1,Y1,Z1 (--world), its low corner below its high corner on
+   every axis. */
+int vw_cli_box(const char *cmd, const char *opt, const char *s, vw_box *out);
 int vw_cli_layout(const char *cmd, const char *opt, const char *s, int dims[3]);
 /* A frame file pattern (-o of animate and edit): a .png name with exactly one integer
    conversion for the frame number (%d or %i, with flags 0-+ #, a width and a precision

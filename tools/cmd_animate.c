@@ -430,7 +430,9 @@ static void help(const char *cmd)
            "  --farm F         auto (default) | all | idle | none, as for render: auto is all\n"
            "                   (every worker holds every cell), or idle with --balance\n"
            "  --margin F       the world box is the scene bounds grown by F x diagonal on\n"
-           "                   every side (default 0.25); objects cannot leave it\n");
+           "                   every side (default 0.25); objects cannot leave it\n"
+           "  --world X0,Y0,Z0,X1,Y1,Z1  the world box covers this box too: the walls then\n"
+           "                   divide the space the scene is meant to fill (as render's)\n");
     if (strcmp(cmd, "edit")) /* edit answers every line and goes on */
         printf("  --keep-going     report bad lines and go on instead of stopping\n"
                "                   (the exit status is still 2)\n");
@@ -702,6 +704,7 @@ int vw_anim_main(const char *cmd, int argc, char **argv)
     s->threshold = 0.1;
     s->interactive = !strcmp(cmd, "edit");
     rt_anim_params p;
+    vw_box world_min;
     memset(&p, 0, sizeof p);
     long workers = 0, depth = 0;
     int rc = VW_EXIT_USAGE, farm = -1; /* -1: auto, resolved once the options are read */
@@ -735,6 +738,9 @@ int vw_anim_main(const char *cmd, int argc, char **argv)
             if (!(v = vw_cli_value(cmd, argc, argv, &i)) || vw_cli_double(cmd, a, v, 0, 100, &s->threshold)) goto done;
         } else if (!strcmp(a, "--margin")) {
             if (!(v = vw_cli_value(cmd, argc, argv, &i)) || vw_cli_double(cmd, a, v, 1e-6, 100, &p.margin)) goto done;
+        } else if (!strcmp(a, "--world")) {
+            if (vw_cli_box(cmd, a, vw_cli_value(cmd, argc, argv, &i), &world_min)) goto done;
+            p.world_min = &world_min;
         } else if (!strcmp(a, "--keep-going") && !s->interactive) {
             /* animate's alone: edit answers every line and goes on, so it takes the
                option no more than any other it has no use for (an unknown option). */

@@ -330,19 +330,8 @@ int vw_cmd_render(int argc, char **argv)
             by_entry = !strcmp(v, "entry");
             by_given = 1;
         } else if (!strcmp(a, "--world")) {
-            double b[6];
-            if (vw_cli_numbers(CMD, a, vw_cli_value(CMD, argc, argv, &i), "X0,Y0,Z0,X1,Y1,Z1", b,
-                               6, 6, NULL))
+            if (vw_cli_box(CMD, a, vw_cli_value(CMD, argc, argv, &i), &world_min))
                 return VW_EXIT_USAGE;
-            for (int k = 0; k < 3; k++) {
-                if (!(b[k] < b[k + 3])) {
-                    vw_cli_error(CMD, "--world: bad value '%s' (the box's low corner must lie "
-                                      "below its high corner on every axis)", argv[i]);
-                    return VW_EXIT_USAGE;
-                }
-                world_min.lo[k] = b[k];
-                world_min.hi[k] = b[k + 3];
-            }
             has_world = 1;
         } else if (!strcmp(a, "--from")) {
             if (vw_cli_numbers(CMD, a, vw_cli_value(CMD, argc, argv, &i), "X,Y,Z", from, 3, 3,

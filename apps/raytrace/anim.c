@@ -90,6 +90,10 @@ vw_status rt_anim_create(vw_scene *s, const rt_anim_params *p, rt_anim **out, ch
         for (int k = 0; k < 3; k++) {
             a->world.lo[k] = lo[k] - margin * diag;
             a->world.hi[k] = hi[k] + margin * diag;
+            if (p->world_min) {
+                a->world.lo[k] = fmin(a->world.lo[k], p->world_min->lo[k]);
+                a->world.hi[k] = fmax(a->world.hi[k], p->world_min->hi[k]);
+            }
         }
         if (s->camera.valid)
             a->cam = s->camera;

@@ -21,6 +21,8 @@ typedef struct rt_anim_params {
     int workers;                /* per process; 0 = cores */
     double margin;              /* the world box: scene bounds grown by margin * diagonal
                                    on every side (objects cannot leave it); 0: 0.25 */
+    const vw_box *world_min;    /* the world box covers this box too (the space the scene
+                                   is meant to fill, as rt_params.world_min); may be NULL */
     int brute_force;            /* decide collisions with the O(n^2) reference */
     int full_rebuild;           /* benchmark: re-place every object and rebuild every
                                    cell at every frame instead of the touched ones */

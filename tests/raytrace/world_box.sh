@@ -1,6 +1,7 @@
 #!/bin/sh
-# world_box.sh VWALLS TMPDIR - `vwalls render --world`: the world box covers the box given,
-# so the walls divide the space the scene is meant to fill, not only its objects' bounds.
+# world_box.sh VWALLS TMPDIR - `vwalls render --world` (and animate's, edit's): the world
+# box covers the box given, so the walls divide the space the scene is meant to fill,
+# not only its objects' bounds.
 # A fully clustered sphere scene (`vwalls gen spheres`: its cluster lies in one octant of
 # the cube [0,10]^3) then has every object in one cell of 2x2x2, as the paper's clustered
 # load case means (without --world the walls cut the cluster's own box evenly); the image
@@ -32,4 +33,18 @@ for bad in "0,0,0,10,10" "0,0,0,10,10,x" "0,0,0,10,-1,10" "0,0,0,0,10,10" "0,0,0
   grep -q "vwalls render: --world: bad value '$bad'" err.txt || fail "--world $bad: $(cat err.txt)"
   [ ! -e bad.png ] || fail "--world $bad: output written"
 done
+# animate and edit take the same box (rt_anim_params.world_min): one frame on 2x2x2.
+printf 'frame\n' > frame.txt
+"$V" animate c1.nff frame.txt -o 'an%d.png' --cells 2x2x2 --size 32x24 --quiet --stats an.json \
+  --world 0,0,0,10,10,10 || fail "animate --world: status $?"
+grep -q '"box": \[\[0,0,0\],\[5,5,5\]\], "worker": [0-9]*, "objects": 300,' an.json ||
+  fail "animate --world: cell [0,5]^3 does not hold the 300 spheres: $(grep '"box"' an.json | head -2)"
+printf 'frame\n' | "$V" edit c1.nff -o 'ed%d.png' --cells 2x2x2 --size 32x24 --quiet \
+  --stats ed.json --world 0,0,0,10,10,10 > /dev/null || fail "edit --world: status $?"
+grep -q '"box": \[\[0,0,0\],\[5,5,5\]\], "worker": [0-9]*, "objects": 300,' ed.json ||
+  fail "edit --world: cell [0,5]^3 does not hold the 300 spheres"
+"$V" animate c1.nff frame.txt -o 'bad%d.png' --world 0,0,0,10,10 2>err.txt; rc=$?
+[ $rc -eq 2 ] || fail "animate --world 0,0,0,10,10: exit $rc"
+grep -q "vwalls animate: --world: bad value '0,0,0,10,10'" err.txt || fail "animate: $(cat err.txt)"
+[ ! -e bad0.png ] || fail "animate --world bad: output written"
 echo ok

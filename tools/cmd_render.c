@@ -56,8 +56,10 @@ static void help(void)
            "                   measures where the work lies, the balancer moves the walls (or,\n"
            "                   duplicate, copies overloaded cells to idle workers, which share\n"
            "                   their rays), then the full render (the image does not change)\n"
-           "  --balance-load M busy (measured time, default) | segments (counted ray-cell\n"
-           "                   visits: deterministic) | model (objects + pixels + messages)\n"
+           "  --balance-load M busy (measured time) | segments (counted ray-cell visits:\n"
+           "                   deterministic) | model (objects + pixels + messages); default:\n"
+           "                   busy, or segments where the workers outnumber the cores (their\n"
+           "                   busy time is then mostly waiting for a core)\n"
            "  --balance-iters N  pre-pass / balance rounds, 1 to 20 (default 2; divide and\n"
            "                     rotate take up to 3 more, stopping when no gain is\n"
            "                     predicted)\n"
@@ -239,6 +241,7 @@ int vw_cmd_render(int argc, char **argv)
     long iters = 2, prepass = 0; /* 0: rt_prepass_stride() */
     vw_load_spec lspec;
     vw_load_spec_init(&lspec);
+    int load_given = 0;
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i], *v;
         int taken;
@@ -273,6 +276,7 @@ int vw_cmd_render(int argc, char **argv)
             balance_given = 1;
         } else if (!strcmp(a, "--balance-load")) {
             tuning = a;
+            load_given = 1;
             if (!(v = vw_cli_value(CMD, argc, argv, &i))) return VW_EXIT_USAGE;
             if (!strcmp(v, "busy")) {
                 lspec.model = VW_LOAD_BUSY;
@@ -578,13 +582,27 @@ int vw_cmd_render(int argc, char **argv)
     if (by_given && !overlay && vw_cli_is_output())
         fprintf(stderr, "vwalls render: warning: --overlay-by has no effect without --overlay\n");
     /* Busy time on more workers than cores is mostly time spent waiting for a core: the
-       balancer then moves walls by the scheduler's noise (docs/known-issues.md). */
-    int cores = vw_host_cores();
-    if (balancing && lspec.model == VW_LOAD_BUSY && vw_world_workers(w) > cores &&
-        vw_cli_is_output())
-        fprintf(stderr, "vwalls render: warning: %d workers on %d cores: their busy time is "
+       balancer would move walls by the scheduler's noise (docs/balancing.md). So the
+       default load is then the counted work; asked for, busy time is warned of. Rank 0's
+       reading decides for every process: they must balance by the same load. */
+    int cores = vw_host_cores(), crowded = vw_world_workers(w) > cores;
+    if (balancing && !load_given) {
+        vw_engine_broadcast(&crowded, sizeof crowded);
+        if (crowded) {
+            lspec.model = VW_LOAD_COUNTER;
+            lspec.counter = RT_C_SEGMENTS;
+            if (!quiet && vw_cli_is_output())
+                fprintf(stderr, "vwalls render: %d workers on %d core%s: balancing on counted "
+                                "ray-cell visits (--balance-load segments), not on busy time, "
+                                "which would be mostly waiting for a core\n",
+                        vw_world_workers(w), cores, cores == 1 ? "" : "s");
+        }
+    } else if (balancing && lspec.model == VW_LOAD_BUSY && crowded && vw_cli_is_output()) {
+        fprintf(stderr, "vwalls render: warning: %d workers on %d core%s: their busy time is "
                         "mostly waiting for a core, a poor load to balance by (--balance-load "
-                        "segments counts the work)\n", vw_world_workers(w), cores);
+                        "segments counts the work)\n", vw_world_workers(w), cores,
+                cores == 1 ? "" : "s");
+    }
     rt_balance_result bi;
     memset(&bi, 0, sizeof bi);
     if ((map_given || speeds) && rt_job_map(job, map, NULL, speeds, err, sizeof err) != VW_OK) {

@@ -54,11 +54,24 @@ for b in none dup farm; do
   awk -v a="$a" -v r="$r" 'BEGIN { d = a - r; exit !(a != "" && d < 0.002 && d > -0.002) }' ||
     fail "$b: stats.awk says lambda_work $a, the render's workers $r"
 done
-# Busy time on more workers than cores is no load to balance by: render says so (and
-# does not with segments counted, above: err.txt of the last render is empty of it).
+# Busy time on more workers than cores is no load to balance by: render balances on the
+# counted work by default there, and warns when busy time is asked for (and does not
+# with segments counted, above: err.txt of the last render is empty of it).
 ! grep -q "poor load" err.txt || fail "a warning with --balance-load segments: $(cat err.txt)"
 VW_CORES=2 "$V" render c1.nff -o busy.png --size 64x64 --cells 2x4 --workers 8 --farm none \
-  --balance tensor --quiet 2> err.txt || fail "busy: status $?"
+  --balance tensor --balance-load busy --quiet --stats busy.json 2> err.txt || fail "busy: status $?"
 grep -q "8 workers on 2 cores: their busy time is mostly waiting for a core" err.txt ||
   fail "no warning for busy time on 8 workers, 2 cores: $(cat err.txt)"
+grep -q '"load_model": "busy"' busy.json || fail "--balance-load busy: $(grep -o '"load_model": "[a-z]*"' busy.json)"
+VW_CORES=2 "$V" render c1.nff -o auto.png --size 64x64 --cells 2x4 --workers 8 --farm none \
+  --balance tensor --stats auto.json 2> err.txt > /dev/null || fail "auto: status $?"
+grep -q '"load_model": "segments"' auto.json ||
+  fail "8 workers on 2 cores balanced by $(grep -o '"load_model": "[a-z]*"' auto.json), want segments"
+grep -q "8 workers on 2 cores: balancing on counted ray-cell visits" err.txt ||
+  fail "no note of the counted load: $(cat err.txt)"
+! grep -q "poor load" err.txt || fail "a warning with the default load: $(cat err.txt)"
+VW_CORES=8 "$V" render c1.nff -o eight.png --size 64x64 --cells 2x4 --workers 8 --farm none \
+  --balance tensor --quiet --stats eight.json 2> err.txt || fail "eight: status $?"
+grep -q '"load_model": "busy"' eight.json ||
+  fail "8 workers on 8 cores balanced by $(grep -o '"load_model": "[a-z]*"' eight.json), want busy"
 echo ok

@@ -424,9 +424,11 @@ static void help(const char *cmd)
            "  --balance S      none|tensor|rotate|staggered|divide: rebalance between frames\n"
            "                   when lambda exceeds 1 + --threshold (default 0.1)\n"
            "  --threshold X    rebalance when lambda exceeds 1 + X (default 0.1)\n"
-           "  --trigger T      busy (default) | work: that lambda is of the workers' busy time,\n"
-           "                   or of their counted work (ray segments: the same on every run\n"
-           "                   when no cell has copies, as with --farm idle or none)\n"
+           "  --trigger T      busy | work: that lambda is of the workers' busy time, or of\n"
+           "                   their counted work (ray segments: the same on every run when\n"
+           "                   no cell has copies, as with --farm idle or none); default:\n"
+           "                   busy, or work where the workers outnumber the cores (their\n"
+           "                   busy time is then mostly waiting for a core)\n"
            "  --farm F         auto (default) | all | idle | none, as for render: auto is all\n"
            "                   (every worker holds every cell), or idle with --balance\n"
            "  --margin F       the world box is the scene bounds grown by F x diagonal on\n"
@@ -457,9 +459,9 @@ static char *frames_json(vw_anim_session *s)
     int ok = vw_cli_appendf(&j, &n, &cap,
                             "\"animation\": {\"frames\": %zu, \"accepted\": %zu, \"collisions\": %zu, "
                             "\"sweeps\": %zu, \"invalid\": %zu, \"objects\": %zu, \"farm\": \"%s\", "
-                            "\"per_frame\": [",
+                            "\"trigger\": \"%s\", \"per_frame\": [",
                             s->nframes, s->total_acc, s->total_coll, s->total_sweep, s->total_invalid,
-                            live_objects(s), rt_farm_name(s->farm));
+                            live_objects(s), rt_farm_name(s->farm), s->trigger_work ? "work" : "busy");
     for (size_t i = 0; ok && i < s->nframes; i++) {
         const frame_rec *f = &s->frames[i];
         ok = vw_cli_appendf(&j, &n, &cap,
@@ -707,6 +709,7 @@ int vw_anim_main(const char *cmd, int argc, char **argv)
     vw_box world_min;
     memset(&p, 0, sizeof p);
     long workers = 0, depth = 0;
+    int trigger_given = 0;
     int rc = VW_EXIT_USAGE, farm = -1; /* -1: auto, resolved once the options are read */
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i], *v;
@@ -734,6 +737,7 @@ int vw_anim_main(const char *cmd, int argc, char **argv)
                 goto done;
             }
             s->trigger_work = !strcmp(v, "work");
+            trigger_given = 1;
         } else if (!strcmp(a, "--threshold")) {
             if (!(v = vw_cli_value(cmd, argc, argv, &i)) || vw_cli_double(cmd, a, v, 0, 100, &s->threshold)) goto done;
         } else if (!strcmp(a, "--margin")) {
@@ -863,6 +867,21 @@ int vw_anim_main(const char *cmd, int argc, char **argv)
         vw_cli_error(cmd, "%s", err);
         rc = st == VW_E_INVAL ? VW_EXIT_USAGE : VW_EXIT_FAIL; /* as render's */
         goto done;
+    }
+    /* Busy time on more workers than cores is mostly time spent waiting for a core: its
+       lambda would rebalance at every frame by the scheduler's noise. The default trigger
+       is then the counted work, as render's default load (process 0's count decides for
+       every process: they must rebalance together). */
+    if (!trigger_given && s->strategy && strcmp(s->strategy, "none")) {
+        int workers_here = vw_world_workers(rt_job_world(rt_anim_job(s->anim)));
+        int cores = vw_host_cores(), crowded = workers_here > cores;
+        vw_engine_broadcast(&crowded, sizeof crowded);
+        s->trigger_work = crowded;
+        if (crowded)
+            say(s, "%d workers on %d core%s: rebalancing when the counted work's lambda "
+                   "exceeds 1 + %g (--trigger work), not busy time's, which would be mostly "
+                   "waiting for a core\n", workers_here, cores, cores == 1 ? "" : "s",
+                s->threshold);
     }
     if (log_path) { /* written by the output process; all stop when it cannot */
         vw_status lst = vw_cli_is_output() ? vw_outfile_open(log_path, &s->logf, err, sizeof err) : VW_OK;

@@ -81,6 +81,19 @@ a, b = ([(f["work_lambda"], f["balanced"]) for f in json.load(open(x))["animatio
         for x in sys.argv[1:])
 assert a == b and all(bal == (lam > 1.2) for lam, bal in a), (a, b)
 PY
+# Without --trigger: busy time decides where the workers have cores of their own, the
+# counted work where they outnumber them (busy time is then mostly waiting for a core).
+VW_CORES=2 "$V" animate scene.nff ok.txt -o 'k%02d.png' --cells 2x2x1 --workers 4 --balance tensor \
+  --stats crowded.json > crowded.out || fail "crowded: status $?"
+grep -q '"trigger": "work"' crowded.json || fail "4 workers on 2 cores: trigger $(grep -o '"trigger": "[a-z]*"' crowded.json)"
+grep -q "^4 workers on 2 cores: rebalancing when the counted work's lambda exceeds 1 + 0.1 (--trigger work)" crowded.out ||
+  fail "4 workers on 2 cores: no note: $(head -2 crowded.out)"
+VW_CORES=4 "$V" animate scene.nff ok.txt -o 'k%02d.png' --cells 2x2x1 --workers 4 --balance tensor \
+  --quiet --stats roomy.json || fail "roomy: status $?"
+grep -q '"trigger": "busy"' roomy.json || fail "4 workers on 4 cores: trigger $(grep -o '"trigger": "[a-z]*"' roomy.json)"
+VW_CORES=2 "$V" animate scene.nff ok.txt -o 'k%02d.png' --cells 2x2x1 --workers 4 --balance tensor \
+  --trigger busy --quiet --stats asked.json || fail "asked: status $?"
+grep -q '"trigger": "busy"' asked.json || fail "--trigger busy: trigger $(grep -o '"trigger": "[a-z]*"' asked.json)"
 # The balance command on walls no frame has measured yet (at the start, and right after
 # a rebalance reset the loads) says so and leaves the walls; it used to report
 # "lambda 1.000 -> 1.000". After a frame on unchanged walls it balances by that frame.

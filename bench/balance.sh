@@ -32,9 +32,14 @@ TABLE="$OUT/table.md"
   echo "| scene | cells | strategy | λ work | 1/λ work | λ busy (2 w) | 1/λ busy | compute s (2 w) | speedup | migrated | max nb |"
   echo "|---|---|---|---|---|---|---|---|---|---|---|"
 } > "$TABLE"
+# The generated sphere scenes fill the cube [0,10]^3 (their cluster lies in one octant):
+# the walls divide that space, as the paper's grids do (--world), not the objects' own
+# bounds, which would cut a full cluster evenly. The oblique line runs corner to corner.
+world() { case $1 in oblique) ;; *) echo --world 0,0,0,10,10,10 ;; esac; }
 for scene in uniform cluster50 cluster100 oblique; do
   for cells in 8 16 64; do
     L=$(layout $cells)
+    read -r -a W <<< "$(world "$scene")"
     base=""
     for s in none tensor rotate staggered divide duplicate; do
       # Deterministic: one worker per cell, loads = counted ray-cell visits (none has
@@ -42,7 +47,7 @@ for scene in uniform cluster50 cluster100 oblique; do
       bl=(--balance-load segments)
       [ "$s" = none ] && bl=()
       "$VWALLS" render "$OUT/$scene.nff" -o "$T/img.png" --size "$SIZE" --cells "$L" \
-        --workers "$cells" --farm none --balance "$s" "${bl[@]}" --quiet \
+        --workers "$cells" --farm none --balance "$s" "${bl[@]}" "${W[@]}" --quiet \
         --stats "$T/w.json"
       read -r lw mig nb < <(json "$T/w.json" "['balance_detail']['imbalance_work']" \
         "['balance_detail']['migrated_objects']" "['balance_detail']['max_neighbours']")
@@ -50,7 +55,7 @@ for scene in uniform cluster50 cluster100 oblique; do
       best=""; lb=""
       for _ in 1 2 3; do
         "$VWALLS" render "$OUT/$scene.nff" -o "$T/img.png" --size "$SIZE" --cells "$L" \
-          --workers 2 --farm none --balance "$s" --quiet --stats "$T/b.json"
+          --workers 2 --farm none --balance "$s" "${W[@]}" --quiet --stats "$T/b.json"
         read -r c l < <(json "$T/b.json" "['time_s']['compute']" "['balance']['imbalance']")
         if [ -z "$best" ] || awk -v a="$c" -v b="$best" 'BEGIN { exit !(a < b) }'; then best=$c; lb=$l; fi
       done
@@ -104,11 +109,11 @@ cat "$MOVING"
 # Walls before and after for the 50% clustered scene (8 cells, staggered), and the
 # mapping of 16 cells onto 2 workers.
 "$VWALLS" render "$OUT/cluster50.nff" -o "$T/img.png" --size 384x384 --cells 2x2x2 --workers 8 \
-  --farm none --quiet --overlay "$OUT/walls_before.png"
+  --farm none --world 0,0,0,10,10,10 --quiet --overlay "$OUT/walls_before.png"
 "$VWALLS" render "$OUT/cluster50.nff" -o "$T/img.png" --size 384x384 --cells 2x2x2 --workers 8 \
-  --balance staggered --balance-load segments --quiet --overlay "$OUT/walls_staggered.png"
+  --balance staggered --balance-load segments --world 0,0,0,10,10,10 --quiet --overlay "$OUT/walls_staggered.png"
 "$VWALLS" render "$OUT/cluster50.nff" -o "$T/img.png" --size 384x384 --cells 2x2x2 --workers 8 \
-  --balance tensor --balance-load segments --quiet --overlay "$OUT/walls_tensor.png"
+  --balance tensor --balance-load segments --world 0,0,0,10,10,10 --quiet --overlay "$OUT/walls_tensor.png"
 # The side-by-side picture is an extra: a convert that cannot make it (ImageMagick
 # missing, or a stand-in of that name) leaves the three pictures, not a failed bench.
 if command -v convert >/dev/null &&

@@ -400,10 +400,26 @@ vw_status rt_job_balance(rt_job *j, const rt_balance *b, rt_balance_result *bi, 
         }
         vw_balance_params bp;
         vw_balance_params_init(&bp);
-        bp.strategy = strategy;
         bp.speeds = b->speeds;
         vw_balance_apply ap = {(int)b->map, b->speeds, 0, 0};
         vw_balance_report rep;
+        if (refuted && strategy == VW_BALANCE_ROTATE && vw_decomp_frame(d) &&
+            !vw_decomp_frame(best.d)) {
+            /* A rotated frame refuted against an unrotated best layout is not tried
+               again: every rotated candidate is predicted from a field that cannot see
+               the work a turned world box adds (more eye rays enter it), so rotate would
+               pick one again, round after round, and the rounds ended on the grid,
+               unbalanced (1000 uniform spheres in [0,10]^3, 160x160, 2x2x2 cells, one
+               worker a cell, --balance-load segments: five rotated layouts refuted, work
+               lambda 1.568 where tensor's walls give 1.272). Back to the best layout, and
+               on with rotate's unrotated candidate, tensor's walls. */
+            if ((st = layout_restore(w, &best)) != VW_OK) {
+                snprintf(err, errlen, "restoring the best layout: %s", vw_status_message(st));
+                break;
+            }
+            strategy = VW_BALANCE_TENSOR;
+        }
+        bp.strategy = strategy;
         if ((st = balance_once(w, f, &bp, &ap, &rep, r == 0, bi, err, errlen)) != VW_OK) break;
         bi->rounds++;
         if (!rep.applied && refuted && r + 1 < rounds) {
@@ -414,18 +430,8 @@ vw_status rt_job_balance(rt_job *j, const rt_balance *b, rt_balance_result *bi, 
                2x4 cells, 8 workers, --balance-load segments) was predicted at lambda 1.000
                from the field of the grid's uniform cells, measured 1.361 with more work,
                could not be re-cut in its frame, and the grid came back with its work lambda
-               1.514, where the unrotated frame's walls give 1.15.
-               A rotated frame refuted against an unrotated best layout is not tried again:
-               every rotated candidate is predicted from a field that cannot see the work a
-               turned world box adds (more eye rays enter it), so rotate would pick one
-               again (at 256x256 the same scene went through four refuted rotated layouts
-               back to the grid). Balancing on goes on with rotate's unrotated candidate,
-               tensor's walls. */
-            int turned = vw_decomp_frame(vw_world_decomp(w)) != NULL;
+               1.514, where the unrotated frame's walls give 1.15. */
             st = layout_restore(w, &best);
-            if (st == VW_OK && strategy == VW_BALANCE_ROTATE && turned &&
-                !vw_decomp_frame(vw_world_decomp(w)))
-                bp.strategy = strategy = VW_BALANCE_TENSOR;
             if (st != VW_OK) {
                 snprintf(err, errlen, "restoring the best layout: %s", vw_status_message(st));
                 break;

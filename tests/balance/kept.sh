@@ -5,7 +5,8 @@
 # - rotate ends better than no balancing: its first rotated frame was refuted by the next
 #   pre-pass and could not be re-cut, and the rounds stopped on the grid, unbalanced
 #   (work lambda 1.502, none's; tensor 1.303). They now go back to the best layout and
-#   balance on from there with rotate's unrotated candidate;
+#   balance on from there with rotate's unrotated candidate (and, on uniform spheres,
+#   after any refuted rotated frame, not only one that cannot be re-cut);
 # - a run that keeps its starting layout reports "predicted" = "before" (it reported the
 #   prediction of the layout it undid: 1.303 for the grid kept at 1.510);
 # - bench/experiments/stats.awk's lambda_work is the workers' own counted work, as the
@@ -38,6 +39,21 @@ for b in none rotate tensor; do
 done
 awk -v r="$(field imbalance_work rotate.json)" -v n="$(field imbalance_work none.json)" \
   'BEGIN { exit !(r < n - 0.1) }' || fail "rotate kept work lambda $(field imbalance_work rotate.json), none's is $(field imbalance_work none.json)"
+# The same on uniform spheres in their cube (bench/balance.sh's uniform row), where each
+# balance from a refuted rotated frame found another rotated frame to apply: five were
+# refuted and the rounds ended on the grid (work lambda 1.568, none's; tensor 1.272). A
+# refuted rotated frame now sends the rounds back to the best layout, on with tensor.
+"$V" gen spheres --count 1000 --seed 7 -o u.nff || fail "gen uniform"
+for b in none rotate; do
+  "$V" render u.nff -o "u$b.png" --size 160x160 --cells 2x2x2 --workers 8 --farm none \
+    --balance $b --balance-load segments --world 0,0,0,10,10,10 --stats "u$b.json" --quiet ||
+    fail "uniform $b: status $?"
+done
+echo "uniform: rotate work lambda $(field imbalance_work urotate.json), none's $(field imbalance_work unone.json)"
+cmp -s unone.png urotate.png || fail "uniform rotate: the image differs from none's"
+awk -v r="$(field imbalance_work urotate.json)" -v n="$(field imbalance_work unone.json)" \
+  'BEGIN { exit !(r < n - 0.1) }' ||
+  fail "uniform: rotate kept work lambda $(field imbalance_work urotate.json), none's is $(field imbalance_work unone.json)"
 for b in rotate tensor; do
   m=$(field imbalance_measured $b.json) bf=$(field imbalance_before $b.json) p=$(field imbalance_predicted $b.json)
   if [ "$m" = "$bf" ]; then

@@ -308,6 +308,7 @@ vw_status rt_job_balance(rt_job *j, const rt_balance *b, rt_balance_result *bi, 
        "before" instead of a gain it never got. */
     double pred_applied = 0, best_pred = 0;
     int best_round = 0;
+    int turned_refuted = 0; /* rotated frames refuted in a row (below) */
     vw_balance_strategy strategy = b->strategy; /* rotate may fall back to tensor, below */
     for (int r = 0; st == VW_OK && r <= rounds; r++) {
         double t0 = now();
@@ -403,16 +404,23 @@ vw_status rt_job_balance(rt_job *j, const rt_balance *b, rt_balance_result *bi, 
         bp.speeds = b->speeds;
         vw_balance_apply ap = {(int)b->map, b->speeds, 0, 0};
         vw_balance_report rep;
-        if (refuted && strategy == VW_BALANCE_ROTATE && vw_decomp_frame(d) &&
-            !vw_decomp_frame(best.d)) {
-            /* A rotated frame refuted against an unrotated best layout is not tried
-               again: every rotated candidate is predicted from a field that cannot see
-               the work a turned world box adds (more eye rays enter it), so rotate would
-               pick one again, round after round, and the rounds ended on the grid,
-               unbalanced (1000 uniform spheres in [0,10]^3, 160x160, 2x2x2 cells, one
-               worker a cell, --balance-load segments: five rotated layouts refuted, work
-               lambda 1.568 where tensor's walls give 1.272). Back to the best layout, and
-               on with rotate's unrotated candidate, tensor's walls. */
+        /* A rotated frame refuted against an unrotated best layout gets one more round
+           in its frame: its walls are cut again there from the field its measurement
+           re-calibrated (the fully clustered 1000 spheres, 512x512, 2x4 cells, one
+           worker a cell, --balance-load segments: the first frame measured 0.2 % worse
+           than the grid, the next one in it gave work lambda 1.087, tensor's walls after
+           it 1.197). Refuted again, rotation is given up: every rotated candidate is
+           predicted from a field that cannot see the work a turned world box adds (more
+           eye rays enter it), so rotate would pick one round after round, and the
+           rounds ended on the grid, unbalanced (1000 uniform spheres in their cube,
+           160x160, 2x2x2: five rotated layouts refuted, work lambda 1.568 where
+           tensor's walls give 1.272). Back to the best layout, and on with rotate's
+           unrotated candidate, tensor's walls. */
+        int turned = vw_decomp_frame(d) != NULL;
+        if (!refuted) {
+            turned_refuted = 0;
+        } else if (strategy == VW_BALANCE_ROTATE && turned && !vw_decomp_frame(best.d) &&
+                   ++turned_refuted >= 2) {
             if ((st = layout_restore(w, &best)) != VW_OK) {
                 snprintf(err, errlen, "restoring the best layout: %s", vw_status_message(st));
                 break;
@@ -430,8 +438,12 @@ vw_status rt_job_balance(rt_job *j, const rt_balance *b, rt_balance_result *bi, 
                2x4 cells, 8 workers, --balance-load segments) was predicted at lambda 1.000
                from the field of the grid's uniform cells, measured 1.361 with more work,
                could not be re-cut in its frame, and the grid came back with its work lambda
-               1.514, where the unrotated frame's walls give 1.15. */
+               1.514, where the unrotated frame's walls give 1.15. A rotated frame that
+               cannot be re-cut is given up at once, as above. */
             st = layout_restore(w, &best);
+            if (st == VW_OK && strategy == VW_BALANCE_ROTATE && turned &&
+                !vw_decomp_frame(vw_world_decomp(w)))
+                bp.strategy = strategy = VW_BALANCE_TENSOR;
             if (st != VW_OK) {
                 snprintf(err, errlen, "restoring the best layout: %s", vw_status_message(st));
                 break;

@@ -42,7 +42,8 @@ awk -v r="$(field imbalance_work rotate.json)" -v n="$(field imbalance_work none
 # The same on uniform spheres in their cube (bench/balance.sh's uniform row), where each
 # balance from a refuted rotated frame found another rotated frame to apply: five were
 # refuted and the rounds ended on the grid (work lambda 1.568, none's; tensor 1.272). A
-# refuted rotated frame now sends the rounds back to the best layout, on with tensor.
+# rotated frame refuted twice in a row now sends the rounds back to the best layout, on
+# with tensor (1.202).
 "$V" gen spheres --count 1000 --seed 7 -o u.nff || fail "gen uniform"
 for b in none rotate; do
   "$V" render u.nff -o "u$b.png" --size 160x160 --cells 2x2x2 --workers 8 --farm none \

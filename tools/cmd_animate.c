@@ -870,12 +870,11 @@ int vw_anim_main(const char *cmd, int argc, char **argv)
     }
     /* Busy time on more workers than cores is mostly time spent waiting for a core: its
        lambda would rebalance at every frame by the scheduler's noise. The default trigger
-       is then the counted work, as render's default load (process 0's count decides for
-       every process: they must rebalance together). */
+       is then the counted work, as render's default load (the cores as render counts
+       them, so every process decides alike: they must rebalance together). */
     if (!trigger_given && s->strategy && strcmp(s->strategy, "none")) {
         int workers_here = vw_world_workers(rt_job_world(rt_anim_job(s->anim)));
-        int cores = vw_host_cores(), crowded = workers_here > cores;
-        vw_engine_broadcast(&crowded, sizeof crowded);
+        int cores = vw_engine_workers(0), crowded = workers_here > cores;
         s->trigger_work = crowded;
         if (crowded)
             say(s, "%d workers on %d core%s: rebalancing when the counted work's lambda "

@@ -583,11 +583,12 @@ int vw_cmd_render(int argc, char **argv)
         fprintf(stderr, "vwalls render: warning: --overlay-by has no effect without --overlay\n");
     /* Busy time on more workers than cores is mostly time spent waiting for a core: the
        balancer would move walls by the scheduler's noise (docs/balancing.md). So the
-       default load is then the counted work; asked for, busy time is warned of. Rank 0's
-       reading decides for every process: they must balance by the same load. */
-    int cores = vw_host_cores(), crowded = vw_world_workers(w) > cores;
+       default load is then the counted work; asked for, busy time is warned of. The
+       cores are each process's share of its host's (processes that may run on the same
+       cores split them), the fewest of any process, so every process decides alike: they
+       must balance by the same load (collective under MPI). */
+    int cores = vw_engine_workers(0), crowded = vw_world_workers(w) > cores;
     if (balancing && !load_given) {
-        vw_engine_broadcast(&crowded, sizeof crowded);
         if (crowded) {
             lspec.model = VW_LOAD_COUNTER;
             lspec.counter = RT_C_SEGMENTS;

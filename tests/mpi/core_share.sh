@@ -2,7 +2,8 @@
 # core_share.sh - the default worker count under MPI: processes of one host that may run
 # on the same CPUs share its cores. Started unbound (each may run on every CPU), the 2
 # processes each run half the workers one process runs alone (at least 1); an explicit
-# --workers is kept, and so is VW_CORES's count (a process told its cores keeps them).
+# --workers is kept, and so is VW_CORES's count (a process told its cores keeps them). The
+# default balance load is the counted work where the workers outnumber that share.
 # usage: core_share.sh VWALLS SCENE FLAVOUR "MPIEXEC -n 2 [flags]"
 vwalls=$1 scene=$2 flavour=$3 launch=$4
 dir=$(mktemp -d)
@@ -32,6 +33,25 @@ expect() {
 expect "$half" "unbound, $alone alone"
 opts="--workers 3"
 expect 3 "unbound, --workers 3"
+# The default balance load follows the same share (every process must decide alike):
+# busy time on the workers the share gives, counted segments on one more, where busy
+# time would be mostly waiting for a core.
+load() {
+    opts="--cells 2x2 --balance tensor --quiet --stats $dir/s.json $1"
+    rm -f "$dir/s.json"
+    # shellcheck disable=SC2086
+    render $launch $unbound >"$dir/out" 2>&1
+    got=$(sed -n 's/.*"load_model": "\([a-z]*\)".*/\1/p' "$dir/s.json" 2>/dev/null)
+    if [ "$got" = "$2" ]; then
+        echo "ok: balance load $got with ${1:-the default workers}"
+    else
+        echo "FAIL: balance load '$got' with ${1:-the default workers}, expected $2:"
+        cat "$dir/out"
+        fail=1
+    fi
+}
+load "" busy
+load "--workers $((half + 1))" segments
 opts=""
 export VW_CORES=3
 expect 3 "unbound, VW_CORES=3"

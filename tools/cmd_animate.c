@@ -876,11 +876,12 @@ int vw_anim_main(const char *cmd, int argc, char **argv)
         int workers_here = vw_world_workers(rt_job_world(rt_anim_job(s->anim)));
         int cores = vw_engine_workers(0), crowded = workers_here > cores;
         s->trigger_work = crowded;
-        if (crowded)
-            say(s, "%d workers on %d core%s: rebalancing when the counted work's lambda "
-                   "exceeds 1 + %g (--trigger work), not busy time's, which would be mostly "
-                   "waiting for a core\n", workers_here, cores, cores == 1 ? "" : "s",
-                s->threshold);
+        /* On stderr, as render's note: edit's standard output is its answers. */
+        if (crowded && !s->quiet && vw_cli_is_output())
+            fprintf(stderr, "vwalls %s: %d workers on %d core%s: rebalancing when the counted "
+                            "work's lambda exceeds 1 + %g (--trigger work), not busy time's, "
+                            "which would be mostly waiting for a core\n",
+                    cmd, workers_here, cores, cores == 1 ? "" : "s", s->threshold);
     }
     if (log_path) { /* written by the output process; all stop when it cannot */
         vw_status lst = vw_cli_is_output() ? vw_outfile_open(log_path, &s->logf, err, sizeof err) : VW_OK;

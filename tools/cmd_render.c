@@ -588,16 +588,14 @@ int vw_cmd_render(int argc, char **argv)
        cores split them), the fewest of any process, so every process decides alike: they
        must balance by the same load (collective under MPI). */
     int cores = vw_engine_workers(0), crowded = vw_world_workers(w) > cores;
-    if (balancing && !load_given) {
-        if (crowded) {
-            lspec.model = VW_LOAD_COUNTER;
-            lspec.counter = RT_C_SEGMENTS;
-            if (!quiet && vw_cli_is_output())
-                fprintf(stderr, "vwalls render: %d workers on %d core%s: balancing on counted "
-                                "ray-cell visits (--balance-load segments), not on busy time, "
-                                "which would be mostly waiting for a core\n",
-                        vw_world_workers(w), cores, cores == 1 ? "" : "s");
-        }
+    if (balancing && !load_given && crowded) {
+        lspec.model = VW_LOAD_COUNTER;
+        lspec.counter = RT_C_SEGMENTS;
+        if (!quiet && vw_cli_is_output())
+            fprintf(stderr, "vwalls render: %d workers on %d core%s: balancing on counted "
+                            "ray-cell visits (--balance-load segments), not on busy time, "
+                            "which would be mostly waiting for a core\n",
+                    vw_world_workers(w), cores, cores == 1 ? "" : "s");
     } else if (balancing && lspec.model == VW_LOAD_BUSY && crowded && vw_cli_is_output()) {
         fprintf(stderr, "vwalls render: warning: %d workers on %d core%s: their busy time is "
                         "mostly waiting for a core, a poor load to balance by (--balance-load "

@@ -84,10 +84,11 @@ PY
 # Without --trigger: busy time decides where the workers have cores of their own, the
 # counted work where they outnumber them (busy time is then mostly waiting for a core).
 VW_CORES=2 "$V" animate scene.nff ok.txt -o 'k%02d.png' --cells 2x2x1 --workers 4 --balance tensor \
-  --stats crowded.json > crowded.out || fail "crowded: status $?"
+  --stats crowded.json > crowded.out 2> crowded.err || fail "crowded: status $?"
 grep -q '"trigger": "work"' crowded.json || fail "4 workers on 2 cores: trigger $(grep -o '"trigger": "[a-z]*"' crowded.json)"
-grep -q "^4 workers on 2 cores: rebalancing when the counted work's lambda exceeds 1 + 0.1 (--trigger work)" crowded.out ||
-  fail "4 workers on 2 cores: no note: $(head -2 crowded.out)"
+grep -q "^vwalls animate: 4 workers on 2 cores: rebalancing when the counted work's lambda exceeds 1 + 0.1 (--trigger work)" crowded.err ||
+  fail "4 workers on 2 cores: no note: $(cat crowded.err)"
+head -1 crowded.out | grep -q "^frame 0:" || fail "the note went to standard output: $(head -1 crowded.out)"
 VW_CORES=4 "$V" animate scene.nff ok.txt -o 'k%02d.png' --cells 2x2x1 --workers 4 --balance tensor \
   --quiet --stats roomy.json || fail "roomy: status $?"
 grep -q '"trigger": "busy"' roomy.json || fail "4 workers on 4 cores: trigger $(grep -o '"trigger": "[a-z]*"' roomy.json)"

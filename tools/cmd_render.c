@@ -56,10 +56,12 @@ static void help(void)
            "                   measures where the work lies, the balancer moves the walls (or,\n"
            "                   duplicate, copies overloaded cells to idle workers, which share\n"
            "                   their rays), then the full render (the image does not change)\n"
-           "  --balance-load M busy (measured time) | segments (counted ray-cell visits:\n"
-           "                   deterministic) | model (objects + pixels + messages); default:\n"
-           "                   busy, or segments where the workers outnumber the cores (their\n"
-           "                   busy time is then mostly waiting for a core)\n"
+           "  --balance-load M busy (measured time) | searches (counted ray-cell visits that\n"
+           "                   search the cell's objects) | segments (all counted ray-cell\n"
+           "                   visits, also those passing through empty space) | model\n"
+           "                   (objects + pixels + messages); the counts are deterministic;\n"
+           "                   default: busy, or searches where the workers outnumber the\n"
+           "                   cores (busy time is then mostly waiting for a core)\n"
            "  --balance-iters N  pre-pass / balance rounds, 1 to 20 (default 2; divide and\n"
            "                     rotate take up to 3 more, stopping when no gain is\n"
            "                     predicted)\n"
@@ -164,6 +166,9 @@ static char *with_balance_json(char *rt, rt_job *job, vw_world *w, const vw_traf
 {
     if (!rt) return NULL;
     static const char *const models[] = {"busy", "segments", "model"};
+    const char *model = ls->model == VW_LOAD_COUNTER && ls->counter == RT_C_SEARCHES
+                            ? "searches"
+                            : models[ls->model <= VW_LOAD_MODEL ? ls->model : 0];
     size_t n = strlen(rt) + 1024;
     char *out = malloc(n);
     if (!out) return rt;
@@ -180,7 +185,7 @@ static char *with_balance_json(char *rt, rt_job *job, vw_world *w, const vw_traf
              "\"machine_messages\": %llu, \"machine_bytes\": %llu, \"share_worker\": %.6g, "
              "\"share_process\": %.6g, \"share_machine\": %.6g}",
              rt, vw_balance_strategy_name(s), vw_map_kind_name(map),
-             models[ls->model <= VW_LOAD_MODEL ? ls->model : 0], bi->rounds,
+             model, bi->rounds,
              num(bi->rep.imbalance_before), num(bi->rep.imbalance_predicted),
              num(vw_world_imbalance(w)), num(rt_job_work_imbalance(job, speeds)),
              (unsigned long long)bi->migrated,
@@ -283,11 +288,15 @@ int vw_cmd_render(int argc, char **argv)
             } else if (!strcmp(v, "segments")) {
                 lspec.model = VW_LOAD_COUNTER;
                 lspec.counter = RT_C_SEGMENTS;
+            } else if (!strcmp(v, "searches")) {
+                lspec.model = VW_LOAD_COUNTER;
+                lspec.counter = RT_C_SEARCHES;
             } else if (!strcmp(v, "model")) {
                 lspec.model = VW_LOAD_MODEL;
                 lspec.counter = RT_C_PIXELS;
             } else {
-                vw_cli_error(CMD, "--balance-load: bad value '%s' (expected busy, segments or model)", v);
+                vw_cli_error(CMD, "--balance-load: bad value '%s' (expected busy, searches, segments "
+                                  "or model)", v);
                 return VW_EXIT_USAGE;
             }
         } else if (!strcmp(a, "--balance-iters")) {
@@ -590,16 +599,16 @@ int vw_cmd_render(int argc, char **argv)
     int cores = vw_engine_workers(0), crowded = vw_world_workers(w) > cores;
     if (balancing && !load_given && crowded) {
         lspec.model = VW_LOAD_COUNTER;
-        lspec.counter = RT_C_SEGMENTS;
+        lspec.counter = RT_C_SEARCHES;
         if (!quiet && vw_cli_is_output())
-            fprintf(stderr, "vwalls render: %d workers on %d core%s: balancing on counted "
-                            "ray-cell visits (--balance-load segments), not on busy time, "
-                            "which would be mostly waiting for a core\n",
+            fprintf(stderr, "vwalls render: %d workers on %d core%s: balancing on the counted "
+                            "searches of the cells' objects (--balance-load searches), not on "
+                            "busy time, which would be mostly waiting for a core\n",
                     vw_world_workers(w), cores, cores == 1 ? "" : "s");
     } else if (balancing && lspec.model == VW_LOAD_BUSY && crowded && vw_cli_is_output()) {
         fprintf(stderr, "vwalls render: warning: %d workers on %d core%s: their busy time is "
                         "mostly waiting for a core, a poor load to balance by (--balance-load "
-                        "segments counts the work)\n", vw_world_workers(w), cores,
+                        "searches counts the work)\n", vw_world_workers(w), cores,
                 cores == 1 ? "" : "s");
     }
     rt_balance_result bi;

@@ -76,7 +76,7 @@ typedef struct rt_cell {
 } rt_cell;
 
 static const char *const counter_names[RT_NCOUNTERS] = {
-    "eye", "reflect", "refract", "shadow", "ended", "pixels", "segments"};
+    "eye", "reflect", "refract", "shadow", "ended", "pixels", "segments", "searches"};
 
 /* ---- small vector helpers ------------------------------------------------------------ */
 
@@ -395,15 +395,18 @@ static int walk_ray(vw_ctx *ctx, rt_cell *c, rt_ray *r, vw_walk *w)
            object of the cell that spawned it, so its first segment meets the reach.) */
         if (c->bounded && r->t0 > 0 && !meets_reach(c, r, tn)) {
             /* nothing of this cell on the segment: on to the next cell */
-        } else if (r->kind == RT_SHADOW) {
-            if (rt_cell_geo_occluded(c->geo, r->org, r->dir, tn, tf)) {
+        } else {
+            c->tally[RT_C_SEARCHES]++;
+            if (r->kind == RT_SHADOW) {
+                if (rt_cell_geo_occluded(c->geo, r->org, r->dir, tn, tf)) {
+                    c->tally[RT_C_ENDED]++;
+                    return entered;
+                }
+            } else if (rt_cell_geo_intersect(c->geo, r->org, r->dir, tn, tf, &h)) {
                 c->tally[RT_C_ENDED]++;
+                shade(ctx, c, r, &h);
                 return entered;
             }
-        } else if (rt_cell_geo_intersect(c->geo, r->org, r->dir, tn, tf, &h)) {
-            c->tally[RT_C_ENDED]++;
-            shade(ctx, c, r, &h);
-            return entered;
         }
         if (!w) {
             vw_segment seg = {vw_ctx_cell(ctx), r->t0, r->t1};

@@ -92,6 +92,8 @@ enum {
     RT_C_ENDED,                                            /* rays ended, any kind */
     RT_C_PIXELS,                                           /* primary pixels of a cell */
     RT_C_SEGMENTS,                                         /* cell visits of all rays */
+    RT_C_SEARCHES, /* the visits that searched the cell's objects (Embree), not passed over
+                      by the reach test: the work the cell's objects make */
     RT_NCOUNTERS
 };
 

@@ -12,7 +12,9 @@
 # - bench/experiments/stats.awk's lambda_work is the workers' own counted work, as the
 #   stats' balance_detail.imbalance_work: it summed each cell's work onto its master, so
 #   duplicate's and farmed rows showed no balancing's lambda (1.514 for duplicate at
-#   512x512, where its workers did 1.08).
+#   512x512, where its workers did 1.08);
+# - the default load with more workers than cores, and the searches load, which cuts the
+#   cluster where the segments load (every visit alike) leaves it whole.
 # usage: kept.sh VWALLS TMPDIR
 set -u
 V=$(cd "$(dirname "$1")" && pwd)/$(basename "$1") T=$2
@@ -82,13 +84,29 @@ grep -q "8 workers on 2 cores: their busy time is mostly waiting for a core" err
 grep -q '"load_model": "busy"' busy.json || fail "--balance-load busy: $(grep -o '"load_model": "[a-z]*"' busy.json)"
 VW_CORES=2 "$V" render c1.nff -o auto.png --size 64x64 --cells 2x4 --workers 8 --farm none \
   --balance tensor --stats auto.json 2> err.txt > /dev/null || fail "auto: status $?"
-grep -q '"load_model": "segments"' auto.json ||
-  fail "8 workers on 2 cores balanced by $(grep -o '"load_model": "[a-z]*"' auto.json), want segments"
-grep -q "8 workers on 2 cores: balancing on counted ray-cell visits" err.txt ||
+grep -q '"load_model": "searches"' auto.json ||
+  fail "8 workers on 2 cores balanced by $(grep -o '"load_model": "[a-z]*"' auto.json), want searches"
+grep -q "8 workers on 2 cores: balancing on the counted searches" err.txt ||
   fail "no note of the counted load: $(cat err.txt)"
 ! grep -q "poor load" err.txt || fail "a warning with the default load: $(cat err.txt)"
 VW_CORES=8 "$V" render c1.nff -o eight.png --size 64x64 --cells 2x4 --workers 8 --farm none \
   --balance tensor --quiet --stats eight.json 2> err.txt || fail "eight: status $?"
 grep -q '"load_model": "busy"' eight.json ||
   fail "8 workers on 8 cores balanced by $(grep -o '"load_model": "[a-z]*"' eight.json), want busy"
+# The searches load counts only the visits that search a cell's objects: on the cluster
+# in its cube (--world), tensor's wall then cuts the cluster in two, where all visits
+# (eye rays crossing the empty cell count as much) leave it whole in one cell.
+for m in segments searches; do
+  "$V" render c1.nff -o "two-$m.png" --size 256x256 --cells 2 --workers 2 --farm none \
+    --balance tensor --balance-load $m --world 0,0,0,10,10,10 --stats "two-$m.json" --quiet ||
+    fail "2 cells, $m: status $?"
+  cmp -s none.png "two-$m.png" || fail "2 cells, $m: the image differs from none's"
+done
+objs() { python3 -c 'import json, sys; print(*[c["objects"] for c in json.load(open(sys.argv[1]))["cells"]])' "$1"; }
+echo "2 cells: objects by segments $(objs two-segments.json), by searches $(objs two-searches.json)"
+grep -q '"load_model": "searches"' two-searches.json || fail "searches: load_model $(grep -o '"load_model": "[a-z]*"' two-searches.json)"
+objs two-searches.json | awk '{ exit !($1 >= 300 && $2 >= 300) }' ||
+  fail "searches: the cluster not cut in two: $(objs two-searches.json)"
+objs two-segments.json | awk '{ exit !($1 == 1000 || $2 == 1000) }' ||
+  fail "segments: expected the cluster whole in one cell (the test's premise): $(objs two-segments.json)"
 echo ok

@@ -34,7 +34,7 @@ expect "$half" "unbound, $alone alone"
 opts="--workers 3"
 expect 3 "unbound, --workers 3"
 # The default balance load follows the same share (every process must decide alike):
-# busy time on the workers the share gives, counted segments on one more, where busy
+# busy time on the workers the share gives, counted searches on one more, where busy
 # time would be mostly waiting for a core.
 load() {
     opts="--cells 2x2 --balance tensor --quiet --stats $dir/s.json $1"
@@ -51,7 +51,7 @@ load() {
     fi
 }
 load "" busy
-load "--workers $((half + 1))" segments
+load "--workers $((half + 1))" searches
 opts=""
 export VW_CORES=3
 expect 3 "unbound, VW_CORES=3"

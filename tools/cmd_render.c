@@ -595,8 +595,10 @@ int vw_cmd_render(int argc, char **argv)
        default load is then the counted work; asked for, busy time is warned of. The
        cores are each process's share of its host's (processes that may run on the same
        cores split them), the fewest of any process, so every process decides alike: they
-       must balance by the same load (collective under MPI). */
-    int cores = vw_engine_workers(0), crowded = vw_world_workers(w) > cores;
+       must balance by the same load (collective under MPI: counted only when balancing,
+       which every process is or none). */
+    int cores = balancing ? vw_engine_workers(0) : 0;
+    int crowded = balancing && vw_world_workers(w) > cores;
     if (balancing && !load_given && crowded) {
         lspec.model = VW_LOAD_COUNTER;
         lspec.counter = RT_C_SEARCHES;

@@ -189,6 +189,15 @@ static vw_status layout_restore(vw_world *w, const layout *l)
     return st;
 }
 
+/* Back to the best layout the rounds measured; err names the step when it fails. */
+static vw_status restore_best(vw_world *w, const layout *best, char *err, size_t errlen)
+{
+    vw_status st = layout_restore(w, best);
+    if (st != VW_OK)
+        snprintf(err, errlen, "restoring the best layout: %s", vw_status_message(st));
+    return st;
+}
+
 /* What the last run (a pre-pass) measured of the layout: lambda of its loads per
    worker (copies of duplicated cells where they ran) into *lam, and its cost: the
    slowest worker's load (its busy time, or its counted or modelled load over its
@@ -370,7 +379,7 @@ vw_status rt_job_balance(rt_job *j, const rt_balance *b, rt_balance_result *bi, 
         if (refuted && last) {
             /* Back to the best layout measured (its cells are built for the pre-pass as
                the others, so stale stays). */
-            st = layout_restore(w, &best);
+            st = restore_best(w, &best, err, errlen);
             bi->reverted = 1;
             break;
         }
@@ -417,20 +426,19 @@ vw_status rt_job_balance(rt_job *j, const rt_balance *b, rt_balance_result *bi, 
            tensor's walls give 1.272). Back to the best layout, and on with rotate's
            unrotated candidate, tensor's walls. */
         int turned = vw_decomp_frame(d) != NULL;
+        int at_best = 0; /* the world holds the best layout again (restored this round) */
         if (!refuted) {
             turned_refuted = 0;
         } else if (strategy == VW_BALANCE_ROTATE && turned && !vw_decomp_frame(best.d) &&
                    ++turned_refuted >= 2) {
-            if ((st = layout_restore(w, &best)) != VW_OK) {
-                snprintf(err, errlen, "restoring the best layout: %s", vw_status_message(st));
-                break;
-            }
+            if ((st = restore_best(w, &best, err, errlen)) != VW_OK) break;
+            at_best = 1;
             strategy = VW_BALANCE_TENSOR;
         }
         bp.strategy = strategy;
         if ((st = balance_once(w, f, &bp, &ap, &rep, r == 0, bi, err, errlen)) != VW_OK) break;
         bi->rounds++;
-        if (!rep.applied && refuted && r + 1 < rounds) {
+        if (!rep.applied && refuted && !at_best && r + 1 < rounds) {
             /* The layout measured worse than the best, and no balance on from it predicts a
                gain: go back to the best layout and balance again from there, on the field
                as this measurement re-calibrated it. Stopping here kept the best layout
@@ -440,24 +448,17 @@ vw_status rt_job_balance(rt_job *j, const rt_balance *b, rt_balance_result *bi, 
                could not be re-cut in its frame, and the grid came back with its work lambda
                1.514, where the unrotated frame's walls give 1.15. A rotated frame that
                cannot be re-cut is given up at once, as above. */
-            st = layout_restore(w, &best);
-            if (st == VW_OK && strategy == VW_BALANCE_ROTATE && turned &&
-                !vw_decomp_frame(vw_world_decomp(w)))
+            if ((st = restore_best(w, &best, err, errlen)) != VW_OK) break;
+            if (strategy == VW_BALANCE_ROTATE && turned && !vw_decomp_frame(vw_world_decomp(w)))
                 bp.strategy = strategy = VW_BALANCE_TENSOR;
-            if (st != VW_OK) {
-                snprintf(err, errlen, "restoring the best layout: %s", vw_status_message(st));
-                break;
-            }
             if ((st = balance_once(w, f, &bp, &ap, &rep, 0, bi, err, errlen)) != VW_OK) break;
             if (!rep.applied) { /* the best layout stays, balanced no further */
                 bi->reverted = 1;
                 break;
             }
         } else if (!rep.applied) { /* nothing changed: measuring again would tell nothing */
-            if (refuted) {
-                st = layout_restore(w, &best);
-                bi->reverted = 1;
-            }
+            if (refuted && !at_best) st = restore_best(w, &best, err, errlen);
+            bi->reverted = refuted;
             break;
         }
         pred_applied = rep.imbalance_predicted;

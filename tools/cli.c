@@ -312,6 +312,18 @@ const char *vw_cli_bytes(double n, char *buf, size_t len)
     return buf;
 }
 
+const char *vw_cli_crowding(int workers, double cores, char *buf, size_t len)
+{
+    const char *each = vw_engine_size() > 1 ? " a process" : "";
+    char c[32];
+    if (cores < 1)
+        snprintf(c, sizeof c, "%.2g of a core", cores);
+    else
+        snprintf(c, sizeof c, "%.3g core%s", cores, cores == 1 ? "" : "s");
+    snprintf(buf, len, "%d worker%s%s on %s%s", workers, workers == 1 ? "" : "s", each, c, each);
+    return buf;
+}
+
 int vw_cli_local_processes(void)
 {
     /* Open MPI and MPICH's launcher (Hydra) say how many processes share this host. */

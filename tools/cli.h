@@ -215,6 +215,10 @@ double vw_cli_now(void);
 int vw_cli_local_processes(void);
 /* n bytes for a message: "1.23 GB", "45 MB" or "678 kB" (in buf). */
 const char *vw_cli_bytes(double n, char *buf, size_t len);
+/* Workers against the cores they run on, for a message (in buf): "3 workers on 2 cores";
+   under MPI a process's, against its share of its host's cores (vw_engine_core_share):
+   "1 worker a process on 0.67 of a core a process". */
+const char *vw_cli_crowding(int workers, double cores, char *buf, size_t len);
 
 /* Appends printf output to the string *buf (length *len, capacity *cap; *buf may start
    NULL with both 0), growing it as needed. Returns 0 when out of memory, and then leaves

@@ -874,14 +874,16 @@ int vw_anim_main(const char *cmd, int argc, char **argv)
        them, so every process decides alike: they must rebalance together). */
     if (!trigger_given && s->strategy && strcmp(s->strategy, "none")) {
         int workers_here = vw_world_workers(rt_job_world(rt_anim_job(s->anim)));
-        int cores = vw_engine_workers(0), crowded = workers_here > cores;
+        double cores = vw_engine_core_share();
+        int crowded = workers_here > cores;
+        char cbuf[96];
         s->trigger_work = crowded;
         /* On stderr, as render's note: edit's standard output is its answers. */
         if (crowded && !s->quiet && vw_cli_is_output())
-            fprintf(stderr, "vwalls %s: %d workers on %d core%s: rebalancing when the counted "
+            fprintf(stderr, "vwalls %s: %s: rebalancing when the counted "
                             "work's lambda exceeds 1 + %g (--trigger work), not busy time's, "
                             "which would be mostly waiting for a core\n",
-                    cmd, workers_here, cores, cores == 1 ? "" : "s", s->threshold);
+                    cmd, vw_cli_crowding(workers_here, cores, cbuf, sizeof cbuf), s->threshold);
     }
     if (log_path) { /* written by the output process; all stop when it cannot */
         vw_status lst = vw_cli_is_output() ? vw_outfile_open(log_path, &s->logf, err, sizeof err) : VW_OK;

@@ -597,21 +597,22 @@ int vw_cmd_render(int argc, char **argv)
        cores split them), the fewest of any process, so every process decides alike: they
        must balance by the same load (collective under MPI: counted only when balancing,
        which every process is or none). */
-    int cores = balancing ? vw_engine_workers(0) : 0;
+    double cores = balancing ? vw_engine_core_share() : 0;
     int crowded = balancing && vw_world_workers(w) > cores;
+    char cbuf[96];
     if (balancing && !load_given && crowded) {
         lspec.model = VW_LOAD_COUNTER;
         lspec.counter = RT_C_SEARCHES;
         if (!quiet && vw_cli_is_output())
-            fprintf(stderr, "vwalls render: %d workers on %d core%s: balancing on the counted "
+            fprintf(stderr, "vwalls render: %s: balancing on the counted "
                             "searches of the cells' objects (--balance-load searches), not on "
                             "busy time, which would be mostly waiting for a core\n",
-                    vw_world_workers(w), cores, cores == 1 ? "" : "s");
+                    vw_cli_crowding(vw_world_workers(w), cores, cbuf, sizeof cbuf));
     } else if (balancing && lspec.model == VW_LOAD_BUSY && crowded && vw_cli_is_output()) {
-        fprintf(stderr, "vwalls render: warning: %d workers on %d core%s: their busy time is "
+        fprintf(stderr, "vwalls render: warning: %s: their busy time is "
                         "mostly waiting for a core, a poor load to balance by (--balance-load "
-                        "searches counts the work)\n", vw_world_workers(w), cores,
-                cores == 1 ? "" : "s");
+                        "searches counts the work)\n",
+                vw_cli_crowding(vw_world_workers(w), cores, cbuf, sizeof cbuf));
     }
     rt_balance_result bi;
     memset(&bi, 0, sizeof bi);

@@ -84,6 +84,13 @@ VW_API void vw_engine_broadcast(void *buf, size_t n);
    size per-worker options (speeds) before the world exists, the same on every host.
    Collective under MPI: every rank must call it, whatever its count. */
 VW_API int vw_engine_workers(int workers);
+/* The cores each process of a world on MPI_COMM_WORLD may count on, the fewest of any
+   process: vw_host_cores alone, and under MPI each process's share of its host's cores
+   as a fraction (three unbound processes on two cores have 2/3 of a core each), which
+   vw_engine_workers(0) rounds down to whole workers, at least one. More workers than
+   this is a crowded host: a worker's busy time is then partly time spent waiting for a
+   core. The same on every process; collective under MPI, as vw_engine_workers. */
+VW_API double vw_engine_core_share(void);
 /* What this host gives the process (not collective). vw_host_cores: the cores it may
    run on, the default worker count: its CPU affinity (taskset, a container's cpuset, an
    MPI launcher's binding), or fewer when a control group it belongs to, or one above,

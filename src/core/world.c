@@ -1544,6 +1544,7 @@ vw_status vw_config_agree(const vw_config *c, vw_status local, char *msg, size_t
     return local;
 }
 void vw_engine_broadcast(void *buf, size_t n) { (void)buf, (void)n; }
+double vw_engine_core_share(void) { return vw_host_cores(); }
 int vw_engine_workers(int workers)
 {
     if (workers < 0 || workers > VW__MAX_WORKERS) return -1; /* vw_world_create refuses it */

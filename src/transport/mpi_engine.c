@@ -189,11 +189,16 @@ void vw_engine_broadcast(void *buf, size_t n)
     }
 }
 
-int vw__mpi_core_share(MPI_Comm comm, int cores)
+/* This process's share of its host's cores as a fraction, num / den: the processes of
+   the host that may run on the same cores split them (three unbound processes on two
+   cores have two thirds of a core each). cores: vw_host_cores, which VW_CORES replaces
+   outright (a process told its cores keeps them). Collective on comm. */
+static void core_share(MPI_Comm comm, int cores, long *num, long *den)
 {
+    *num = cores, *den = 1;
     MPI_Comm host;
     if (MPI_Comm_split_type(comm, MPI_COMM_TYPE_SHARED, 0, MPI_INFO_NULL, &host) != MPI_SUCCESS)
-        return cores;
+        return;
     int n = 1;
     MPI_Comm_size(host, &n);
     if (n > 1) {
@@ -205,25 +210,39 @@ int vw__mpi_core_share(MPI_Comm comm, int cores)
         long count = CPU_COUNT(&mine), sum = 0;
         MPI_Allreduce(&mine, &any, (int)sizeof mine, MPI_BYTE, MPI_BOR, host);
         MPI_Allreduce(&count, &sum, 1, MPI_LONG, MPI_SUM, host);
-        long share = sum > 0 ? (long)cores * CPU_COUNT(&any) / sum : cores;
-        if (!vw__host_cores_given()) cores = share < 1 ? 1 : share < cores ? (int)share : cores;
+        if (sum > 0 && !vw__host_cores_given())
+            *num = (long)cores * CPU_COUNT(&any), *den = sum;
     }
     MPI_Comm_free(&host);
-    return cores;
+}
+
+int vw__mpi_core_share(MPI_Comm comm, int cores)
+{
+    long num, den;
+    core_share(comm, cores, &num, &den);
+    return num < den ? 1 : (int)(num / den); /* whole workers, at least one */
+}
+
+double vw_engine_core_share(void)
+{
+    double share = vw_host_cores(), fewest = share;
+    if (mpi_up() && vw_engine_size() > 1) {
+        long num, den;
+        core_share(MPI_COMM_WORLD, (int)share, &num, &den);
+        share = (double)num / (double)den;
+        MPI_Allreduce(&share, &fewest, 1, MPI_DOUBLE, MPI_MIN, MPI_COMM_WORLD);
+    }
+    return fewest;
 }
 
 int vw_engine_workers(int workers)
 {
     /* The reductions run whatever this rank's workers, so every rank makes them. */
-    int cores = vw_host_cores(), fewest = cores;
-    if (mpi_up() && vw_engine_size() > 1) {
-        cores = vw__mpi_core_share(MPI_COMM_WORLD, cores);
-        MPI_Allreduce(&cores, &fewest, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
-    }
+    double share = vw_engine_core_share();
     /* A count vw_world_create refuses has no answer (it took a negative one as one per
        core); the reductions above were still made, as the other ranks make them. */
     if (workers < 0 || workers > VW__MAX_WORKERS) return -1;
-    return workers > 0 ? workers : fewest;
+    return workers > 0 ? workers : share < 1 ? 1 : (int)share;
 }
 
 /* On the communicator vw__mpi_attach will choose for a world made with c, without making

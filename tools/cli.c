@@ -810,18 +810,23 @@ int vw_cli_stats_end(const char *cmd, const char *path, char **buf, size_t *len,
     return VW_EXIT_OK;
 }
 
+int vw_cli_box_json(char **buf, size_t *len, size_t *cap, const double lo[3], const double hi[3])
+{
+    char n[6][32];
+    return vw_cli_appendf(buf, len, cap, "[[%s, %s, %s], [%s, %s, %s]]",
+                          vw_cli_json_number(lo[0], n[0]), vw_cli_json_number(lo[1], n[1]),
+                          vw_cli_json_number(lo[2], n[2]), vw_cli_json_number(hi[0], n[3]),
+                          vw_cli_json_number(hi[1], n[4]), vw_cli_json_number(hi[2], n[5]));
+}
+
 int vw_cli_scene_json(char **buf, size_t *len, size_t *cap, const vw_scene *s)
 {
     double lo[3], hi[3];
-    char n[6][32];
     vw_scene_bounds(s, lo, hi);
     return vw_cli_appendf(buf, len, cap,
                           "\"objects\": %zu, \"spheres\": %zu, \"cones\": %zu, \"polygons\": %zu, "
-                          "\"vertices\": %zu, \"materials\": %zu, \"lights\": %zu, "
-                          "\"bounds\": [[%s, %s, %s], [%s, %s, %s]]",
+                          "\"vertices\": %zu, \"materials\": %zu, \"lights\": %zu, \"bounds\": ",
                           vw_scene_count_objects(s), s->nspheres, s->ncones, s->npolygons,
-                          s->nvertices, s->nmaterials, s->nlights, vw_cli_json_number(lo[0], n[0]),
-                          vw_cli_json_number(lo[1], n[1]), vw_cli_json_number(lo[2], n[2]),
-                          vw_cli_json_number(hi[0], n[3]), vw_cli_json_number(hi[1], n[4]),
-                          vw_cli_json_number(hi[2], n[5]));
+                          s->nvertices, s->nmaterials, s->nlights) &&
+           vw_cli_box_json(buf, len, cap, lo, hi);
 }

@@ -249,5 +249,7 @@ const char *vw_cli_json_number(double x, char buf[32]);
    ",\n  \"scene\": {" and what the caller puts first (its "file" or "generator") and
    ", ". */
 int vw_cli_scene_json(char **buf, size_t *len, size_t *cap, const vw_scene *s);
+/* A box as JSON, [[lo], [hi]], appended. 0 when out of memory. */
+int vw_cli_box_json(char **buf, size_t *len, size_t *cap, const double lo[3], const double hi[3]);
 
 #endif

@@ -46,6 +46,8 @@ static void help(void)
            "  --size WxH       image size (default 256x256)\n"
            "  --depth D        maximum ray depth, 1 to 64 (default 5)\n"
            "  --repeat N       rounds, 1 to %d (default 3)\n"
+           "  --world X0,Y0,Z0,X1,Y1,Z1  the world box covers at least this box, as for\n"
+           "                   vwalls render (default: the scene's bounds, padded)\n"
            "  --farm F         auto (default) | all | idle | none, as vwalls render --farm:\n"
            "                   none maps the cells onto the workers, so rays cross between\n"
            "                   workers as messages (the paper's setting)\n"
@@ -172,27 +174,19 @@ static int rounds_json(char **buf, size_t *len, size_t *cap, const char *name, c
     return ok && vw_cli_appendf(buf, len, cap, "]");
 }
 
-/* One render of configuration c (its times go to round `round`; last: it is the last
-   configuration); the output process keeps the pixel sums of the first render in *ref
+/* One render of configuration c (base: the parameters every configuration shares; its
+   times go to round `round`; last: it is the last configuration); the output process keeps the pixel sums of the first render in *ref
    (allocated here) and compares every later render's with them: the first pixel that
    differs goes to *bad_pixel. The rays of the first render go to *ref_rays (-1 before
    it); a later render that traced another number sets *bad_rays (every process alike:
    the counters are summed over the processes). */
-static vw_status run_one(const vw_scene *scene, const vw_camera *cam, int width, int height,
-                         long depth, int farm, bench_config *c, int round, int last, int64_t **ref,
-                         size_t *nref, long long *bad_pixel, long long *ref_rays, int *bad_rays,
-                         char *err, size_t errlen)
+static vw_status run_one(const vw_scene *scene, const rt_params *base, bench_config *c, int round,
+                         int last, int64_t **ref, size_t *nref, long long *bad_pixel,
+                         long long *ref_rays, int *bad_rays, char *err, size_t errlen)
 {
-    rt_params p;
-    memset(&p, 0, sizeof p);
-    p.width = width;
-    p.height = height;
-    p.depth = (int)depth;
+    rt_params p = *base;
     memcpy(p.dims, c->dims, sizeof p.dims);
     p.workers = (int)c->workers;
-    p.camera = cam;
-    p.farm_first = 1; /* no balancer and no new mapping: the copies come first */
-    p.farm = (rt_farm)vw_cli_farm_resolve(farm, 0);
     rt_job *job = NULL;
     double t0 = vw_cli_now();
     vw_status st = rt_job_create(scene, &p, &job, err, errlen);
@@ -259,6 +253,8 @@ int vw_cmd_bench(int argc, char **argv)
     const char *scene_path = NULL, *csv = NULL, *stats = NULL, *v;
     double t0 = vw_cli_now();
     int width = 256, height = 256, quiet = 0, farm = -1, cells_given = 0, workers_given = 0;
+    int has_world = 0;
+    vw_box world_min;
     long depth = 5, repeat = 3;
     lists L;
     memset(&L, 0, sizeof L);
@@ -289,6 +285,10 @@ int vw_cmd_bench(int argc, char **argv)
         } else if (!strcmp(a, "--farm")) {
             if (!(v = vw_cli_value(CMD, argc, argv, &i)) || vw_cli_farm(CMD, v, &farm))
                 return VW_EXIT_USAGE;
+        } else if (!strcmp(a, "--world")) {
+            if (vw_cli_box(CMD, a, vw_cli_value(CMD, argc, argv, &i), &world_min))
+                return VW_EXIT_USAGE;
+            has_world = 1;
         } else if (!strcmp(a, "--csv")) {
             if (!(csv = vw_cli_output(CMD, argc, argv, &i))) return VW_EXIT_USAGE;
         } else if (!strcmp(a, "--stats")) {
@@ -391,14 +391,23 @@ int vw_cmd_bench(int argc, char **argv)
     bench_config warm = conf[0];
     long long px0 = -1;
     int rays0 = 0;
-    vw_status st = run_one(scene, &cam, width, height, depth, farm, &warm, 0, 0, &ref, &nref, &px0,
-                           &ref_rays, &rays0, err, sizeof err);
+    rt_params base;
+    memset(&base, 0, sizeof base);
+    base.width = width;
+    base.height = height;
+    base.depth = (int)depth;
+    base.camera = &cam;
+    base.world_min = has_world ? &world_min : NULL;
+    base.farm_first = 1; /* no balancer and no new mapping: the copies come first */
+    base.farm = (rt_farm)vw_cli_farm_resolve(farm, 0);
+    vw_status st = run_one(scene, &base, &warm, 0, 0, &ref, &nref, &px0, &ref_rays, &rays0, err,
+                           sizeof err);
     for (int r = 0; r < repeat && st == VW_OK; r++)
         for (int k = 0; k < nconf && st == VW_OK; k++) {
             long long px = -1;
             int bad_rays = 0;
-            st = run_one(scene, &cam, width, height, depth, farm, &conf[k], r, k == nconf - 1, &ref,
-                         &nref, &px, &ref_rays, &bad_rays, err, sizeof err);
+            st = run_one(scene, &base, &conf[k], r, k == nconf - 1, &ref, &nref, &px, &ref_rays,
+                         &bad_rays, err, sizeof err);
             if (px >= 0 && bad_conf < 0) bad_conf = k, bad_pixel = px;
             if (bad_rays && bad_rays_conf < 0) bad_rays_conf = k, bad_rays_count = conf[k].rays;
             char note[64];
@@ -423,9 +432,14 @@ int vw_cmd_bench(int argc, char **argv)
         jok = jok && vw_cli_scene_json(&js, &jl, &jc, scene);
         jok = jok && vw_cli_appendf(&js, &jl, &jc,
                                     "},\n  \"image\": {\"width\": %d, \"height\": %d, \"depth\": %ld},"
-                                    "\n  \"rounds\": %ld,\n  \"farm\": \"%s\",\n  \"configurations\": [",
+                                    "\n  \"rounds\": %ld,\n  \"farm\": \"%s\",\n  \"world\": ",
                                     width, height, depth, repeat,
                                     farm < 0 ? "auto" : rt_farm_name((rt_farm)farm));
+        if (has_world)
+            jok = jok && vw_cli_box_json(&js, &jl, &jc, world_min.lo, world_min.hi);
+        else
+            jok = jok && vw_cli_appendf(&js, &jl, &jc, "null");
+        jok = jok && vw_cli_appendf(&js, &jl, &jc, ",\n  \"configurations\": [");
     }
     vw_scene_free(scene);
     if (st != VW_OK) {

@@ -1,5 +1,5 @@
 #!/bin/sh
-# world_box.sh VWALLS TMPDIR - `vwalls render --world` (and animate's, edit's): the world
+# world_box.sh VWALLS TMPDIR - `vwalls render --world` (and animate's, edit's, bench's): the world
 # box covers the box given, so the walls divide the space the scene is meant to fill,
 # not only its objects' bounds.
 # A fully clustered sphere scene (`vwalls gen spheres`: its cluster lies in one octant of
@@ -47,4 +47,21 @@ grep -q '"box": \[\[0,0,0\],\[5,5,5\]\], "worker": [0-9]*, "objects": 300,' ed.j
 [ $rc -eq 2 ] || fail "animate --world 0,0,0,10,10: exit $rc"
 grep -q "vwalls animate: --world: bad value '0,0,0,10,10'" err.txt || fail "animate: $(cat err.txt)"
 [ ! -e bad0.png ] || fail "animate --world bad: output written"
+# bench takes it too: its 2x2x2 row visits as many ray-cell segments as render's 2x2x2
+# on the same box (a deterministic count), and a bad box is refused.
+segs() { sed -n 's/.*"segments": \([0-9]*\).*/\1/p' "$1" | head -1; }
+r seg8 --cells 2x2x2 --workers 1 --world 0,0,0,10,10,10
+b() { n=$1; shift; "$V" bench c1.nff --cells 2x2x2 --workers 1 --repeat 1 --size 64x48 --quiet \
+  --stats "$n.json" "$@" > /dev/null || fail "bench $n: status $?"; }
+b bw --world 0,0,0,10,10,10
+b bfree
+grep -q '"world": \[\[0, 0, 0\], \[10, 10, 10\]\]' bw.json || fail "bench --world: not in its stats"
+grep -q '"world": null' bfree.json || fail "bench without --world: no \"world\": null"
+[ "$(segs bw.json)" = "$(segs seg8.json)" ] ||
+  fail "bench --world: $(segs bw.json) segments, render's $(segs seg8.json)"
+[ "$(segs bfree.json)" != "$(segs seg8.json)" ] || fail "bench without --world: the box was used"
+"$V" bench c1.nff --world 0,0,0,10,10 --stats bad.json 2>err.txt; rc=$?
+[ $rc -eq 2 ] || fail "bench --world 0,0,0,10,10: exit $rc"
+grep -q "vwalls bench: --world: bad value '0,0,0,10,10'" err.txt || fail "bench: $(cat err.txt)"
+[ ! -e bad.json ] || fail "bench --world bad: output written"
 echo ok

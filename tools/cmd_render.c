@@ -60,7 +60,7 @@ static void help(void)
            "                   search the cell's objects) | segments (all counted ray-cell\n"
            "                   visits, also those passing through empty space) | model\n"
            "                   (objects + pixels + messages); the counts are deterministic;\n"
-           "                   default: busy, or searches where the workers outnumber the\n"
+           "                   default: busy, or segments where the workers outnumber the\n"
            "                   cores (busy time is then mostly waiting for a core)\n"
            "  --balance-iters N  pre-pass / balance rounds, 1 to 20 (default 2; divide and\n"
            "                     rotate take up to 3 more, stopping when no gain is\n"
@@ -592,7 +592,9 @@ int vw_cmd_render(int argc, char **argv)
         fprintf(stderr, "vwalls render: warning: --overlay-by has no effect without --overlay\n");
     /* Busy time on more workers than cores is mostly time spent waiting for a core: the
        balancer would move walls by the scheduler's noise (docs/balancing.md). So the
-       default load is then the counted work; asked for, busy time is warned of. The
+       default load is then the counted visits (segments: searches alone hand the empty
+       cells to one worker, and measured slower, docs/balancing.md); asked for, busy time is
+       warned of. The
        cores are each process's share of its host's (processes that may run on the same
        cores split them), the fewest of any process, so every process decides alike: they
        must balance by the same load (collective under MPI: counted only when balancing,
@@ -602,16 +604,16 @@ int vw_cmd_render(int argc, char **argv)
     char cbuf[96];
     if (balancing && !load_given && crowded) {
         lspec.model = VW_LOAD_COUNTER;
-        lspec.counter = RT_C_SEARCHES;
+        lspec.counter = RT_C_SEGMENTS;
         if (!quiet && vw_cli_is_output())
             fprintf(stderr, "vwalls render: %s: balancing on the counted "
-                            "searches of the cells' objects (--balance-load searches), not on "
+                            "ray-cell visits (--balance-load segments), not on "
                             "busy time, which would be mostly waiting for a core\n",
                     vw_cli_crowding(vw_world_workers(w), cores, cbuf, sizeof cbuf));
     } else if (balancing && lspec.model == VW_LOAD_BUSY && crowded && vw_cli_is_output()) {
         fprintf(stderr, "vwalls render: warning: %s: their busy time is "
                         "mostly waiting for a core, a poor load to balance by (--balance-load "
-                        "searches counts the work)\n",
+                        "segments counts the work)\n",
                 vw_cli_crowding(vw_world_workers(w), cores, cbuf, sizeof cbuf));
     }
     rt_balance_result bi;

@@ -84,9 +84,9 @@ grep -q "8 workers on 2 cores: their busy time is mostly waiting for a core" err
 grep -q '"load_model": "busy"' busy.json || fail "--balance-load busy: $(grep -o '"load_model": "[a-z]*"' busy.json)"
 VW_CORES=2 "$V" render c1.nff -o auto.png --size 64x64 --cells 2x4 --workers 8 --farm none \
   --balance tensor --stats auto.json 2> err.txt > /dev/null || fail "auto: status $?"
-grep -q '"load_model": "searches"' auto.json ||
-  fail "8 workers on 2 cores balanced by $(grep -o '"load_model": "[a-z]*"' auto.json), want searches"
-grep -q "8 workers on 2 cores: balancing on the counted searches" err.txt ||
+grep -q '"load_model": "segments"' auto.json ||
+  fail "8 workers on 2 cores balanced by $(grep -o '"load_model": "[a-z]*"' auto.json), want segments"
+grep -q "8 workers on 2 cores: balancing on the counted ray-cell visits" err.txt ||
   fail "no note of the counted load: $(cat err.txt)"
 ! grep -q "poor load" err.txt || fail "a warning with the default load: $(cat err.txt)"
 VW_CORES=8 "$V" render c1.nff -o eight.png --size 64x64 --cells 2x4 --workers 8 --farm none \

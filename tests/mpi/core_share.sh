@@ -35,7 +35,7 @@ expect "$half" "unbound, $alone alone"
 opts="--workers 3"
 expect 3 "unbound, --workers 3"
 # The default balance load follows the same share (every process must decide alike):
-# busy time on the workers the share gives, counted searches on one more, where busy
+# busy time on the workers the share gives, counted visits on one more, where busy
 # time would be mostly waiting for a core.
 load() {
     opts="--cells 2x2 --balance tensor --quiet --stats $dir/s.json $1"
@@ -53,12 +53,12 @@ load() {
 }
 pre=""
 load "" busy
-load "--workers $((half + 1))" searches
+load "--workers $((half + 1))" segments
 # Both processes on one CPU have half a core each: their one worker each (the least)
 # is crowded, though it rounds to a whole worker.
 if command -v taskset >/dev/null 2>&1; then
     pre="taskset -c 0"
-    load "" searches
+    load "" segments
     pre=""
 fi
 opts=""

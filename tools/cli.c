@@ -314,13 +314,13 @@ const char *vw_cli_bytes(double n, char *buf, size_t len)
 
 const char *vw_cli_crowding(int workers, double cores, char *buf, size_t len)
 {
-    const char *each = vw_engine_size() > 1 ? " a process" : "";
     char c[32];
     if (cores < 1)
         snprintf(c, sizeof c, "%.2g of a core", cores);
     else
         snprintf(c, sizeof c, "%.3g core%s", cores, cores == 1 ? "" : "s");
-    snprintf(buf, len, "%d worker%s%s on %s%s", workers, workers == 1 ? "" : "s", each, c, each);
+    snprintf(buf, len, "%d worker%s on %s%s", workers, workers == 1 ? "" : "s", c,
+             vw_engine_size() > 1 ? " in each process" : "");
     return buf;
 }
 

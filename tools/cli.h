@@ -217,7 +217,7 @@ int vw_cli_local_processes(void);
 const char *vw_cli_bytes(double n, char *buf, size_t len);
 /* Workers against the cores they run on, for a message (in buf): "3 workers on 2 cores";
    under MPI a process's, against its share of its host's cores (vw_engine_core_share):
-   "1 worker a process on 0.67 of a core a process". */
+   "1 worker on 0.67 of a core in each process". */
 const char *vw_cli_crowding(int workers, double cores, char *buf, size_t len);
 
 /* Appends printf output to the string *buf (length *len, capacity *cap; *buf may start

@@ -175,9 +175,9 @@ static int rounds_json(char **buf, size_t *len, size_t *cap, const char *name, c
 }
 
 /* One render of configuration c (base: the parameters every configuration shares; its
-   times go to round `round`; last: it is the last configuration); the output process keeps the pixel sums of the first render in *ref
-   (allocated here) and compares every later render's with them: the first pixel that
-   differs goes to *bad_pixel. The rays of the first render go to *ref_rays (-1 before
+   times go to round `round`; last: it is the last configuration); the output process
+   keeps the pixel sums of the first render in *ref (allocated here) and compares every
+   later render's with them: the first pixel that differs goes to *bad_pixel. The rays of the first render go to *ref_rays (-1 before
    it); a later render that traced another number sets *bad_rays (every process alike:
    the counters are summed over the processes). */
 static vw_status run_one(const vw_scene *scene, const rt_params *base, bench_config *c, int round,

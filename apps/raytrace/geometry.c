@@ -52,18 +52,30 @@ static int cone_hit(const rt_object *o, const double org[3], const double dir[3]
     if (!(h > 0)) return 0;
     for (int a = 0; a < 3; a++) w[a] /= h;
     double r0 = o->g.cone.r0, k = (o->g.cone.r1 - o->g.cone.r0) / h;
-    double dd = dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2];
     double dw = dir[0] * w[0] + dir[1] * w[1] + dir[2] * w[2];
-    double Dd = D[0] * dir[0] + D[1] * dir[1] + D[2] * dir[2];
     double Dw = D[0] * w[0] + D[1] * w[1] + D[2] * w[2];
-    double DD = D[0] * D[0] + D[1] * D[1] + D[2] * D[2];
+    /* The coefficients from the parts of d and D across the axis, not as dd - dw^2 and
+       DD - Dw^2: those differences cancel for a ray nearly along the axis (A ~ 1e-14
+       from two numbers near 1, with an error of a per cent) and for an origin far along
+       it (DD ~ 1e13), and a ray 1e-7 rad off a cylinder's axis then met its side
+       0.02 % off; the parts across are small numbers computed as such. */
+    double dp[3], Dp[3];
+    for (int a = 0; a < 3; a++) {
+        dp[a] = dir[a] - dw * w[a];
+        Dp[a] = D[a] - Dw * w[a];
+    }
     double rD = r0 + k * Dw;
-    double A = dd - dw * dw - k * k * dw * dw;
-    double B = 2.0 * (Dd - Dw * dw - rD * k * dw);
-    double C = DD - Dw * Dw - rD * rD;
+    double A = dp[0] * dp[0] + dp[1] * dp[1] + dp[2] * dp[2] - k * k * dw * dw;
+    double B = 2.0 * (Dp[0] * dp[0] + Dp[1] * dp[1] + Dp[2] * dp[2] - rD * k * dw);
+    double C = Dp[0] * Dp[0] + Dp[1] * Dp[1] + Dp[2] * Dp[2] - rD * rD;
     double ts[2];
     int nt = 0;
-    if (fabs(A) < 1e-12 * dd) {
+    /* Linear only where the quadratic term is exactly gone (a ray parallel to a
+       cylinder's axis, or to a cone's side). A small A is no licence to drop it: a ray
+       at 1e-7 rad to a cylinder 7e6 long has A ~ 1e-13, and A t^2 ~ 1 at t ~ 3e6,
+       where the linear root made a hit out of a miss. The stable pair below keeps the
+       near root accurate for a small A, and puts the far one far away. */
+    if (A == 0) {
         if (B != 0) ts[nt++] = -C / B;
     } else {
         double disc = B * B - 4 * A * C;

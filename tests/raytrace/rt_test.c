@@ -686,6 +686,45 @@ static int test_cone(void)
     }
     EXPECT(hits == n, "%d of %d rays hit", hits, n);
     rt_cell_geo_free(&g);
+
+    /* Rays at 1e-7 rad to a cylinder 7e6 long (a fuzzer's scene): the quadratic term of
+       the side's equation is ~1e-14 and was dropped as if zero, which made a hit out of
+       a ray passing 1.35 or more from the axis (a cell holding the cylinder alone then
+       found its shadow ray occluded, and the image differed from one cell's), and put
+       the exit of a ray starting inside 0.67e6 too far. */
+    rt_object cyl;
+    memset(&cyl, 0, sizeof cyl);
+    cyl.kind = RT_CONE;
+    const double cb[3] = {-1.8, 7000000.8, 0}, ca[3] = {-0.8, 0.8, 1.8};
+    memcpy(cyl.g.cone.base, cb, sizeof cb);
+    memcpy(cyl.g.cone.apex, ca, sizeof ca);
+    cyl.g.cone.r0 = cyl.g.cone.r1 = 0.5;
+    EXPECT(rt_cell_geo_build(dev, &cyl, 1, &rt_float_frame_identity, &g) == VW_OK, "build");
+    for (int i = 0; i < 5; i++) {
+        double org[3] = {-3.17 + 0.1 * i, 3.9, 2e-7}, dir[3] = {2.7e-9, 1, 2.67e-9};
+        double l = sqrt(dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2]);
+        for (int a = 0; a < 3; a++) dir[a] /= l;
+        rt_hit h;
+        EXPECT(!rt_cell_geo_intersect(&g, org, dir, 0, 1e7, &h), "parallel ray %d: a hit at t %g", i,
+               h.t);
+        EXPECT(!rt_cell_geo_occluded(&g, org, dir, 0, 1e7), "parallel ray %d: occluded", i);
+        EXPECT(!rt_cell_geo_occluded(&g, org, dir, 3.5e6, 1e7), "parallel ray %d: occluded past 3.5e6", i);
+    }
+    rt_cell_geo_free(&g);
+    /* A cylinder along y, r 0.5; a ray inside it, 0.3 off the axis, drifting out at 1e-7
+       rad: it meets the side where x = 0.5, at t = 0.2 / sin(1e-7) = 2e6. */
+    const double yb[3] = {0, 0, 0}, ya[3] = {0, 7e6, 0};
+    memcpy(cyl.g.cone.base, yb, sizeof yb);
+    memcpy(cyl.g.cone.apex, ya, sizeof ya);
+    EXPECT(rt_cell_geo_build(dev, &cyl, 1, &rt_float_frame_identity, &g) == VW_OK, "build");
+    {
+        double org[3] = {0.3, 1, 0}, dir[3] = {sin(1e-7), cos(1e-7), 0};
+        rt_hit h;
+        int hit = rt_cell_geo_intersect(&g, org, dir, 0, 1e7, &h);
+        EXPECT(hit && fabs(h.t - 0.2 / sin(1e-7)) < 1.0, "drifting ray: %s t %.9g, want %.9g",
+               hit ? "hit at" : "no hit,", hit ? h.t : 0.0, 0.2 / sin(1e-7));
+    }
+    rt_cell_geo_free(&g);
     rt_device_free(dev);
     printf("cone: %d of %d sampled points hit\n", hits, n);
     return vw_test_failures ? 1 : 0;

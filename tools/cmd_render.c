@@ -165,9 +165,11 @@ static char *with_balance_json(char *rt, rt_job *job, vw_world *w, const vw_traf
                                const double *speeds, rt_farm farm, int farm_copies)
 {
     if (!rt) return NULL;
-    static const char *const models[] = {"busy", "segments", "model"};
-    const char *model = ls->model == VW_LOAD_COUNTER && ls->counter == RT_C_SEARCHES
-                            ? "searches"
+    /* A counted load is named by its counter ("segments", "searches"). */
+    static const char *const models[] = {"busy", "counter", "model"};
+    const char *model = ls->model == VW_LOAD_COUNTER && ls->counter >= 0 &&
+                                ls->counter < rt_module.ncounters
+                            ? rt_module.counters[ls->counter]
                             : models[ls->model <= VW_LOAD_MODEL ? ls->model : 0];
     size_t n = strlen(rt) + 1024;
     char *out = malloc(n);
@@ -593,12 +595,11 @@ int vw_cmd_render(int argc, char **argv)
     /* Busy time on more workers than cores is mostly time spent waiting for a core: the
        balancer would move walls by the scheduler's noise (docs/balancing.md). So the
        default load is then the counted visits (segments: searches alone hand the empty
-       cells to one worker, and measured slower, docs/balancing.md); asked for, busy time is
-       warned of. The
-       cores are each process's share of its host's (processes that may run on the same
-       cores split them), the fewest of any process, so every process decides alike: they
-       must balance by the same load (collective under MPI: counted only when balancing,
-       which every process is or none). */
+       cells to one worker, and measured slower, docs/balancing.md); asked for, busy time
+       is warned of. The cores are each process's share of its host's (processes that may
+       run on the same cores split them), the fewest of any process, so every process
+       decides alike: they must balance by the same load (collective under MPI: counted
+       only when balancing, which every process is or none). */
     double cores = balancing ? vw_engine_core_share() : 0;
     int crowded = balancing && vw_world_workers(w) > cores;
     char cbuf[96];

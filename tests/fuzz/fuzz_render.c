@@ -1,10 +1,12 @@
 /* fuzz_render.c - libFuzzer target for the ray tracer behind the scene readers: any
  * scene the NFF reader, or else the OBJ reader, accepts is rendered small (8x6 pixels,
- * depth 3, one worker) on one cell and on 2x2x2 cells. Besides "never crash" (a NaN or
- * infinite ray reaching Embree aborts in its assertions), it checks what the design
- * promises for every scene: every ray created ends exactly once, and the walls change
- * neither the image (its 8-bit values, what the PNG holds) nor the ray counts, unless
- * the scene has coincident surfaces whose tie nothing decides (z-fighting, below).
+ * depth 3, one worker) on one cell, on 2x2x2 cells (walls through the world box's
+ * centre) and on one more layout the input's hash picks (walls at thirds, fifths, ...:
+ * where 2x2x2 puts none). Besides "never crash" (a NaN or infinite ray reaching Embree
+ * aborts in its assertions), it checks what the design promises for every scene: every
+ * ray created ends exactly once, and the walls change neither the image (its 8-bit
+ * values, what the PNG holds) nor the ray counts, unless the scene has coincident
+ * surfaces whose tie nothing decides (z-fighting, below).
  */
 #ifndef _GNU_SOURCE
 #define _GNU_SOURCE
@@ -18,7 +20,7 @@
 #include "raytrace/raytrace.h"
 #include "vwalls/scene.h"
 
-enum { W = 8, H = 6 };
+enum { W = 8, H = 6, NLAYOUTS = 2 };
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 
@@ -121,14 +123,21 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     if (vw_scene_read_nff("fuzz.nff", (const char *)data, size, &s, err, sizeof err) != VW_OK &&
         vw_scene_read_obj("fuzz.obj", (const char *)data, size, NULL, &s, err, sizeof err) != VW_OK)
         return 0;
-    static const int one[3] = {1, 1, 1}, eight[3] = {2, 2, 2};
+    /* The layouts compared with one cell: 2x2x2, and one of these by the input's hash
+       (FNV-1a), so a finding replays on the layout that found it. */
+    static const int one[3] = {1, 1, 1}, uneven[][3] = {{3, 1, 1}, {1, 3, 2}, {2, 1, 5},
+                                                        {3, 3, 3}, {1, 4, 3}, {5, 2, 1}};
+    uint64_t hash = 14695981039346656037u;
+    for (size_t i = 0; i < size; i++) hash = (hash ^ data[i]) * 1099511628211u;
+    const int *dims[NLAYOUTS] = {(const int[3]){2, 2, 2},
+                                 uneven[hash % (sizeof uneven / sizeof uneven[0])]};
     /* 8-bit values, not the fixed-point sums: two surfaces a float ulp apart along a ray
        are a tie too (Embree need not report the nearer one, and which it reports
        depends on its tree), shifting a sum by a few 2^-32 where both look the same. */
-    static uint8_t img1[W * H * 3], img8[W * H * 3], imgr[W * H * 3];
-    int64_t c1[RT_NCOUNTERS], c8[RT_NCOUNTERS], cr[RT_NCOUNTERS];
-    int ok1 = render(s, NULL, 0, one, img1, c1);
-    int ok8 = render(s, NULL, 0, eight, img8, c8);
+    static uint8_t img1[W * H * 3], imgl[NLAYOUTS][W * H * 3], imgr[W * H * 3];
+    int64_t c1[RT_NCOUNTERS], cl[NLAYOUTS][RT_NCOUNTERS], cr[RT_NCOUNTERS];
+    int ok1 = render(s, NULL, 0, one, img1, c1), okl[NLAYOUTS];
+    for (int l = 0; l < NLAYOUTS; l++) okl[l] = render(s, NULL, 0, dims[l], imgl[l], cl[l]);
     /* Coincident surfaces that look different tie, and no order decides the tie
        (z-fighting, docs/known-issues.md): the walls may change such an image. Skipped
        are scenes with two such records, and scenes whose one-cell image changes with
@@ -153,32 +162,39 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     free(perm);
     free(objs);
     vw_scene_free(s);
-    if (ok1 != ok8) {
-        fprintf(stderr, "one layout rendered the scene, the other refused it\n");
-        abort();
+    char name[NLAYOUTS][16];
+    for (int l = 0; l < NLAYOUTS; l++) {
+        snprintf(name[l], sizeof name[l], "%dx%dx%d", dims[l][0], dims[l][1], dims[l][2]);
+        if (ok1 != okl[l]) {
+            fprintf(stderr, "one cell %s the scene, %s %s it\n", ok1 ? "rendered" : "refused",
+                    name[l], okl[l] ? "rendered" : "refused");
+            abort();
+        }
     }
     if (!ok1) return 0;
-    /* Every ray created ends once, on either layout, ties or not. */
-    for (int l = 0; l < 2; l++) {
-        const int64_t *c = l ? c8 : c1;
+    /* Every ray created ends once, on every layout, ties or not. */
+    for (int l = -1; l < NLAYOUTS; l++) {
+        const int64_t *c = l < 0 ? c1 : cl[l];
         int64_t created = c[RT_C_EYE] + c[RT_C_REFLECT] + c[RT_C_REFRACT] + c[RT_C_SHADOW];
         if (created != c[RT_C_ENDED] || c[RT_C_EYE] != c[RT_C_PIXELS]) {
             fprintf(stderr, "%s: %lld rays created, %lld ended; %lld eye rays, %lld pixels\n",
-                    l ? "2x2x2" : "1 cell", (long long)created, (long long)c[RT_C_ENDED],
+                    l < 0 ? "1 cell" : name[l], (long long)created, (long long)c[RT_C_ENDED],
                     (long long)c[RT_C_EYE], (long long)c[RT_C_PIXELS]);
             abort();
         }
     }
     if (!stable) return 0;
-    for (int k = RT_C_EYE; k <= RT_C_PIXELS; k++)
-        if (c1[k] != c8[k]) {
-            fprintf(stderr, "counter %d: %lld on 1 cell, %lld on 2x2x2\n", k, (long long)c1[k],
-                    (long long)c8[k]);
+    for (int l = 0; l < NLAYOUTS; l++) {
+        for (int k = RT_C_EYE; k <= RT_C_PIXELS; k++)
+            if (c1[k] != cl[l][k]) {
+                fprintf(stderr, "counter %d: %lld on 1 cell, %lld on %s\n", k, (long long)c1[k],
+                        (long long)cl[l][k], name[l]);
+                abort();
+            }
+        if (memcmp(img1, imgl[l], sizeof img1)) {
+            fprintf(stderr, "the images differ between 1 cell and %s\n", name[l]);
             abort();
         }
-    if (memcmp(img1, img8, sizeof img1)) {
-        fprintf(stderr, "the images differ between 1 cell and 2x2x2\n");
-        abort();
     }
     return 0;
 }

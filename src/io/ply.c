@@ -630,10 +630,14 @@ static vw_status read_faces(ply *P, const elem *e, int seen_vertices)
     return st;
 }
 
-/* Reads past an element nobody uses. */
+/* Reads past an element nobody uses. An element without properties holds no data,
+   whatever its count: nothing to read, and no loop over a count the file cannot bound
+   (check_count has no least size for it; 2^31 empty records took minutes). */
 static vw_status skip_element(ply *P, const elem *e)
 {
     vw_status st = check_count(P, e);
+    if (e->nprops == 0)
+        return st;
     char what[64];
     for (uint64_t r = 0; r < e->count && st == VW_OK; r++) {
         snprintf(what, sizeof what, "%s %llu", e->name, (unsigned long long)r);

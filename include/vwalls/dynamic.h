@@ -78,13 +78,16 @@ typedef struct vw_collider vw_collider;
    already interpenetrates `start` does not count for the sweep (so a resting object
    can be lifted off what it rests on), only for the end test: its contact says
    VW_PROBE_START instead; where a sphere is in the pair, only when the path takes it no
-   deeper than it starts (one sunk a hair in a floor cannot go through it), and never
-   where a box (a cone) is, whose box may hold the mover without touching the cone. The rule is the object's: a sweep that meets one shape of an
-   obstacle whose other shape `start` interpenetrates (a floor of two triangles, the
-   mover sunk in one) is no sweep hit either; the contacts of one tag and obstacle are
-   merged (their bits or'ed), so a caller counts a sweep hit where a contact has
-   VW_PROBE_SWEEP and not VW_PROBE_START. */
-enum { VW_PROBE_END = 1, VW_PROBE_SWEEP = 2, VW_PROBE_START = 4 };
+   deeper than it starts (one sunk a hair in a floor cannot go through it: that pair
+   says VW_PROBE_THROUGH), and never where a box (a cone) is, whose box may hold the
+   mover without touching the cone. The rule is the object's: a sweep that meets one
+   shape of an obstacle whose other shape `start` interpenetrates (a floor of two
+   triangles, the mover sunk in one) is no sweep hit either, but a path deeper into a
+   shape it starts in is one, whatever the obstacle's other shapes say (a mover sunk in
+   both triangles of a floor, going through one and away from the other). The contacts
+   of one tag and obstacle are merged (their bits or'ed), so a caller counts a sweep hit
+   where a contact has VW_PROBE_THROUGH, or VW_PROBE_SWEEP and not VW_PROBE_START. */
+enum { VW_PROBE_END = 1, VW_PROBE_SWEEP = 2, VW_PROBE_START = 4, VW_PROBE_THROUGH = 8 };
 typedef struct vw_probe {
     vw_shape start, end;
     double d[3];
@@ -95,7 +98,7 @@ typedef struct vw_probe {
 typedef struct vw_contact {
     int32_t tag;       /* the probe's tag */
     int32_t obstacle;  /* the id of the object hit */
-    int32_t how;       /* VW_PROBE_END, VW_PROBE_SWEEP, VW_PROBE_START, or'ed */
+    int32_t how;       /* VW_PROBE_END, _SWEEP, _START, _THROUGH, or'ed */
     int32_t pad;
 } vw_contact;
 

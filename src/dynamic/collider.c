@@ -127,12 +127,17 @@ int vw__probe_test(const vw_probe *p, const vw_shape *o, double tol)
        where a sphere is involved, only for a path that takes the mover no deeper into o
        than it starts (leaving o, or sliding along it): a sphere sunk in a floor by a
        hair more than tol (a scene written with six digits) went through the floor with
-       sweep on, where one resting on it exactly was stopped. */
+       sweep on, where one resting on it exactly was stopped. Sunk and going deeper is
+       THROUGH, which no START of the obstacle's other shapes cancels: a ball sunk on
+       the diagonal of a floor quad, so in both its triangles, dropped through one while
+       stepping away from the other, whose START exempted the whole quad. */
     if ((p->flags & VW_PROBE_SWEEP) && vw_shape_collide(&p->start, p->d, o, tol)) {
         int exact = p->start.kind != VW_SHAPE_BOX && o->kind != VW_SHAPE_BOX;
-        int start = exact && vw_shape_collide(&p->start, NULL, o, tol) &&
-                    !vw__shape_sweep_deepens(&p->start, p->d, o, tol);
-        how |= start ? VW_PROBE_START : VW_PROBE_SWEEP;
+        if (!exact || !vw_shape_collide(&p->start, NULL, o, tol))
+            how |= VW_PROBE_SWEEP;
+        else
+            how |= vw__shape_sweep_deepens(&p->start, p->d, o, tol) ? VW_PROBE_THROUGH
+                                                                    : VW_PROBE_START;
     }
     return how;
 }

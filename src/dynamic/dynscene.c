@@ -505,11 +505,12 @@ static int boxes_overlap(const vw_box *a, const vw_box *b, double pad)
     return 1;
 }
 
-/* Whether an obstacle's merged contact bits make a sweep hit: the mover's path meets
-   it and the mover did not already interpenetrate it at its start (dynamic.h). */
+/* Whether an obstacle's merged contact bits make a sweep hit: the mover's path goes
+   deeper into a shape it starts in, or meets it and the mover did not already
+   interpenetrate it at its start (dynamic.h). */
 static int sweep_hits(int how)
 {
-    return (how & VW_PROBE_SWEEP) && !(how & VW_PROBE_START);
+    return (how & VW_PROBE_THROUGH) || ((how & VW_PROBE_SWEEP) && !(how & VW_PROBE_START));
 }
 
 static int contact_cmp(const void *a, const void *b)

@@ -537,6 +537,13 @@ static void test_cone_slack(const vw_decomp *d, const vw_config *cfg)
    the rounding of a scene written with six digits) went through the floor with sweep
    on, where one resting on it exactly was stopped; a triangle sunk in a sphere went
    through the sphere's middle. Leaving stays free. */
+struct sunk_case {
+    const char *edit;
+    int outcome, obstacle;
+};
+static void sunk_cases(const vw_decomp *d, const vw_config *cfg, const char *nff,
+                       const struct sunk_case *cases, size_t ncases);
+
 static void test_sunk_through(const vw_decomp *d, const vw_config *cfg)
 {
     const char *nff = "v\nfrom 0 -20 0\nat 0 0 0\nup 0 0 1\nangle 40\nhither 0.01\n"
@@ -546,16 +553,38 @@ static void test_sunk_through(const vw_decomp *d, const vw_config *cfg)
                       "s 1 1 0.5 0.5\n"                          /* id 2: resting on it */
                       "s -2 2 2 1\n"                             /* id 3: a ball */
                       "p 3\n-2.2 2 2.5\n-1.8 2 2.5\n-2 2.2 2.5\n"; /* id 4: sunk in it */
-    static const struct {
-        const char *edit;
-        int outcome, obstacle;
-    } cases[] = {
+    static const struct sunk_case cases[] = {
         {"move 1 0 0 -2", VW_OUT_SWEEP, 0},    /* through the floor: it was accepted */
         {"move 2 0 0 -2", VW_OUT_SWEEP, 0},    /* the same from resting on it */
         {"move 4 0 0 -1.5", VW_OUT_SWEEP, 3},  /* through the ball's middle: accepted */
         {"move 1 0 0 1", VW_OUT_ACCEPTED, -1}, /* off the floor */
         {"move 4 0 0 1", VW_OUT_ACCEPTED, -1}, /* out of the ball */
     };
+    sunk_cases(d, cfg, nff, cases, sizeof cases / sizeof cases[0]);
+    /* A small ball sunk 1e-5 on the diagonal that splits a floor quad into two
+       triangles, so it is sunk in both. Dropped through the floor with a sideways step
+       across the diagonal, its centre comes nearer to one triangle (the one it goes
+       through) and, by less than tol, to the other (which it leaves): the second
+       triangle's START once cancelled the first's sweep hit, for the whole quad, and
+       the ball went through. The same with the floor lifted through the ball. */
+    const char *diag = "v\nfrom 0 -10 5\nat 0 0 0\nup 0 0 1\nangle 45\nhither 0.01\n"
+                       "resolution 8 8\nl 0 0 4\nf 0.8 0.8 0.8 1 0 0 0 0\n"
+                       "p 4\n-4 -4 0\n4 -4 0\n4 4 0\n-4 4 0\n" /* id 0: the floor */
+                       "s 1 1 0.00099 0.001\n";                  /* id 1: sunk in both halves */
+    static const struct sunk_case across[] = {
+        {"move 1 -0.5 0.5 -0.0021", VW_OUT_SWEEP, 0}, /* through, stepping aside: accepted */
+        {"move 0 0.5 -0.5 0.0021", VW_OUT_SWEEP, 1},  /* the floor up through it: accepted */
+        {"move 1 0 0 -0.0021", VW_OUT_SWEEP, 0},      /* straight through */
+        {"move 1 0.5 0 0.002", VW_OUT_ACCEPTED, -1},  /* off it, stepping aside */
+    };
+    sunk_cases(d, cfg, diag, across, sizeof across / sizeof across[0]);
+}
+
+/* Applies each edit (sweep on) to the scene, in order, on the cells of d and by brute
+   force, and checks its outcome and the obstacle named. */
+static void sunk_cases(const vw_decomp *d, const vw_config *cfg, const char *nff,
+                       const struct sunk_case *cases, size_t ncases)
+{
     for (int brute = 0; brute < 2; brute++) {
         char err[256];
         vw_scene *s;
@@ -563,7 +592,7 @@ static void test_sunk_through(const vw_decomp *d, const vw_config *cfg)
         vw_dynscene_params p = {d, cfg, 0, brute};
         vw_dynscene *ds;
         CHECK(vw_dynscene_create(s, &p, &ds, err, sizeof err) == VW_OK);
-        for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        for (size_t i = 0; i < ncases; i++) {
             vw_edit e;
             vw_result r;
             int *ch;

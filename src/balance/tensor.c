@@ -346,7 +346,8 @@ vw_status vw__balance_rotate(const vw_decomp *cur, const vw_load_field *f,
         best = NULL;
         if (turned) st = tensor_in_frame(f, bestF, &best_wb, dims, p->min_width, NULL, &d);
         if (st == VW_OK) st = vw__balance_tensor(cur, f, p, dims, &flat);
-        if (st == VW_OK && d && cells_lambda(f, d, p, ld, map) < cells_lambda(f, flat, p, ld, map) - 1e-9) {
+        if (st == VW_OK && d &&
+            cells_lambda(f, d, p, ld, map) < cells_lambda(f, flat, p, ld, map) - 1e-9) {
             best = d;
             vw_decomp_free(flat);
         } else {

@@ -8,8 +8,7 @@
 
 /* The test of one probe against one obstacle shape, as a cell runs it: VW_PROBE_END
    and/or one of VW_PROBE_SWEEP, VW_PROBE_START and VW_PROBE_THROUGH (dynamic.h), 0 for
-   no hit. The
-   brute-force reference uses it too, so both decide by one rule. */
+   no hit. The brute-force reference uses it too, so both decide by one rule. */
 int vw__probe_test(const vw_probe *p, const vw_shape *o, double tol);
 
 /* Whether a, swept by d, comes nearer to b along its path than it is at its start, by

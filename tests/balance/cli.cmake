@@ -160,9 +160,9 @@ foreach(bal none divide duplicate)
 endforeach()
 
 # A balancer with --map greedy starts from the layout --balance none gives (the first
-# layout mapped by its measured loads), so it ends no worse: it kept tensor's walls, or
+# layout mapped by its measured loads), so it ends no worse. It kept tensor's walls, or
 # staggered slabs, because they measured better than the grid as first mapped, before any
-# load was known (work lambda 1.176 against none's 1.024 on 2x2x2 cells, 3 workers).
+# load was known: work lambda 1.176 against none's 1.024 on 2x2x2 cells, 3 workers.
 foreach(bal none tensor staggered)
   execute_process(COMMAND ${VWALLS} render ${SCENE} -o ${WORK}/start_${bal}.png ${common}
                   --cells 2x2x2 --workers 3 --map greedy --balance ${bal} --balance-load segments

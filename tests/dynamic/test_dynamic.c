@@ -532,11 +532,6 @@ static void test_cone_slack(const vw_decomp *d, const vw_config *cfg)
         }
 }
 
-/* An object a mover starts sunk in is exempt from the sweep only along a path that
-   takes it no deeper: a sphere sunk in a floor by a hair more than the tolerance (1e-6,
-   the rounding of a scene written with six digits) went through the floor with sweep
-   on, where one resting on it exactly was stopped; a triangle sunk in a sphere went
-   through the sphere's middle. Leaving stays free. */
 struct sunk_case {
     const char *edit;
     int outcome, obstacle;
@@ -544,6 +539,11 @@ struct sunk_case {
 static void sunk_cases(const vw_decomp *d, const vw_config *cfg, const char *nff,
                        const struct sunk_case *cases, size_t ncases);
 
+/* An object a mover starts sunk in is exempt from the sweep only along a path that
+   takes it no deeper: a sphere sunk in a floor by a hair more than the tolerance (1e-6,
+   the rounding of a scene written with six digits) went through the floor with sweep
+   on, where one resting on it exactly was stopped; a triangle sunk in a sphere went
+   through the sphere's middle. Leaving stays free. */
 static void test_sunk_through(const vw_decomp *d, const vw_config *cfg)
 {
     const char *nff = "v\nfrom 0 -20 0\nat 0 0 0\nup 0 0 1\nangle 40\nhither 0.01\n"
